@@ -1,0 +1,967 @@
+//! The stateful controller of one agent: configuration, owned estimates (S9, S10), the
+//! table of what it last heard from each neighbour, and the control step.
+
+use crate::config::{AgentConfig, AgentId, ConfigError, EstimatorMode, LeaderRole, Schedule};
+use crate::geometry::AngleGeometry;
+use crate::law;
+use crate::wire::{decode_frame, FrameError, FrameWriter, WireItem};
+use crate::{FrameStats, Real, Vec2};
+
+/// No neighbour slot (the vertex is this agent itself).
+const SELF_SLOT: usize = usize::MAX;
+
+/// One bearing measured by this agent.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BearingMeasurement<T: Real> {
+    /// The neighbour it points to.
+    pub neighbour: AgentId,
+    /// Unit bearing `s_{n,neighbour}` in the shared world frame (S2).
+    pub bearing: Vec2<T>,
+    /// Measured bearing rate `ṡ`, if the sensor gives one. Without it the agent uses the
+    /// finite difference of successive bearings (zero on the first step).
+    pub rate: Option<Vec2<T>>,
+    /// Measured distance, for [`EstimatorMode::Measured`].
+    pub range: Option<T>,
+}
+
+/// What one agent's own sensors give it at one control tick.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Measurements<'a, T: Real> {
+    /// Time in seconds (for the `v*`, `z*` schedules).
+    pub time: T,
+    /// Seconds since the previous step (the estimator's `Δt`, finite differences and
+    /// neighbour ages). Zero is allowed (no time passes).
+    pub dt: T,
+    /// Own velocity `v_n` (world frame).
+    pub velocity: Vec2<T>,
+    /// Bearings to the neighbours (every triangle neighbour, every tick).
+    pub bearings: &'a [BearingMeasurement<T>],
+    /// Leaders only: the partner's position minus this agent's (relative-position sensor).
+    pub partner_offset: Option<Vec2<T>>,
+}
+
+/// A measurement the agent refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum MeasurementError {
+    /// Time, `Δt` (negative), velocity or partner offset is NaN or infinite.
+    NonFinite,
+    /// The bearing to this neighbour is not a finite unit vector (or its rate is not finite).
+    BadBearing(AgentId),
+    /// The bearing's neighbour is not a neighbour of this agent.
+    UnknownNeighbour(AgentId),
+    /// Two bearings to the same neighbour.
+    DuplicateBearing(AgentId),
+    /// A range that is not finite and positive.
+    BadRange(AgentId),
+}
+
+/// Why a step produced the safe output instead of the control law.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Fault {
+    /// The measurements were refused.
+    Measurement(MeasurementError),
+    /// No bearing to this triangle neighbour this tick.
+    MissingBearing(AgentId),
+    /// Nothing heard from this neighbour for longer than the timeout (or ever).
+    Stale(AgentId),
+    /// This neighbour's frames lacked something the step needs (its velocity, its
+    /// bearing to a common neighbour, or the estimate it owns).
+    MissingData(AgentId),
+    /// A leader without the partner's relative position.
+    MissingPartnerOffset,
+    /// [`EstimatorMode::Measured`] without a range to this neighbour.
+    MissingRange(AgentId),
+    /// The computed force was not finite.
+    NonFinite,
+}
+
+/// The kind of output of a step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Status {
+    /// The control law S7–S12 (saturated to `max_force`).
+    Nominal,
+    /// The safe output `U = −safe_damping · v` (no formation force), and why.
+    Safe(Fault),
+}
+
+/// The result of [`Agent::step`]. `force` is always finite and at most `max_force` long.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepOutput<T: Real> {
+    /// The force command `U_n`.
+    pub force: Vec2<T>,
+    /// Control law or safe output.
+    pub status: Status,
+    /// The force was scaled down to `max_force`.
+    pub saturated: bool,
+    /// A current angle is within the configured margin of 0 or π (SPEC §3).
+    pub degenerate: bool,
+}
+
+#[cfg(feature = "defmt")]
+impl<T: Real> defmt::Format for StepOutput<T> {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(
+            f,
+            "StepOutput {{ force: ({}, {}), status: {}, saturated: {}, degenerate: {} }}",
+            self.force.x,
+            self.force.y,
+            self.status,
+            self.saturated,
+            self.degenerate
+        )
+    }
+}
+
+/// The control law evaluated without changing any state (see [`Agent::evaluate`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Evaluation<T: Real, const MT: usize> {
+    /// `U_n` before saturation.
+    pub force: Vec2<T>,
+    /// S9 with the S10 projection for every estimate this agent owns, indexed
+    /// `[triangle][angle][edge]` (zero where it owns none).
+    pub estimate_rates: heapless::Vec<[[T; 2]; 2], MT>,
+    /// A current angle is within the configured margin of 0 or π.
+    pub degenerate: bool,
+}
+
+/// One estimate owned by this agent (see [`Agent::owned_estimates`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct OwnedEstimate<T> {
+    /// Triangle index in the configuration.
+    pub triangle: usize,
+    /// Controlled angle index (0 or 1) in the triangle.
+    pub angle: usize,
+    /// Edge index: 0 is apex → first far vertex, 1 is apex → second far vertex.
+    pub edge: usize,
+    /// The angle's apex.
+    pub apex: AgentId,
+    /// The far vertex of the edge.
+    pub far: AgentId,
+    /// `r̂`.
+    pub value: T,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Role {
+    Apex,
+    Far(usize),
+}
+
+#[derive(Clone, Copy, Debug)]
+struct AngleState<T: Real> {
+    apex: AgentId,
+    far: [AgentId; 2],
+    role: Role,
+    /// Neighbour slots of `[apex, far0, far1]` (`SELF_SLOT` for this agent).
+    slots: [usize; 3],
+    cos_desired: T,
+    stiffness: T,
+    damping: T,
+    estimator_gain: T,
+    /// Own estimates for edges `[apex–far0, apex–far1]` (only the owned ones are used).
+    estimate: [T; 2],
+    /// Far vertex only: the apex's bearing and rate to the other far vertex.
+    remote_bearing: Option<(Vec2<T>, Vec2<T>)>,
+    /// Far vertex, shared mode only: the apex's estimate for this agent's edge.
+    remote_estimate: Option<T>,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Neighbour<T: Real> {
+    id: AgentId,
+    /// Is in a triangle with this agent (needs a bearing every tick).
+    in_triangle: bool,
+    /// Some triangle neighbour needs this agent's bearing to it (far vertex of own apex angle).
+    bearing_needed: bool,
+    heard: bool,
+    age: T,
+    last_seq: Option<u16>,
+    velocity: Option<Vec2<T>>,
+    bearing: Option<Vec2<T>>,
+    rate: Vec2<T>,
+    range: Option<T>,
+    fresh: bool,
+}
+
+/// One agent's controller: `MT` triangles at most, `NB` neighbours at most.
+///
+/// Per control tick: [`Agent::receive`] each frame heard since the last tick, then
+/// [`Agent::step`] with the own measurements, then [`Agent::frames`] to broadcast.
+/// Nothing here allocates or panics.
+#[derive(Clone, Debug)]
+pub struct Agent<T: Real, const MT: usize, const NB: usize> {
+    config: AgentConfig<T, MT>,
+    angles: heapless::Vec<[AngleState<T>; 2], MT>,
+    neighbours: heapless::Vec<Neighbour<T>, NB>,
+    partner_slot: usize,
+    time: T,
+    velocity: Vec2<T>,
+    partner_offset: Option<Vec2<T>>,
+    seq: u16,
+    stats: FrameStats,
+}
+
+fn finite_vec<T: Real>(v: &Vec2<T>) -> bool {
+    v.x.finite() && v.y.finite()
+}
+
+fn finite_pair<T: Real>(v: &[T; 2], min: T) -> bool {
+    v[0].finite() && v[1].finite() && v[0] >= min && v[1] >= min
+}
+
+/// `x[k]` for `k ∈ {0, 1}` (any other `k` reads index 1): panic-free pair indexing.
+#[inline]
+fn pick<X: Copy>(x: &[X; 2], k: usize) -> X {
+    if k == 0 {
+        x[0]
+    } else {
+        x[1]
+    }
+}
+
+/// Apex bearings `[s_uv, s_uw]` and their rates, as seen by one agent.
+type ApexBearings<T> = ([Vec2<T>; 2], [Vec2<T>; 2]);
+
+fn vec2<T: Real>(a: [T; 2]) -> Vec2<T> {
+    Vec2::new(a[0], a[1])
+}
+
+fn schedule_ok<T: Real>(s: &Schedule<T>) -> bool {
+    s.steps
+        .iter()
+        .all(|st| st.from.finite() && st.value[0].finite() && st.value[1].finite())
+}
+
+impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
+    /// Checks `config` (SPEC §3 validity, gains, capacity) and builds the agent.
+    pub fn new(config: AgentConfig<T, MT>) -> Result<Self, ConfigError> {
+        Self::check_parameters(&config)?;
+        let me = config.id;
+        let mut neighbours: heapless::Vec<Neighbour<T>, NB> = heapless::Vec::new();
+        let mut angles = heapless::Vec::new();
+        for (ti, tri) in config.triangles.iter().enumerate() {
+            Self::check_triangle(me, ti, tri, &config.limits)?;
+            let mut pair = [None, None];
+            for (ai, a) in tri.angles.iter().enumerate() {
+                let mut far = [0; 2];
+                let mut k = 0;
+                for &v in &tri.vertices {
+                    if v != a.apex {
+                        if let Some(f) = far.get_mut(k) {
+                            *f = v;
+                        }
+                        k += 1;
+                    }
+                }
+                let role = if a.apex == me {
+                    Role::Apex
+                } else if far[0] == me {
+                    Role::Far(0)
+                } else {
+                    Role::Far(1)
+                };
+                let mut slots = [SELF_SLOT; 3];
+                for (slot, id) in slots.iter_mut().zip([a.apex, far[0], far[1]]) {
+                    if id != me {
+                        *slot = Self::add_neighbour(&mut neighbours, id, true)?;
+                    }
+                }
+                if role == Role::Apex {
+                    for &s in &slots[1..] {
+                        if let Some(n) = neighbours.get_mut(s) {
+                            n.bearing_needed = true;
+                        }
+                    }
+                }
+                if let Some(p) = pair.get_mut(ai) {
+                    *p = Some(AngleState {
+                        apex: a.apex,
+                        far,
+                        role,
+                        slots,
+                        cos_desired: a.cos_desired,
+                        stiffness: a.stiffness,
+                        damping: a.damping,
+                        estimator_gain: a.estimator_gain,
+                        estimate: [config.initial_estimate; 2],
+                        remote_bearing: None,
+                        remote_estimate: None,
+                    });
+                }
+            }
+            if let [Some(a0), Some(a1)] = pair {
+                angles
+                    .push([a0, a1])
+                    .map_err(|_| ConfigError::TooManyNeighbours)?;
+            }
+        }
+        let partner_slot = match &config.leader {
+            Some(l) => Self::add_neighbour(&mut neighbours, l.partner, false)?,
+            None => SELF_SLOT,
+        };
+        Ok(Self {
+            config,
+            angles,
+            neighbours,
+            partner_slot,
+            time: T::zero(),
+            velocity: Vec2::zeros(),
+            partner_offset: None,
+            seq: 0,
+            stats: FrameStats::default(),
+        })
+    }
+
+    fn check_parameters(c: &AgentConfig<T, MT>) -> Result<(), ConfigError> {
+        let l = &c.limits;
+        let zero = T::zero();
+        let ok = c.min_estimate.finite()
+            && c.min_estimate > zero
+            && c.initial_estimate.finite()
+            && c.initial_estimate >= c.min_estimate
+            && finite_pair(&c.friction, zero)
+            && finite_pair(&c.velocity_damping, zero)
+            && schedule_ok(&c.velocity_reference)
+            && l.max_force.finite()
+            && l.max_force > zero
+            && l.neighbour_timeout.finite()
+            && l.neighbour_timeout > zero
+            && l.safe_damping.finite()
+            && l.safe_damping >= zero
+            && l.bearing_tolerance.finite()
+            && l.bearing_tolerance > zero
+            && l.margin_cos.finite()
+            && l.margin_cos > zero
+            && l.margin_cos < T::one();
+        if !ok {
+            return Err(ConfigError::BadParameter);
+        }
+        if let Some(ld) = &c.leader {
+            if ld.partner == c.id {
+                return Err(ConfigError::BadLeader);
+            }
+            if !(ld.stiffness.finite()
+                && ld.stiffness > zero
+                && finite_pair(&ld.damping, zero)
+                && schedule_ok(&ld.displacement))
+            {
+                return Err(ConfigError::BadParameter);
+            }
+        }
+        Ok(())
+    }
+
+    fn check_triangle(
+        me: AgentId,
+        ti: usize,
+        tri: &crate::TriangleConfig<T>,
+        limits: &crate::Limits<T>,
+    ) -> Result<(), ConfigError> {
+        let [a, b, c] = tri.vertices;
+        if a == b || b == c || a == c {
+            return Err(ConfigError::RepeatedVertex { triangle: ti });
+        }
+        if !tri.vertices.contains(&me) {
+            return Err(ConfigError::NotInTriangle { triangle: ti });
+        }
+        let [x, y] = &tri.angles;
+        if x.apex == y.apex || !tri.vertices.contains(&x.apex) || !tri.vertices.contains(&y.apex) {
+            return Err(ConfigError::BadApex { triangle: ti });
+        }
+        let zero = T::zero();
+        for an in &tri.angles {
+            if !(an.stiffness.finite()
+                && an.stiffness > zero
+                && an.damping.finite()
+                && an.damping >= zero
+                && an.estimator_gain.finite()
+                && an.estimator_gain > zero)
+            {
+                return Err(ConfigError::BadGain { triangle: ti });
+            }
+            // SPEC §3: margin < α* < π − margin, i.e. |cos α*| < cos(margin).
+            if !(an.cos_desired.finite() && an.cos_desired.abs() < limits.margin_cos) {
+                return Err(ConfigError::InfeasibleAngles { triangle: ti });
+            }
+        }
+        // SPEC §3: α₁ + α₂ < π  ⇔  cos α₁ > cos(π − α₂) = −cos α₂.
+        if x.cos_desired + y.cos_desired <= zero {
+            return Err(ConfigError::InfeasibleAngles { triangle: ti });
+        }
+        Ok(())
+    }
+
+    fn add_neighbour(
+        list: &mut heapless::Vec<Neighbour<T>, NB>,
+        id: AgentId,
+        in_triangle: bool,
+    ) -> Result<usize, ConfigError> {
+        if let Some(i) = list.iter().position(|n| n.id == id) {
+            if let Some(n) = list.get_mut(i) {
+                n.in_triangle |= in_triangle;
+            }
+            return Ok(i);
+        }
+        list.push(Neighbour {
+            id,
+            in_triangle,
+            bearing_needed: false,
+            heard: false,
+            age: T::zero(),
+            last_seq: None,
+            velocity: None,
+            bearing: None,
+            rate: Vec2::zeros(),
+            range: None,
+            fresh: false,
+        })
+        .map_err(|_| ConfigError::TooManyNeighbours)?;
+        Ok(list.len() - 1)
+    }
+
+    /// This agent's id.
+    pub fn id(&self) -> AgentId {
+        self.config.id
+    }
+
+    /// The configuration it was built with.
+    pub fn config(&self) -> &AgentConfig<T, MT> {
+        &self.config
+    }
+
+    /// Ids of all neighbours (triangle neighbours and leader partner).
+    pub fn neighbours(&self) -> impl Iterator<Item = AgentId> + '_ {
+        self.neighbours.iter().map(|n| n.id)
+    }
+
+    /// Counters of accepted and rejected frames.
+    pub fn stats(&self) -> &FrameStats {
+        &self.stats
+    }
+
+    fn slot(&self, id: AgentId) -> Option<usize> {
+        self.neighbours.iter().position(|n| n.id == id)
+    }
+
+    // ---------------------------------------------------------------- sensing
+
+    /// Checks and stores the own measurements (bearings, rates, velocity, time) and ages
+    /// the neighbour table by `dt`. Nothing changes if they are refused.
+    pub fn sense(&mut self, m: &Measurements<'_, T>) -> Result<(), Fault> {
+        let bad = |e| Err(Fault::Measurement(e));
+        if !(m.time.finite() && m.dt.finite() && m.dt >= T::zero() && finite_vec(&m.velocity)) {
+            return bad(MeasurementError::NonFinite);
+        }
+        if let Some(p) = &m.partner_offset {
+            if !finite_vec(p) {
+                return bad(MeasurementError::NonFinite);
+            }
+        }
+        let tol = self.config.limits.bearing_tolerance;
+        for (i, b) in m.bearings.iter().enumerate() {
+            let id = b.neighbour;
+            if self.slot(id).is_none() {
+                return bad(MeasurementError::UnknownNeighbour(id));
+            }
+            if m.bearings.iter().take(i).any(|o| o.neighbour == id) {
+                return bad(MeasurementError::DuplicateBearing(id));
+            }
+            let s = &b.bearing;
+            let unit = finite_vec(s) && (s.dot(s) - T::one()).abs() <= tol;
+            if !unit || !b.rate.as_ref().is_none_or(finite_vec) {
+                return bad(MeasurementError::BadBearing(id));
+            }
+            if let Some(r) = b.range {
+                if !(r.finite() && r > T::zero()) {
+                    return bad(MeasurementError::BadRange(id));
+                }
+            }
+        }
+        self.time = m.time;
+        self.velocity = m.velocity;
+        self.partner_offset = m.partner_offset;
+        for n in self.neighbours.iter_mut() {
+            n.fresh = false;
+            n.range = None;
+            n.age += m.dt;
+        }
+        for b in m.bearings {
+            let Some(n) = self.neighbours.iter_mut().find(|n| n.id == b.neighbour) else {
+                continue;
+            };
+            n.rate = match (b.rate, n.bearing) {
+                (Some(rate), _) => rate,
+                // Finite difference of successive bearings (SPEC §2).
+                (None, Some(prev)) if m.dt > T::zero() => (b.bearing - prev) / m.dt,
+                _ => Vec2::zeros(),
+            };
+            n.bearing = Some(b.bearing);
+            n.range = b.range;
+            n.fresh = true;
+        }
+        Ok(())
+    }
+
+    // ---------------------------------------------------------------- control law
+
+    fn neighbour(&self, slot: usize) -> Option<&Neighbour<T>> {
+        self.neighbours.get(slot)
+    }
+
+    fn neighbour_velocity(&self, slot: usize) -> Result<Vec2<T>, Fault> {
+        match self.neighbour(slot) {
+            None => Ok(self.velocity),
+            Some(n) => n.velocity.ok_or(Fault::MissingData(n.id)),
+        }
+    }
+
+    /// Own measured bearing and rate to the neighbour in `slot`.
+    fn own_bearing(&self, slot: usize) -> Result<(Vec2<T>, Vec2<T>), Fault> {
+        let n = self.neighbour(slot).ok_or(Fault::NonFinite)?;
+        match (n.fresh, n.bearing) {
+            (true, Some(s)) => Ok((s, n.rate)),
+            _ => Err(Fault::MissingBearing(n.id)),
+        }
+    }
+
+    /// The apex bearings `[s_uv, s_uw]` and rates of an angle, seen by this agent.
+    fn angle_bearings(&self, a: &AngleState<T>) -> Result<ApexBearings<T>, Fault> {
+        match a.role {
+            Role::Apex => {
+                let (s0, d0) = self.own_bearing(a.slots[1])?;
+                let (s1, d1) = self.own_bearing(a.slots[2])?;
+                Ok(([s0, s1], [d0, d1]))
+            }
+            Role::Far(k) => {
+                // s_uk = −s_ku: own bearing to the apex, reversed (SPEC §2).
+                let (s_k, d_k) = self.own_bearing(a.slots[0])?;
+                let (s_j, d_j) = a.remote_bearing.ok_or(Fault::MissingData(a.apex))?;
+                Ok(if k == 0 {
+                    ([-s_k, s_j], [-d_k, d_j])
+                } else {
+                    ([s_j, -s_k], [d_j, -d_k])
+                })
+            }
+        }
+    }
+
+    /// Distances `[r_uv, r_uw]` used in S8 (only the ones this agent's force needs).
+    fn angle_distances(&self, a: &AngleState<T>) -> Result<[T; 2], Fault> {
+        match (self.config.estimator, a.role) {
+            (EstimatorMode::Shared, Role::Far(k)) => {
+                let r = a.remote_estimate.ok_or(Fault::MissingData(a.apex))?;
+                let mut out = a.estimate;
+                if let Some(o) = out.get_mut(k) {
+                    *o = r;
+                }
+                Ok(out)
+            }
+            (EstimatorMode::Shared | EstimatorMode::PerAgent, _) => Ok(a.estimate),
+            (EstimatorMode::Measured, Role::Apex) => {
+                Ok([self.range(a.slots[1])?, self.range(a.slots[2])?])
+            }
+            (EstimatorMode::Measured, Role::Far(k)) => {
+                let mut out = [T::one(); 2];
+                if let Some(o) = out.get_mut(k) {
+                    *o = self.range(a.slots[0])?;
+                }
+                Ok(out)
+            }
+        }
+    }
+
+    fn range(&self, slot: usize) -> Result<T, Fault> {
+        let n = self.neighbour(slot).ok_or(Fault::NonFinite)?;
+        n.range.ok_or(Fault::MissingRange(n.id))
+    }
+
+    /// Whether this agent owns (integrates) the estimate of `edge` of angle `a`.
+    fn owns(&self, a: &AngleState<T>, edge: usize) -> bool {
+        match (self.config.estimator, a.role) {
+            (EstimatorMode::Measured, _) => false,
+            (_, Role::Apex) => true,
+            (EstimatorMode::PerAgent, Role::Far(k)) => k == edge,
+            (EstimatorMode::Shared, Role::Far(_)) => false,
+        }
+    }
+
+    /// Checks that every neighbour has been heard recently (or reports the stale one).
+    fn check_fresh(&self) -> Result<(), Fault> {
+        let timeout = self.config.limits.neighbour_timeout;
+        for n in &self.neighbours {
+            if !n.heard || n.age > timeout {
+                return Err(Fault::Stale(n.id));
+            }
+        }
+        Ok(())
+    }
+
+    /// Evaluates the control law S7–S12 and the estimator flows S9/S10 on the stored
+    /// measurements and neighbour data, without changing anything. Used by [`Agent::step`]
+    /// and by simulators that integrate the estimators themselves (continuous time).
+    pub fn evaluate(&self) -> Result<Evaluation<T, MT>, Fault> {
+        self.check_fresh()?;
+        let c = &self.config;
+        let v = self.velocity;
+        let v_star = vec2(c.velocity_reference.at(self.time));
+        // S12.
+        let mut force = law::velocity_force(&c.friction, &c.velocity_damping, &v, &v_star);
+        let mut rates = heapless::Vec::new();
+        let mut degenerate = false;
+        let r_min = c.min_estimate;
+        for tri in &self.angles {
+            let mut tri_rates = [[T::zero(); 2]; 2];
+            for (a, out) in tri.iter().zip(tri_rates.iter_mut()) {
+                let (s, s_dot) = self.angle_bearings(a)?;
+                // S4–S6.
+                let geo = AngleGeometry::new(&s, &s_dot);
+                degenerate |= geo.y.abs() > c.limits.margin_cos;
+                // S7.
+                let gamma =
+                    law::port_effort(a.stiffness, a.damping, geo.y - a.cos_desired, geo.y_dot);
+                let r = self.angle_distances(a)?;
+                // S8.
+                force += match a.role {
+                    Role::Apex => law::apex_force(gamma, &geo.g, r),
+                    Role::Far(k) => law::far_vertex_force(gamma, &pick(&geo.g, k), pick(&r, k)),
+                };
+                // S9/S10 for the estimates this agent owns.
+                for (e, rate) in out.iter_mut().enumerate() {
+                    if !self.owns(a, e) {
+                        continue;
+                    }
+                    let r_hat = pick(&a.estimate, e);
+                    let (s_e, g_e) = (pick(&s, e), pick(&geo.g, e));
+                    let (range_rate, share) = match a.role {
+                        Role::Apex => {
+                            let v_far =
+                                self.neighbour_velocity(pick(&[a.slots[1], a.slots[2]], e))?;
+                            let rr = crate::geometry::range_rate(&s_e, &(v_far - v));
+                            let share = match c.estimator {
+                                EstimatorMode::PerAgent => law::own_share(&g_e, &v, r_hat, false),
+                                _ => pick(&geo.t, e),
+                            };
+                            (rr, share)
+                        }
+                        Role::Far(_) => {
+                            let v_apex = self.neighbour_velocity(a.slots[0])?;
+                            let rr = crate::geometry::range_rate(&s_e, &(v - v_apex));
+                            (rr, law::own_share(&g_e, &v, r_hat, true))
+                        }
+                    };
+                    let flow =
+                        law::estimator_rate(range_rate, gamma, share, a.estimator_gain, r_hat);
+                    *rate = law::projected_rate(r_hat, flow, r_min);
+                }
+            }
+            // Capacity equals the number of triangles: cannot fail.
+            let _ = rates.push(tri_rates);
+        }
+        if let Some(l) = &c.leader {
+            // S11 with z = q_a − q_b.
+            let p = self.partner_offset.ok_or(Fault::MissingPartnerOffset)?;
+            let v_p = self.neighbour_velocity(self.partner_slot)?;
+            let z_star = vec2(l.displacement.at(self.time));
+            let (z, z_dot, sign) = match l.role {
+                LeaderRole::A => (-p, v - v_p, T::one()),
+                LeaderRole::B => (p, v_p - v, -T::one()),
+            };
+            force += law::leader_force(l.stiffness, &l.damping, &(z - z_star), &z_dot) * sign;
+        }
+        if !finite_vec(&force) {
+            return Err(Fault::NonFinite);
+        }
+        Ok(Evaluation {
+            force,
+            estimate_rates: rates,
+            degenerate,
+        })
+    }
+
+    /// One control tick: [`Agent::sense`], [`Agent::evaluate`], integrate the owned
+    /// estimates (sampled S10), saturate. On any fault the output is the documented safe
+    /// command `U = −safe_damping · v` (no formation force) and the estimates hold still.
+    pub fn step(&mut self, m: &Measurements<'_, T>) -> StepOutput<T> {
+        let limit = self.config.limits.max_force;
+        let result = self.sense(m).and_then(|()| self.evaluate());
+        match result {
+            Ok(ev) => {
+                let r_min = self.config.min_estimate;
+                for (tri, rates) in self.angles.iter_mut().zip(ev.estimate_rates.iter()) {
+                    for (a, ar) in tri.iter_mut().zip(rates.iter()) {
+                        for (est, rate) in a.estimate.iter_mut().zip(ar.iter()) {
+                            *est = law::estimator_step(*est, *rate, m.dt, r_min);
+                        }
+                    }
+                }
+                let (force, saturated) = law::saturate(&ev.force, limit);
+                StepOutput {
+                    force,
+                    status: Status::Nominal,
+                    saturated,
+                    degenerate: ev.degenerate,
+                }
+            }
+            Err(fault) => {
+                let v = if finite_vec(&m.velocity) {
+                    m.velocity
+                } else {
+                    Vec2::zeros()
+                };
+                let (force, saturated) =
+                    law::saturate(&(v * -self.config.limits.safe_damping), limit);
+                StepOutput {
+                    force,
+                    status: Status::Safe(fault),
+                    saturated,
+                    degenerate: false,
+                }
+            }
+        }
+    }
+
+    // ---------------------------------------------------------------- estimates
+
+    /// The estimates this agent owns and integrates, with where they belong.
+    pub fn owned_estimates(&self) -> impl Iterator<Item = OwnedEstimate<T>> + '_ {
+        self.angles.iter().enumerate().flat_map(move |(ti, tri)| {
+            tri.iter().enumerate().flat_map(move |(ai, a)| {
+                (0..2usize)
+                    .filter(move |&e| self.owns(a, e))
+                    .map(move |e| OwnedEstimate {
+                        triangle: ti,
+                        angle: ai,
+                        edge: e,
+                        apex: a.apex,
+                        far: pick(&a.far, e),
+                        value: pick(&a.estimate, e),
+                    })
+            })
+        })
+    }
+
+    /// Overwrites an owned estimate (for simulators integrating S9 in continuous time).
+    /// Values are clamped to `r_min`; returns `false` for an estimate this agent does not own
+    /// or a non-finite value.
+    pub fn set_estimate(&mut self, triangle: usize, angle: usize, edge: usize, value: T) -> bool {
+        let owned = match self.angles.get(triangle).and_then(|t| t.get(angle)) {
+            Some(a) => self.owns(a, edge),
+            None => false,
+        };
+        let r_min = self.config.min_estimate;
+        let slot = self
+            .angles
+            .get_mut(triangle)
+            .and_then(|t| t.get_mut(angle))
+            .and_then(|a| a.estimate.get_mut(edge));
+        match slot {
+            Some(s) if owned && value.finite() => {
+                *s = if value > r_min { value } else { r_min };
+                true
+            }
+            _ => false,
+        }
+    }
+
+    // ---------------------------------------------------------------- communication
+
+    /// Calls `f` for everything this agent broadcasts: velocity, the bearings its
+    /// neighbours need, and (shared mode) the estimates it owns.
+    fn for_each_item(&self, mut f: impl FnMut(Item<T>)) {
+        f(Item::Velocity(self.velocity));
+        for n in &self.neighbours {
+            if let (true, true, Some(s)) = (n.bearing_needed, n.fresh, n.bearing) {
+                f(Item::Bearing {
+                    to: n.id,
+                    s,
+                    rate: n.rate,
+                });
+            }
+        }
+        if self.config.estimator == EstimatorMode::Shared {
+            for a in self
+                .angles
+                .iter()
+                .flatten()
+                .filter(|a| a.role == Role::Apex)
+            {
+                f(Item::Estimate {
+                    far: a.far[0],
+                    other: a.far[1],
+                    r: a.estimate[0],
+                });
+                f(Item::Estimate {
+                    far: a.far[1],
+                    other: a.far[0],
+                    r: a.estimate[1],
+                });
+            }
+        }
+    }
+
+    /// Encodes this tick's broadcast into frames of at most 60 bytes and passes each to
+    /// `send`. Returns the number of frames.
+    pub fn frames(&mut self, mut send: impl FnMut(&[u8])) -> usize {
+        let id = self.config.id;
+        let mut seq = self.seq;
+        let mut count = 0;
+        let mut writer = FrameWriter::new(id, seq);
+        self.for_each_item(|item| {
+            let wire = item.to_wire();
+            if !writer.push(&wire) {
+                send(writer.finish());
+                count += 1;
+                seq = seq.wrapping_add(1);
+                writer = FrameWriter::new(id, seq);
+                // A single item always fits in an empty frame.
+                let _ = writer.push(&wire);
+            }
+        });
+        if writer.items() > 0 {
+            send(writer.finish());
+            count += 1;
+            seq = seq.wrapping_add(1);
+        }
+        self.seq = seq;
+        count
+    }
+
+    /// Decodes and applies one received frame. Rejected frames change nothing but the
+    /// counters. A neighbour that was stale may restart its sequence numbers.
+    pub fn receive(&mut self, bytes: &[u8]) -> Result<(), FrameError> {
+        let result = self.receive_inner(bytes);
+        self.stats.record(&result);
+        result
+    }
+
+    fn receive_inner(&mut self, bytes: &[u8]) -> Result<(), FrameError> {
+        let frame = decode_frame(bytes, self.config.limits.bearing_tolerance.as_f32())?;
+        let sender = frame.header.sender;
+        if sender == self.config.id {
+            return Err(FrameError::OwnFrame);
+        }
+        let slot = self.slot(sender).ok_or(FrameError::UnknownSender(sender))?;
+        let timeout = self.config.limits.neighbour_timeout;
+        let n = self
+            .neighbours
+            .get_mut(slot)
+            .ok_or(FrameError::UnknownSender(sender))?;
+        let seq = frame.header.seq;
+        if let Some(last) = n.last_seq {
+            // Serial-number arithmetic: newer means ahead by 1..=32767.
+            let ahead = seq.wrapping_sub(last);
+            let resync = !n.heard || n.age > timeout;
+            if (ahead == 0 || ahead >= 0x8000) && !resync {
+                return Err(FrameError::StaleSequence { sender, seq });
+            }
+        }
+        n.last_seq = Some(seq);
+        n.heard = true;
+        n.age = T::zero();
+        for item in &frame.items {
+            self.apply(sender, slot, Item::from_wire(item));
+        }
+        Ok(())
+    }
+
+    /// Takes a neighbour's broadcast directly, without the wire (no `f32` rounding, no
+    /// sequence numbers): for in-process simulation and tests.
+    pub fn receive_direct(&mut self, from: &Self) -> Result<(), FrameError> {
+        let sender = from.id();
+        let slot = self.slot(sender).ok_or(FrameError::UnknownSender(sender))?;
+        if let Some(n) = self.neighbours.get_mut(slot) {
+            n.heard = true;
+            n.age = T::zero();
+        }
+        from.for_each_item(|item| self.apply(sender, slot, item));
+        Ok(())
+    }
+
+    fn apply(&mut self, sender: AgentId, slot: usize, item: Item<T>) {
+        let me = self.config.id;
+        match item {
+            Item::Velocity(v) => {
+                if let Some(n) = self.neighbours.get_mut(slot) {
+                    n.velocity = Some(v);
+                }
+            }
+            Item::Bearing { to, s, rate } => {
+                for a in self.angles.iter_mut().flatten() {
+                    if let Role::Far(k) = a.role {
+                        if a.apex == sender && pick(&a.far, 1 - k.min(1)) == to {
+                            a.remote_bearing = Some((s, rate));
+                        }
+                    }
+                }
+            }
+            Item::Estimate { far, other, r } => {
+                if far != me {
+                    return;
+                }
+                for a in self.angles.iter_mut().flatten() {
+                    if let Role::Far(k) = a.role {
+                        if a.apex == sender && pick(&a.far, 1 - k.min(1)) == other {
+                            a.remote_estimate = Some(r);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A broadcast item at full precision (the wire form is [`WireItem`]).
+#[derive(Clone, Copy, Debug)]
+enum Item<T: Real> {
+    Velocity(Vec2<T>),
+    Bearing {
+        to: AgentId,
+        s: Vec2<T>,
+        rate: Vec2<T>,
+    },
+    Estimate {
+        far: AgentId,
+        other: AgentId,
+        r: T,
+    },
+}
+
+impl<T: Real> Item<T> {
+    fn to_wire(self) -> WireItem {
+        let w = |v: Vec2<T>| [v.x.as_f32(), v.y.as_f32()];
+        match self {
+            Item::Velocity(v) => WireItem::Velocity(w(v)),
+            Item::Bearing { to, s, rate } => WireItem::Bearing {
+                to,
+                s: w(s),
+                rate: w(rate),
+            },
+            Item::Estimate { far, other, r } => WireItem::Estimate {
+                far,
+                other,
+                r: r.as_f32(),
+            },
+        }
+    }
+
+    fn from_wire(w: &WireItem) -> Self {
+        let v = |a: [f32; 2]| Vec2::new(T::of_f32(a[0]), T::of_f32(a[1]));
+        match *w {
+            WireItem::Velocity(x) => Item::Velocity(v(x)),
+            WireItem::Bearing { to, s, rate } => Item::Bearing {
+                to,
+                s: v(s),
+                rate: v(rate),
+            },
+            WireItem::Estimate { far, other, r } => Item::Estimate {
+                far,
+                other,
+                r: T::of_f32(r),
+            },
+        }
+    }
+}

@@ -1,0 +1,234 @@
+//! One agent's local configuration: its triangles, controlled angles, gains, maneuvers
+//! and limits. Everything is fixed-capacity and `serde`-serializable.
+
+use crate::Real;
+use serde::{Deserialize, Serialize};
+
+/// An agent identifier (unique within a formation).
+pub type AgentId = u8;
+
+/// Capacity of a piecewise-constant schedule (`v*`, `z*`).
+pub const MAX_SCHEDULE_STEPS: usize = 8;
+
+/// How the controller gets the distances it needs in S8 (SPEC §6).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum EstimatorMode {
+    /// One passive estimate per angle and edge, owned by the apex and sent to the far vertex (S9, S10).
+    #[default]
+    Shared,
+    /// The paper's structure: every agent of an angle keeps its own copies (not passive).
+    PerAgent,
+    /// A range sensor measures the distances (e.g. UWB); no estimator.
+    Measured,
+}
+
+/// One controlled angle `α = (apex; v, w)` of a triangle.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct AngleConfig<T> {
+    /// The apex `u`; the far vertices are the triangle's two other vertices.
+    pub apex: AgentId,
+    /// `y*_α = cos α*` (S4). The host converts degrees; the core never calls trigonometry.
+    pub cos_desired: T,
+    /// `c_α > 0` (S7), shared by the three agents of the angle.
+    pub stiffness: T,
+    /// `d_α ≥ 0` (S7), shared by the three agents of the angle.
+    pub damping: T,
+    /// `c_e > 0` (S9), for both edges of the angle.
+    pub estimator_gain: T,
+}
+
+/// A triangle of the Laman graph with its two controlled angles.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct TriangleConfig<T> {
+    /// The three vertices.
+    pub vertices: [AgentId; 3],
+    /// The two controlled angles (distinct apexes).
+    pub angles: [AngleConfig<T>; 2],
+}
+
+/// One step of a piecewise-constant schedule: `value` holds from time `from` on.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ScheduleStep<T> {
+    /// Start time in seconds.
+    pub from: T,
+    /// The value `[x, y]`.
+    pub value: [T; 2],
+}
+
+/// A piecewise-constant 2-D schedule, steps sorted by `from`. Before the first step the
+/// first value holds; an empty schedule is zero.
+#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Schedule<T> {
+    /// The steps.
+    pub steps: heapless::Vec<ScheduleStep<T>, MAX_SCHEDULE_STEPS>,
+}
+
+impl<T: Real> Schedule<T> {
+    /// A schedule with one constant value.
+    pub fn constant(value: [T; 2]) -> Self {
+        let mut steps = heapless::Vec::new();
+        // Capacity is at least one: this push cannot fail.
+        let _ = steps.push(ScheduleStep {
+            from: T::zero(),
+            value,
+        });
+        Self { steps }
+    }
+
+    /// The value at time `t`.
+    pub fn at(&self, t: T) -> [T; 2] {
+        let mut value = match self.steps.first() {
+            Some(s) => s.value,
+            None => [T::zero(); 2],
+        };
+        for s in &self.steps {
+            if s.from <= t {
+                value = s.value;
+            }
+        }
+        value
+    }
+}
+
+/// Which end of the leader edge this agent is (SPEC S11 with `z = q_a − q_b`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum LeaderRole {
+    /// Agent `a` (`z = q_a − q_b`, force `−k_z z̃ − D_z ż`).
+    A,
+    /// Agent `b` (force `+k_z z̃ + D_z ż`).
+    B,
+}
+
+/// The leader-edge maneuver (S11).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LeaderConfig<T> {
+    /// This agent's role.
+    pub role: LeaderRole,
+    /// The other leader.
+    pub partner: AgentId,
+    /// `k_z > 0`.
+    pub stiffness: T,
+    /// `D_z` (diagonal).
+    pub damping: [T; 2],
+    /// `z*(t)`: desired `q_a − q_b`.
+    pub displacement: Schedule<T>,
+}
+
+/// Safety limits and input tolerances.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Limits<T> {
+    /// The commanded force is scaled down to this norm (N).
+    pub max_force: T,
+    /// A neighbour not heard from for longer than this (s) is stale: safe output.
+    pub neighbour_timeout: T,
+    /// Safe output: `U = −safe_damping · v` (damp own velocity, no formation force).
+    pub safe_damping: T,
+    /// A bearing `s` is accepted when `| |s|² − 1 | ≤ bearing_tolerance`.
+    pub bearing_tolerance: T,
+    /// `cos` of the angle margin (default 5°): a current angle with `|cos α|` above this
+    /// is reported as degenerate (the output is still computed).
+    pub margin_cos: T,
+}
+
+impl<T: Real> Default for Limits<T> {
+    fn default() -> Self {
+        Self {
+            max_force: T::lit(1.0e3),
+            neighbour_timeout: T::lit(0.1),
+            safe_damping: T::lit(1.0),
+            bearing_tolerance: T::lit(1.0e-3),
+            margin_cos: T::lit(0.996_194_698_091_745_5), // cos 5°
+        }
+    }
+}
+
+/// One agent's complete local configuration, for up to `MT` triangles.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct AgentConfig<T, const MT: usize> {
+    /// This agent's id.
+    pub id: AgentId,
+    /// The triangles this agent belongs to.
+    pub triangles: heapless::Vec<TriangleConfig<T>, MT>,
+    /// Distance source (SPEC §6).
+    pub estimator: EstimatorMode,
+    /// `r̂(0)` (SPEC §6, default 1.0).
+    pub initial_estimate: T,
+    /// `r_min > 0` of S10 (default 0.1).
+    pub min_estimate: T,
+    /// `D^r_n` (diagonal), used by S12 to cancel friction at `v*`.
+    pub friction: [T; 2],
+    /// `D^v_n` (diagonal) of S12.
+    pub velocity_damping: [T; 2],
+    /// `v*(t)` of S12.
+    pub velocity_reference: Schedule<T>,
+    /// The leader-edge maneuver, for the two leaders only.
+    pub leader: Option<LeaderConfig<T>>,
+    /// Safety limits.
+    pub limits: Limits<T>,
+}
+
+impl<T: Real, const MT: usize> AgentConfig<T, MT> {
+    /// A configuration with the SPEC defaults and no triangles yet.
+    pub fn new(id: AgentId) -> Self {
+        Self {
+            id,
+            triangles: heapless::Vec::new(),
+            estimator: EstimatorMode::Shared,
+            initial_estimate: T::one(),
+            min_estimate: T::lit(0.1),
+            friction: [T::zero(); 2],
+            velocity_damping: [T::zero(); 2],
+            velocity_reference: Schedule::default(),
+            leader: None,
+            limits: Limits::default(),
+        }
+    }
+}
+
+/// Why a configuration was refused by [`crate::Agent::new`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ConfigError {
+    /// Triangle `triangle` does not contain this agent.
+    NotInTriangle {
+        /// Index in `triangles`.
+        triangle: usize,
+    },
+    /// Triangle `triangle` repeats a vertex.
+    RepeatedVertex {
+        /// Index in `triangles`.
+        triangle: usize,
+    },
+    /// A controlled angle's apex is not a vertex of its triangle, or both angles share it.
+    BadApex {
+        /// Index in `triangles`.
+        triangle: usize,
+    },
+    /// A desired angle is outside `(margin, π − margin)`, or the two controlled angles of
+    /// the triangle sum to `π` or more (SPEC §3 validity).
+    InfeasibleAngles {
+        /// Index in `triangles`.
+        triangle: usize,
+    },
+    /// A gain is not finite, or `c_α ≤ 0`, `d_α < 0`, `c_e ≤ 0`.
+    BadGain {
+        /// Index in `triangles`.
+        triangle: usize,
+    },
+    /// More distinct neighbours than the capacity `NB`.
+    TooManyNeighbours,
+    /// A scalar parameter (estimate, limit, friction, damping, schedule, leader gain) is
+    /// not finite or out of range.
+    BadParameter,
+    /// The leader partner is this agent itself.
+    BadLeader,
+}

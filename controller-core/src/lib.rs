@@ -1,0 +1,54 @@
+//! # controller-core
+//!
+//! ONE agent's angle-based port-Hamiltonian formation controller (Li, Borja, van der
+//! Schaft, Scherpen), its passive distance estimators and its wire frames, as it runs on
+//! one microcontroller. The math is `SPEC.md` (equations cited as `S<n>`).
+//!
+//! * `no_std`, no heap, fixed capacity: [`Agent<T, MT, NB>`] holds at most `MT` triangles
+//!   and `NB` neighbours.
+//! * Generic over the scalar ([`Real`]): `f32` on target (hardware FPU and `vsqrt`),
+//!   `f64` on the host. No trigonometry in the control step.
+//! * Nothing reachable from the public API panics; bad input gives a typed error
+//!   ([`FrameError`], [`Fault`], [`ConfigError`]) or the documented safe output.
+//!
+//! Per control tick:
+//! 1. [`Agent::receive`] every frame heard since the last tick;
+//! 2. [`Agent::step`] with [`Measurements`] (bearings, optional rates, own velocity, `Δt`,
+//!    the leader's partner offset) → [`StepOutput`] (force, status);
+//! 3. [`Agent::frames`] → frames of at most 60 bytes to broadcast.
+#![no_std]
+#![deny(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::indexing_slicing,
+    clippy::unreachable,
+    clippy::todo,
+    clippy::unimplemented
+)]
+#![cfg_attr(test, allow(clippy::unwrap_used, clippy::indexing_slicing))]
+#![deny(missing_docs)]
+
+pub mod agent;
+pub mod config;
+pub mod energy;
+pub mod geometry;
+pub mod law;
+pub mod scalar;
+pub mod stats;
+pub mod wire;
+
+pub use agent::{
+    Agent, BearingMeasurement, Evaluation, Fault, MeasurementError, Measurements, OwnedEstimate,
+    Status, StepOutput,
+};
+pub use config::{
+    AgentConfig, AgentId, AngleConfig, ConfigError, EstimatorMode, LeaderConfig, LeaderRole,
+    Limits, Schedule, ScheduleStep, TriangleConfig, MAX_SCHEDULE_STEPS,
+};
+pub use scalar::Real;
+pub use stats::FrameStats;
+pub use wire::{FrameError, MAX_FRAME_LEN};
+
+/// A 2-D column vector (world frame).
+pub type Vec2<T> = nalgebra::Vector2<T>;

@@ -1,0 +1,1 @@
+//! ph-formation host simulator.
