@@ -1,0 +1,251 @@
+#!/usr/bin/env bash
+# Build the release firmware and check its on-target resource use against
+# firmware-example/budgets.toml. Deterministic: nothing depends on wall-clock
+# time. Prints one table per measurement and exits non-zero on any
+# regression.
+#
+#   (a) sizes (text/data/bss) of the release ELFs          llvm-size
+#   (b) instructions per control step, per configuration   QEMU + tools/qemu-insn plugin
+#   (c) peak stack use                                     painted stack, reported by the firmware
+#   (d) no soft-float f64 routine linked (__aeabi_d*, …)   llvm-nm
+#   plus: the panic and HardFault handlers exit QEMU with code 1
+#
+# Needs what scripts/firmware-deps.sh installs (qemu-system-arm, defmt-print,
+# gcc, the rustup target and llvm-tools).
+#
+# Environment: FIRMWARE_BUDGETS (budget file; default
+# firmware-example/budgets.toml), FIRMWARE_CHECK_OUT (logs; default
+# target/firmware-check), QEMU_TIMEOUT (per QEMU run, default 60 s).
+set -euo pipefail
+
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$root"
+
+target=thumbv7em-none-eabihf
+elf_dir=$root/target/$target/release
+budgets_file=${FIRMWARE_BUDGETS:-firmware-example/budgets.toml}
+out=${FIRMWARE_CHECK_OUT:-$root/target/firmware-check}
+# Binaries whose sizes and stack are budgeted (the self-tests are not).
+budgeted_bins=(firmware-example measure)
+export QEMU_TIMEOUT=${QEMU_TIMEOUT:-60}
+
+host=$(rustc -vV | sed -n 's/^host: //p')
+llvm_bin=$(rustc --print sysroot)/lib/rustlib/$host/bin
+llvm_size=$llvm_bin/llvm-size
+llvm_nm=$llvm_bin/llvm-nm
+
+die() {
+    echo "firmware-check: $*" >&2
+    exit 1
+}
+
+for tool in qemu-system-arm defmt-print timeout gcc awk; do
+    command -v "$tool" >/dev/null 2>&1 || die "'$tool' not found; run scripts/firmware-deps.sh (as root)"
+done
+[[ -x $llvm_size && -x $llvm_nm ]] || die "llvm-size/llvm-nm missing in $llvm_bin; run: rustup component add llvm-tools"
+
+mkdir -p "$out"
+rm -f "$out"/*.log "$out"/*.txt
+
+passed=0
+failures=()
+pass() { passed=$((passed + 1)); }
+fail() {
+    failures+=("$1")
+    echo "FAIL: $1" >&2
+}
+
+# ---------------------------------------------------------------- budgets
+declare -A budget=()
+while IFS= read -r raw || [[ -n $raw ]]; do
+    line=${raw%%#*}
+    line=${line//[[:space:]]/}
+    [[ -z $line ]] && continue
+    if [[ $line =~ ^([a-z0-9_]+)=([0-9_]+)$ ]]; then
+        budget[${BASH_REMATCH[1]}]=${BASH_REMATCH[2]//_/}
+    else
+        die "$budgets_file: cannot parse '$raw' (expected: key = integer)"
+    fi
+done <"$budgets_file"
+for key in "${!budget[@]}"; do
+    case $key in
+    insn_step_* | text_bytes | data_bytes | bss_bytes | stack_bytes | ram_plus_stack_bytes) ;;
+    *) die "$budgets_file: unknown key '$key'" ;;
+    esac
+done
+
+# check_budget WHAT VALUE KEY: compare VALUE with budget KEY (if set);
+# leaves the table cell in $cell. (Not called in a subshell: it counts.)
+cell=
+check_budget() {
+    local what=$1 value=$2 key=$3
+    if [[ -z ${budget[$key]:-} ]]; then
+        cell="-"
+        return
+    fi
+    if ((value > budget[$key])); then
+        fail "$what = $value exceeds budget $key = ${budget[$key]} ($budgets_file)"
+        cell="${budget[$key]} OVER"
+    else
+        pass
+        cell="${budget[$key]} ok"
+    fi
+}
+
+# ------------------------------------------------------------------ build
+echo "== build (release, $target)"
+cargo build -p firmware-example --target "$target" --release --bins
+plugin=$(tools/qemu-insn/build.sh)
+
+# ------------------------------------------------------------- run QEMU
+# run_qemu NAME [qemu args…]: decoded log in $out/NAME.log, exit code in $rc.
+run_qemu() {
+    local name=$1
+    shift
+    set +e
+    scripts/qemu-run.sh "$elf_dir/$name" "$@" >"$out/$name.log" 2>&1
+    rc=$?
+    set -e
+}
+
+declare -A stack_peak=()
+parse_stack() {
+    local name=$1 peak
+    peak=$(sed -n 's/.*FWCHECK stack peak_bytes=\([0-9]*\).*/\1/p' "$out/$name.log" | tail -n1)
+    if [[ -z $peak ]]; then
+        fail "$name: no 'FWCHECK stack' line in its output (see $out/$name.log)"
+        return
+    fi
+    stack_peak[$name]=$peak
+}
+
+echo "== run firmware-example under QEMU"
+run_qemu firmware-example
+if ((rc != 0)); then
+    fail "firmware-example exited with code $rc under QEMU (see $out/firmware-example.log)"
+else
+    pass
+fi
+parse_stack firmware-example
+
+echo "== run measure under QEMU with the instruction-count plugin"
+marker=$("$llvm_nm" "$elf_dir/measure" | awk '$3 == "PH_INSN_MARKERS" { print "0x" $1 }')
+[[ -n $marker ]] || die "symbol PH_INSN_MARKERS not found in $elf_dir/measure"
+insn_file=$out/measure-insn.txt
+run_qemu measure -plugin "$plugin,marker=$marker,out=$insn_file"
+if ((rc != 0)); then
+    fail "measure exited with code $rc under QEMU (see $out/measure.log)"
+elif ! grep -q 'FWCHECK done' "$out/measure.log"; then
+    fail "measure did not print 'FWCHECK done' (see $out/measure.log)"
+else
+    pass
+fi
+parse_stack measure
+
+echo "== handler self-tests (must exit with code 1)"
+for name in selftest-panic selftest-hardfault; do
+    run_qemu "$name"
+    if ((rc == 1)); then
+        pass
+        echo "   $name: exit code 1 (ok)"
+    else
+        fail "$name: expected exit code 1 from the handler, got $rc (see $out/$name.log)"
+    fi
+done
+
+# ------------------------------------------------------------ (a) sizes
+echo
+echo "(a) sizes of the release ELFs (bytes; llvm-size)"
+printf '%-20s %8s %8s %8s %14s\n' binary text data bss "text budget"
+declare -A sz_text=() sz_data=() sz_bss=()
+for name in "${budgeted_bins[@]}"; do
+    read -r text data bss _ < <("$llvm_size" -B "$elf_dir/$name" | awk 'NR == 2')
+    sz_text[$name]=$text sz_data[$name]=$data sz_bss[$name]=$bss
+    check_budget "$name data" "$data" data_bytes
+    check_budget "$name bss" "$bss" bss_bytes
+    check_budget "$name text" "$text" text_bytes
+    printf '%-20s %8d %8d %8d %14s\n' "$name" "$text" "$data" "$bss" "$cell"
+done
+
+# ------------------------------------------------------ (b) instructions
+echo
+echo "(b) instructions per measured step (QEMU TCG plugin; includes marker overhead)"
+if [[ ! -s $insn_file ]]; then
+    fail "the plugin wrote no counts ($insn_file)"
+else
+    if grep -q 'qemu-insn error' "$insn_file"; then
+        fail "marker errors: $(grep 'qemu-insn error' "$insn_file" | tr '\n' ';')"
+    fi
+    printf '%-12s %9s %5s %8s %8s %14s\n' config triangles runs min max budget
+    declare -A measured=()
+    while read -r id cname tri reps; do
+        counts=$(awk -v id="$id" '$1 == "qemu-insn" && $2 == "region=" id { sub("insns=", "", $4); print $4 }' "$insn_file")
+        runs=$(printf '%s\n' "$counts" | grep -c . || true)
+        if ((runs == 0)); then
+            fail "config $cname (region $id): no instruction count from the plugin"
+            continue
+        fi
+        if ((runs != reps)); then
+            fail "config $cname (region $id): $runs counted regions, firmware announced $reps"
+        fi
+        min=$(printf '%s\n' "$counts" | sort -n | head -n1)
+        max=$(printf '%s\n' "$counts" | sort -n | tail -n1)
+        measured[$cname]=1
+        if [[ $cname == overhead ]]; then
+            cell="-"
+        else
+            check_budget "insn_step_$cname" "$max" "insn_step_$cname"
+        fi
+        printf '%-12s %9s %5d %8d %8d %14s\n' "$cname" "$tri" "$runs" "$min" "$max" "$cell"
+    done < <(sed -n 's/.*FWCHECK region id=\([0-9]*\) name=\([A-Za-z0-9_-]*\) triangles=\([0-9]*\) repeats=\([0-9]*\).*/\1 \2 \3 \4/p' "$out/measure.log")
+    if ((${#measured[@]} == 0)); then
+        fail "measure announced no regions (no 'FWCHECK region' lines in $out/measure.log)"
+    fi
+    for key in "${!budget[@]}"; do
+        if [[ $key == insn_step_* && -z ${measured[${key#insn_step_}]:-} ]]; then
+            fail "budget $key has no measured configuration '${key#insn_step_}'"
+        fi
+    done
+fi
+
+# ------------------------------------------------------------ (c) stack
+echo
+echo "(c) peak stack and RAM (bytes; painted stack scanned by the firmware)"
+printf '%-20s %8s %8s %10s %16s\n' binary stack data+bss ram+stack budget
+for name in "${budgeted_bins[@]}"; do
+    [[ -n ${stack_peak[$name]:-} ]] || continue
+    peak=${stack_peak[$name]}
+    statics=$((sz_data[$name] + sz_bss[$name]))
+    total=$((statics + peak))
+    check_budget "$name peak stack" "$peak" stack_bytes
+    check_budget "$name data+bss+stack" "$total" ram_plus_stack_bytes
+    printf '%-20s %8d %8d %10d %16s\n' "$name" "$peak" "$statics" "$total" "$cell"
+done
+
+# ---------------------------------------------------- (d) no f64 routines
+echo
+echo "(d) soft-float f64 routines linked (llvm-nm)"
+f64_re='^(__aeabi_d[a-z0-9]*|__aeabi_[a-z0-9]+2d|__(add|sub|mul|div|neg|cmp|eq|ne|lt|le|gt|ge|unord)df[0-9]|__fix(uns)?df[a-z]+|__float(un)?[a-z]*df|__extendsfdf2|__truncdfsf2)$'
+for name in "${budgeted_bins[@]}"; do
+    found=$("$llvm_nm" --defined-only "$elf_dir/$name" | awk '{ print $NF }' | grep -E "$f64_re" | sort -u | tr '\n' ' ' || true)
+    if [[ -n $found ]]; then
+        printf '%-20s %s\n' "$name" "FOUND: $found"
+        fail "$name links soft-float f64 routines: $found(find the f64 use, e.g. with: llvm-objdump -d … | grep -B20 __aeabi_d)"
+    else
+        printf '%-20s %s\n' "$name" "none (ok)"
+        pass
+    fi
+done
+
+# ---------------------------------------------------------------- verdict
+echo
+echo "logs: $out"
+if ((${#failures[@]} > 0)); then
+    echo "firmware-check: FAILED (${#failures[@]}):" >&2
+    for f in "${failures[@]}"; do
+        echo "  - $f" >&2
+    done
+    echo "firmware-check: $passed passed, ${#failures[@]} failed"
+    exit 1
+fi
+echo "firmware-check: $passed passed, 0 failed"
