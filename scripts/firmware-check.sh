@@ -157,10 +157,10 @@ done
 echo
 echo "(a) sizes of the release ELFs (bytes; llvm-size)"
 printf '%-20s %8s %8s %8s %14s\n' binary text data bss "text budget"
-declare -A sz_text=() sz_data=() sz_bss=()
+declare -A sz_data=() sz_bss=()
 for name in "${budgeted_bins[@]}"; do
     read -r text data bss _ < <("$llvm_size" -B "$elf_dir/$name" | awk 'NR == 2')
-    sz_text[$name]=$text sz_data[$name]=$data sz_bss[$name]=$bss
+    sz_data[$name]=$data sz_bss[$name]=$bss
     check_budget "$name data" "$data" data_bytes
     check_budget "$name bss" "$bss" bss_bytes
     check_budget "$name text" "$text" text_bytes

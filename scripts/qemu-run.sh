@@ -44,6 +44,7 @@ fi
 # --foreground keeps QEMU in the terminal's process group (with
 # -nographic it configures the tty; in a background group it would stop on
 # SIGTTOU). -k: SIGKILL if SIGTERM did not end it.
+# shellcheck disable=SC2054 # the commas are inside QEMU option values
 qemu_cmd=(timeout --foreground -k 5 "$limit"
     "$qemu" -machine netduinoplus2 -nographic
     -semihosting-config enable=on,target=native
