@@ -39,7 +39,7 @@ die() {
     exit 1
 }
 
-for tool in qemu-system-arm defmt-print timeout gcc awk; do
+for tool in "${QEMU_SYSTEM_ARM:-qemu-system-arm}" "${DEFMT_PRINT:-defmt-print}" timeout gcc awk; do
     command -v "$tool" >/dev/null 2>&1 || die "'$tool' not found; run scripts/firmware-deps.sh (as root)"
 done
 [[ -x $llvm_size && -x $llvm_nm ]] || die "llvm-size/llvm-nm missing in $llvm_bin; run: rustup component add llvm-tools"

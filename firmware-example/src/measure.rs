@@ -9,17 +9,21 @@
 //!
 //! The QEMU TCG plugin in `tools/qemu-insn/` watches stores to that table and
 //! prints how many guest instructions executed between the begin and the end
-//! store of each region (the count includes the end store and the one or two
-//! instructions that form its address: see the `overhead` row that
-//! `scripts/firmware-check.sh` prints). The stored value is the region id,
+//! store of each region. The count includes a small fixed overhead (the end
+//! store and the [`black_box`] spills of [`measured`], 6 instructions today):
+//! the `overhead` row that `scripts/firmware-check.sh` prints is an empty
+//! region measured the same way. The stored value is the region id,
 //! which also makes the markers visible to a debugger on a real board, where
 //! they are ordinary RAM stores and cost a few cycles.
 //!
 //! Use [`measured`] around one step:
 //!
 //! ```ignore
-//! let force = measure::measured(id, &mut state, |s| controller_step(s));
+//! let force = measure::measured(id, &inputs, |inp| controller_step(inp));
 //! ```
+//!
+//! Region ids are `0..MAX_REGIONS`; the `measure` binary uses 0 for the empty
+//! calibration region and `i + 1` for `STEP_CONFIGS[i]`.
 
 use core::cell::UnsafeCell;
 use core::hint::black_box;
