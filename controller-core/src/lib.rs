@@ -34,6 +34,7 @@ pub mod config;
 pub mod energy;
 pub mod geometry;
 pub mod law;
+pub mod link;
 pub mod scalar;
 pub mod stats;
 pub mod wire;

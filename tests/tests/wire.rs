@@ -297,3 +297,61 @@ proptest! {
         prop_assert_eq!(errors, 1);
     }
 }
+
+#[test]
+fn link_messages_round_trip_within_their_size_limit() {
+    use controller_core::link::{HostMsg, LinkBearing, LinkStep, MAX_LINK_BEARINGS, MAX_LINK_MSG};
+    // The largest configuration the HIL link carries: 4 triangles, leader, schedules full.
+    let mut r = rng(1);
+    let f = Formation::random(6, fan(4), &fan_positions(4, 0.1, &mut r), &mut r);
+    let mut cfg = f.config::<f32>(0);
+    let full = |c: &mut controller_core::Schedule<f32>| {
+        while c
+            .steps
+            .push(controller_core::ScheduleStep {
+                from: 1.5,
+                value: [1.0, -2.0],
+            })
+            .is_ok()
+        {}
+    };
+    full(&mut cfg.velocity_reference);
+    if let Some(l) = cfg.leader.as_mut() {
+        full(&mut l.displacement);
+    }
+    let small: controller_core::AgentConfig<f32, 4> = controller_core::AgentConfig {
+        triangles: cfg.triangles.iter().copied().collect(),
+        ..controller_core::AgentConfig::new(cfg.id)
+    };
+    let small = controller_core::AgentConfig {
+        leader: cfg.leader.clone(),
+        velocity_reference: cfg.velocity_reference.clone(),
+        ..small
+    };
+    let mut bearings = heapless::Vec::new();
+    for k in 0..MAX_LINK_BEARINGS {
+        let _ = bearings.push(LinkBearing {
+            neighbour: k as u8,
+            s: [0.6, 0.8],
+            rate: Some([0.1, 0.2]),
+            range: Some(3.0),
+        });
+    }
+    let msgs: [HostMsg<4>; 3] = [
+        HostMsg::Configure(small),
+        HostMsg::Step(LinkStep {
+            time: 1.0,
+            dt: 0.01,
+            velocity: [1.0, 2.0],
+            bearings,
+            partner_offset: Some([1.0, 1.0]),
+        }),
+        HostMsg::Radio(heapless::Vec::from_slice(&[7u8; MAX_FRAME_LEN]).expect("fits")),
+    ];
+    for m in &msgs {
+        let mut buf = [0u8; MAX_LINK_MSG];
+        let bytes = postcard::to_slice(m, &mut buf).expect("fits in MAX_LINK_MSG");
+        let back: HostMsg<4> = postcard::from_bytes(bytes).expect("decodes");
+        assert_eq!(&back, m);
+    }
+}
