@@ -182,6 +182,8 @@ struct Neighbour<T: Real> {
     last_seq: Option<u16>,
     velocity: Option<Vec2<T>>,
     bearing: Option<Vec2<T>>,
+    /// Seconds since `bearing` was measured (finite-difference interval).
+    bearing_age: T,
     rate: Vec2<T>,
     range: Option<T>,
     fresh: bool,
@@ -415,6 +417,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             last_seq: None,
             velocity: None,
             bearing: None,
+            bearing_age: T::zero(),
             rate: Vec2::zeros(),
             range: None,
             fresh: false,
@@ -449,11 +452,19 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
 
     // ---------------------------------------------------------------- sensing
 
-    /// Checks and stores the own measurements (bearings, rates, velocity, time) and ages
-    /// the neighbour table by `dt`. Nothing changes if they are refused.
+    /// Ages the neighbour table by `dt` (when `dt` is finite and ≥ 0, even if the rest is
+    /// refused), then checks and stores the own measurements (bearings, rates, velocity,
+    /// time). Nothing else changes if they are refused.
     pub fn sense(&mut self, m: &Measurements<'_, T>) -> Result<(), Fault> {
         let bad = |e| Err(Fault::Measurement(e));
-        if !(m.time.finite() && m.dt.finite() && m.dt >= T::zero() && finite_vec(&m.velocity)) {
+        if !(m.dt.finite() && m.dt >= T::zero()) {
+            return bad(MeasurementError::NonFinite);
+        }
+        for n in self.neighbours.iter_mut() {
+            n.age += m.dt;
+            n.bearing_age += m.dt;
+        }
+        if !(m.time.finite() && finite_vec(&m.velocity)) {
             return bad(MeasurementError::NonFinite);
         }
         if let Some(p) = &m.partner_offset {
@@ -487,7 +498,6 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         for n in self.neighbours.iter_mut() {
             n.fresh = false;
             n.range = None;
-            n.age += m.dt;
         }
         for b in m.bearings {
             let Some(n) = self.neighbours.iter_mut().find(|n| n.id == b.neighbour) else {
@@ -495,11 +505,15 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             };
             n.rate = match (b.rate, n.bearing) {
                 (Some(rate), _) => rate,
-                // Finite difference of successive bearings (SPEC §2).
-                (None, Some(prev)) if m.dt > T::zero() => (b.bearing - prev) / m.dt,
+                // Finite difference of successive bearings (SPEC §2), over the time
+                // since the previous bearing (a missed tick widens the interval).
+                (None, Some(prev)) if n.bearing_age > T::zero() => {
+                    (b.bearing - prev) / n.bearing_age
+                }
                 _ => Vec2::zeros(),
             };
             n.bearing = Some(b.bearing);
+            n.bearing_age = T::zero();
             n.range = b.range;
             n.fresh = true;
         }
