@@ -1,0 +1,307 @@
+//! The radio model: frames are real postcard bytes (at most 60), broadcast by a sender
+//! and copied to each of its radio neighbours; every copy independently suffers loss,
+//! latency + jitter, reordering, duplication and corruption. A sender's air time is
+//! limited by an optional bandwidth with a bounded transmit queue.
+//!
+//! Receivers are the sender's radio neighbours (triangle neighbours and leader partner):
+//! frames from other agents would be rejected by the receiver's core as an unknown
+//! sender, so they are not delivered at all (this keeps the cost linear in N).
+//!
+//! Nothing here allocates after construction unless the preallocated capacity of the
+//! in-flight queue is exceeded (it is sized from the scenario's rates and delays).
+
+use crate::model::RadioModel;
+use controller_core::MAX_FRAME_LEN;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+/// Random stream of the radio (independent of the sensors' stream).
+const RADIO_STREAM: u64 = 2;
+/// Tolerance on delivery times (s): a frame due at `t + 1e-9` is delivered at `t`.
+const TIME_EPS: f64 = 1e-9;
+
+/// One frame on the air: up to [`MAX_FRAME_LEN`] bytes, stored inline (no heap).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RadioFrame {
+    len: u8,
+    bytes: [u8; MAX_FRAME_LEN],
+}
+
+impl RadioFrame {
+    /// Copies `bytes` (truncated to [`MAX_FRAME_LEN`]; the core never produces more).
+    pub fn new(bytes: &[u8]) -> Self {
+        let n = bytes.len().min(MAX_FRAME_LEN);
+        let mut f = Self {
+            len: n as u8,
+            bytes: [0; MAX_FRAME_LEN],
+        };
+        if let (Some(dst), Some(src)) = (f.bytes.get_mut(..n), bytes.get(..n)) {
+            dst.copy_from_slice(src);
+        }
+        f
+    }
+
+    /// The frame's bytes.
+    pub fn as_bytes(&self) -> &[u8] {
+        self.bytes.get(..usize::from(self.len)).unwrap_or(&[])
+    }
+
+    /// Flips bit `bit` (modulo the frame length in bits).
+    fn flip(&mut self, bit: usize) {
+        let n = usize::from(self.len) * 8;
+        if n > 0 {
+            let b = bit % n;
+            if let Some(byte) = self.bytes.get_mut(b / 8) {
+                *byte ^= 1 << (b % 8);
+            }
+        }
+    }
+}
+
+/// Counters of the radio, per link copy (a broadcast to `k` neighbours is `k` copies).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RadioStats {
+    /// Frames produced by the controllers (each broadcast once).
+    pub broadcasts: u64,
+    /// Link copies put on the air (one per receiver per broadcast).
+    pub sent: u64,
+    /// Copies lost (random loss).
+    pub lost: u64,
+    /// Copies dropped because the sender's transmit queue was full (bandwidth).
+    pub queue_dropped: u64,
+    /// Extra copies created by duplication.
+    pub duplicated: u64,
+    /// Copies with a flipped bit.
+    pub corrupted: u64,
+    /// Copies held back by the reordering delay.
+    pub reordered: u64,
+    /// Copies handed to a receiver.
+    pub delivered: u64,
+}
+
+impl RadioStats {
+    /// Copies that never arrived (lost or dropped by the queue).
+    pub fn dropped(&self) -> u64 {
+        self.lost + self.queue_dropped
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+struct InFlight {
+    at: f64,
+    order: u64,
+    to: u32,
+    frame: RadioFrame,
+}
+
+impl PartialEq for InFlight {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+impl Eq for InFlight {}
+impl PartialOrd for InFlight {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for InFlight {
+    /// Reversed (earliest first in a max-heap), ties broken by send order: deterministic.
+    fn cmp(&self, other: &Self) -> Ordering {
+        other
+            .at
+            .total_cmp(&self.at)
+            .then_with(|| other.order.cmp(&self.order))
+    }
+}
+
+/// The radio between all agents.
+#[derive(Debug)]
+pub struct Radio {
+    model: RadioModel,
+    rng: ChaCha8Rng,
+    queue: BinaryHeap<InFlight>,
+    order: u64,
+    busy_until: Vec<f64>,
+    stats: RadioStats,
+}
+
+impl Radio {
+    /// A radio for `n` agents, seeded; `capacity` in-flight copies are preallocated.
+    pub fn new(model: &RadioModel, n: usize, seed: u64, capacity: usize) -> Self {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        rng.set_stream(RADIO_STREAM);
+        Self {
+            model: model.clone(),
+            rng,
+            queue: BinaryHeap::with_capacity(capacity),
+            order: 0,
+            busy_until: vec![0.0; n],
+            stats: RadioStats::default(),
+        }
+    }
+
+    /// The counters.
+    pub fn stats(&self) -> &RadioStats {
+        &self.stats
+    }
+
+    /// Frames in flight.
+    pub fn in_flight(&self) -> usize {
+        self.queue.len()
+    }
+
+    fn chance(&mut self, p: f64) -> bool {
+        p > 0.0 && self.rng.random::<f64>() < p
+    }
+
+    fn jitter(&mut self) -> f64 {
+        if self.model.jitter > 0.0 {
+            self.model.jitter * self.rng.random::<f64>()
+        } else {
+            0.0
+        }
+    }
+
+    fn push(&mut self, at: f64, to: usize, frame: RadioFrame) {
+        self.order += 1;
+        self.queue.push(InFlight {
+            at,
+            order: self.order,
+            to: to as u32,
+            frame,
+        });
+    }
+
+    /// Broadcasts `bytes` from agent `from` at time `now` to `receivers`.
+    pub fn broadcast(&mut self, now: f64, from: usize, receivers: &[usize], bytes: &[u8]) {
+        let frame = RadioFrame::new(bytes);
+        self.stats.broadcasts += 1;
+        let copies = receivers.len() as u64;
+        self.stats.sent += copies;
+        // Air time: the sender transmits one frame at a time.
+        let mut on_air = now;
+        if self.model.bandwidth > 0.0 {
+            let busy = self.busy_until.get(from).copied().unwrap_or(now);
+            let start = busy.max(now);
+            if start - now > self.model.queue_limit + TIME_EPS {
+                self.stats.queue_dropped += copies;
+                return;
+            }
+            on_air = start + bytes.len() as f64 / self.model.bandwidth;
+            if let Some(b) = self.busy_until.get_mut(from) {
+                *b = on_air;
+            }
+        }
+        for &to in receivers {
+            if self.chance(self.model.loss) {
+                self.stats.lost += 1;
+                continue;
+            }
+            let mut copy = frame;
+            if self.chance(self.model.corruption) {
+                let bit = self.rng.random_range(0..usize::from(copy.len).max(1) * 8);
+                copy.flip(bit);
+                self.stats.corrupted += 1;
+            }
+            let mut at = on_air + self.model.latency + self.jitter();
+            if self.chance(self.model.reordering) {
+                at += self.model.reorder_delay * (1.0 - self.rng.random::<f64>());
+                self.stats.reordered += 1;
+            }
+            self.push(at, to, copy);
+            if self.chance(self.model.duplication) {
+                let again = on_air + self.model.latency + self.jitter();
+                self.push(again, to, copy);
+                self.stats.duplicated += 1;
+            }
+        }
+    }
+
+    /// Hands every copy due by `now` to its receiver's inbox, in arrival order.
+    pub fn deliver(&mut self, now: f64, inboxes: &mut [Vec<RadioFrame>]) {
+        while let Some(top) = self.queue.peek() {
+            if top.at > now + TIME_EPS {
+                break;
+            }
+            if let Some(f) = self.queue.pop() {
+                if let Some(inbox) = inboxes.get_mut(f.to as usize) {
+                    inbox.push(f.frame);
+                    self.stats.delivered += 1;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn model() -> RadioModel {
+        RadioModel::ideal()
+    }
+
+    #[test]
+    fn ideal_radio_delivers_in_order() {
+        let mut r = Radio::new(&model(), 3, 1, 16);
+        r.broadcast(0.0, 0, &[1, 2], &[1, 2, 3]);
+        r.broadcast(0.0, 1, &[0], &[4]);
+        let mut inboxes = vec![Vec::new(); 3];
+        r.deliver(0.0, &mut inboxes);
+        assert_eq!(inboxes[1][0].as_bytes(), &[1, 2, 3]);
+        assert_eq!(inboxes[2][0].as_bytes(), &[1, 2, 3]);
+        assert_eq!(inboxes[0][0].as_bytes(), &[4]);
+        assert_eq!(r.stats().sent, 3);
+        assert_eq!(r.stats().delivered, 3);
+    }
+
+    #[test]
+    fn latency_and_loss() {
+        let mut m = model();
+        m.latency = 0.02;
+        m.loss = 0.5;
+        let mut r = Radio::new(&m, 2, 7, 16);
+        for k in 0..1000 {
+            r.broadcast(f64::from(k) * 0.01, 0, &[1], &[9]);
+        }
+        let mut inboxes = vec![Vec::new(); 2];
+        r.deliver(0.015, &mut inboxes);
+        assert!(inboxes[1].is_empty());
+        r.deliver(100.0, &mut inboxes);
+        let got = inboxes[1].len();
+        assert!((400..600).contains(&got), "{got}");
+        assert_eq!(r.stats().lost as usize + got, 1000);
+    }
+
+    #[test]
+    fn bandwidth_queue_drops() {
+        let mut m = model();
+        m.bandwidth = 100.0; // 60-byte frames take 0.6 s each
+        m.queue_limit = 1.0;
+        let mut r = Radio::new(&m, 2, 7, 16);
+        for _ in 0..5 {
+            r.broadcast(0.0, 0, &[1], &[0; 60]);
+        }
+        // Starts at 0, 0.6, 1.2 (> 1.0 queue limit: dropped), …
+        assert_eq!(r.stats().queue_dropped, 3);
+    }
+
+    #[test]
+    fn corruption_flips_one_bit() {
+        let mut m = model();
+        m.corruption = 1.0;
+        let mut r = Radio::new(&m, 2, 3, 16);
+        r.broadcast(0.0, 0, &[1], &[0; 10]);
+        let mut inboxes = vec![Vec::new(); 2];
+        r.deliver(0.0, &mut inboxes);
+        let ones: u32 = inboxes[1][0]
+            .as_bytes()
+            .iter()
+            .map(|b| b.count_ones())
+            .sum();
+        assert_eq!(ones, 1);
+    }
+}
