@@ -666,8 +666,8 @@ fn line_col(text: &str, pos: usize) -> (usize, usize) {
     (line, col)
 }
 
-/// Best guess of the dotted key at byte offset `pos`: the last table header before it and
-/// the key on its line.
+/// Best guess of the dotted key at byte offset `pos`: the last table header before it
+/// (with its index for an array of tables, `agents[2]`) and the key on its line.
 fn field_at(text: &str, pos: usize) -> String {
     let before = text.get(..pos).unwrap_or(text);
     let line_start = before.rfind('\n').map_or(0, |i| i + 1);
@@ -676,26 +676,36 @@ fn field_at(text: &str, pos: usize) -> String {
         .and_then(|r| r.find('\n'))
         .map_or(text.len(), |i| pos + i);
     let line = text.get(line_start..line_end).unwrap_or("").trim();
-    let mut section = String::new();
-    let header_of = |l: &str| -> Option<String> {
+    // `[name]` → ("name", false); `[[name]]` → ("name", true).
+    let header_of = |l: &str| -> Option<(String, bool)> {
         let l = l.trim();
-        if l.starts_with('[') {
-            let inner = l.trim_start_matches('[');
-            let end = inner.find(']')?;
-            Some(inner.get(..end)?.trim().to_owned())
-        } else {
-            None
-        }
+        let array = l.starts_with("[[");
+        let inner = l.strip_prefix('[')?.trim_start_matches('[');
+        let end = inner.find(']')?;
+        Some((inner.get(..end)?.trim().to_owned(), array))
     };
-    if let Some(h) = header_of(line) {
-        return h;
-    }
-    for l in text.get(..line_start).unwrap_or("").lines().rev() {
-        if let Some(h) = header_of(l) {
-            section = h;
-            break;
+    let head = text.get(..line_end).unwrap_or("");
+    let named = |name: &str, array: bool| -> String {
+        if !array {
+            return name.to_owned();
         }
+        let count = head
+            .lines()
+            .filter(|l| header_of(l).is_some_and(|(n, a)| a && n == name))
+            .count();
+        format!("{name}[{}]", count.saturating_sub(1))
+    };
+    if let Some((h, array)) = header_of(line) {
+        return named(&h, array);
     }
+    let section = text
+        .get(..line_start)
+        .unwrap_or("")
+        .lines()
+        .rev()
+        .find_map(header_of)
+        .map(|(h, array)| named(&h, array))
+        .unwrap_or_default();
     let key = line
         .split_once('=')
         .map(|(k, _)| k.trim().to_owned())

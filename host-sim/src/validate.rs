@@ -650,6 +650,9 @@ pub fn validate(s: &ScenarioFile, file: &str, default_name: &str) -> Result<Mode
     }
 
     if !c.errors.is_empty() {
+        // A default gain used by several angles is reported once.
+        let mut seen = std::collections::HashSet::new();
+        c.errors.retain(|e| seen.insert(e.to_string()));
         return Err(ScenarioErrors(c.errors));
     }
 

@@ -1,0 +1,212 @@
+//! The built-in scenarios end as SPEC §9 says, continuous mode keeps V from increasing,
+//! the paper scenario survives a lossy, delayed radio, and runs are reproducible.
+
+use host_sim::cli::run_to_dir;
+use host_sim::diagnostics::Outcome;
+use host_sim::model::Model;
+use host_sim::output::NullRecorder;
+use host_sim::scenario::Mode;
+use host_sim::sim::{self, RunResult};
+use host_sim::strip::strip_model;
+use host_sim::validate::load;
+
+fn model(name: &str, overrides: &[&str]) -> Model {
+    let o: Vec<String> = overrides.iter().map(|s| (*s).to_owned()).collect();
+    load(name, &o).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+fn run(m: &Model) -> RunResult {
+    sim::run(m, &mut NullRecorder, &mut |_| {}).expect("run")
+}
+
+/// The target square 1-2-4-3 built on the final leader edge, on the same side as at
+/// t = 0 (not its mirror): q3 = q1 + R(−90°)(q2 − q1), q4 = q2 + (q3 − q1).
+fn square_error(p: &[[f64; 2]]) -> f64 {
+    let (q1, q2, q3, q4) = (p[0], p[1], p[2], p[3]);
+    let d = [q2[0] - q1[0], q2[1] - q1[1]];
+    let e3 = [q1[0] + d[1], q1[1] - d[0]];
+    let e4 = [q2[0] + (e3[0] - q1[0]), q2[1] + (e3[1] - q1[1])];
+    let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+    dist(q3, e3).max(dist(q4, e4))
+}
+
+fn mirror_error(p: &[[f64; 2]]) -> f64 {
+    let (q1, q2, q3, q4) = (p[0], p[1], p[2], p[3]);
+    let d = [q2[0] - q1[0], q2[1] - q1[1]];
+    let e3 = [q1[0] - d[1], q1[1] + d[0]];
+    let e4 = [q2[0] + (e3[0] - q1[0]), q2[1] + (e3[1] - q1[1])];
+    let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+    dist(q3, e3).max(dist(q4, e4))
+}
+
+fn assert_converged_square(name: &str, r: &RunResult, side: Option<f64>) {
+    assert_eq!(r.outcome, Outcome::Converged, "{name}: {}", r.reason);
+    let settle = r.settle_time.expect("settle time");
+    assert!(settle < 100.0, "{name}: settle {settle}");
+    assert!(r.final_max_angle_error < 1e-3);
+    let p = &r.final_positions;
+    let side_now = (p[1][0] - p[0][0]).hypot(p[1][1] - p[0][1]);
+    let err = square_error(p);
+    assert!(
+        err < 1e-3 * side_now,
+        "{name}: not the square 1-2-4-3: {p:?} (error {err})"
+    );
+    assert!(mirror_error(p) > side_now, "{name}: mirror");
+    assert!(
+        r.orientation_kept.iter().all(|&k| k),
+        "{name}: a triangle flipped"
+    );
+    if let Some(s) = side {
+        // z* = (10, −10): the leader edge, a side of the square, is 10√2 long.
+        assert!((side_now - s).abs() < 1e-2, "{name}: side {side_now}");
+    }
+}
+
+#[test]
+fn paper_converges_into_the_square_not_its_mirror() {
+    let m = model("paper", &[]);
+    assert_eq!(m.duration, 100.0);
+    let r = run(&m);
+    assert_converged_square("paper", &r, Some(200f64.sqrt()));
+    assert!(r.final_displacement_error < 1e-2);
+    assert!(r.final_velocity_error < 1e-2);
+    // Sampled at 100 Hz with finite-difference rates, nothing saturates or faults
+    // after the first tick (nothing heard yet at t = 0).
+    assert_eq!(r.control.saturated, 0);
+    assert_eq!(r.control.safe_after_start, 0);
+    assert_eq!(r.frames.dropped, 0);
+    assert_eq!(r.frames.rejected, 0);
+    assert!(r.frames.sent > 0 && r.frames.accepted == r.frames.delivered);
+}
+
+#[test]
+fn paper_printed_fails_and_names_the_cause() {
+    let r = run(&model("paper-printed", &[]));
+    assert_eq!(r.outcome, Outcome::EstimateCollapse, "{}", r.reason);
+    assert_eq!(r.outcome.exit_code(), 12);
+    assert_eq!(r.min_estimate, Some(0.1));
+    assert!(
+        r.final_time < 5.0,
+        "stopped at the collision: {}",
+        r.final_time
+    );
+    assert!(r.reason.contains("r_min"), "{}", r.reason);
+    assert!(r.reason.contains("collided"), "{}", r.reason);
+    let kinds: Vec<Outcome> = r.events.iter().map(|e| e.kind).collect();
+    assert_eq!(kinds, [Outcome::EstimateCollapse, Outcome::Collision]);
+    assert!(r.min_distance.0 < 0.05);
+}
+
+#[test]
+fn paper_printed_fails_in_continuous_mode_too() {
+    // The failure is the gains', not the sampling's.
+    let r = run(&model("paper-printed", &["mode=continuous"]));
+    assert_eq!(r.outcome, Outcome::EstimateCollapse, "{}", r.reason);
+    assert!(r.v_max_increase_rel < 1e-9);
+}
+
+#[test]
+fn formation_only_converges() {
+    let r = run(&model("formation-only", &[]));
+    assert_converged_square("formation-only", &r, None);
+    assert_eq!(r.final_displacement_error, 0.0);
+}
+
+/// Continuous mode: V (S13) must not increase beyond RK4 error. Measured: ≈ 6e-12 of
+/// V(0) for `paper`, ≈ 1e-12 for `formation-only` (dt = 1 ms); the tolerance is 1e-9.
+const V_TOLERANCE: f64 = 1e-9;
+
+#[test]
+fn continuous_mode_v_does_not_increase() {
+    for name in ["paper", "formation-only"] {
+        let m = model(name, &["mode=continuous"]);
+        assert_eq!(m.mode, Mode::Continuous);
+        let r = run(&m);
+        assert!(
+            r.v_max_increase_rel < V_TOLERANCE,
+            "{name}: V rose by {} of V(0) at t = {}",
+            r.v_max_increase_rel,
+            r.v_max_increase_t
+        );
+        assert!(r.v_final < r.v0);
+        assert_eq!(r.control.saturated, 0);
+        assert_eq!(r.control.safe, 0);
+        assert_eq!(r.frames.sent, 0);
+        assert_converged_square(name, &r, None);
+    }
+}
+
+#[test]
+fn continuous_mode_per_agent_estimator_is_not_passive_but_runs() {
+    // SPEC §6: PerAgent is kept for comparison; it must run without faults.
+    let r = run(&model(
+        "formation-only",
+        &[
+            "mode=continuous",
+            "controller.estimator=per_agent",
+            "duration=5.0",
+        ],
+    ));
+    assert_eq!(r.control.safe, 0);
+    assert!(r.final_positions.iter().flatten().all(|x| x.is_finite()));
+}
+
+#[test]
+fn paper_converges_with_20_percent_loss_and_20_ms_latency() {
+    let r = run(&model("paper", &["radio.loss=0.2", "radio.latency=0.02"]));
+    assert_converged_square("paper lossy", &r, Some(200f64.sqrt()));
+    let lost = r.frames.dropped as f64 / r.frames.sent as f64;
+    assert!((0.18..0.22).contains(&lost), "loss fraction {lost}");
+}
+
+#[test]
+fn paper_with_exact_rates_and_measured_ranges_converges() {
+    let r = run(&model("paper", &["sensors.bearing_rate=exact"]));
+    assert_converged_square("paper exact rates", &r, Some(200f64.sqrt()));
+    let r = run(&model(
+        "paper",
+        &["controller.estimator=measured", "duration=60.0"],
+    ));
+    assert_converged_square("paper measured", &r, Some(200f64.sqrt()));
+    assert_eq!(r.min_estimate, None);
+}
+
+#[test]
+fn same_seed_same_csv_other_seed_other_csv() {
+    let faulty = [
+        "duration=10.0",
+        "radio.loss=0.2",
+        "radio.latency=0.02",
+        "radio.jitter=0.01",
+        "radio.duplication=0.05",
+        "radio.reordering=0.05",
+        "radio.corruption=0.02",
+        "sensors.bearing_noise_deg=0.05",
+        "sensors.velocity_noise=0.01",
+    ];
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut csv = Vec::new();
+    let mut summaries = Vec::new();
+    for (k, seed) in [7, 7, 8].iter().enumerate() {
+        let mut o: Vec<&str> = faulty.to_vec();
+        let s = format!("seed={seed}");
+        o.push(&s);
+        let m = model("paper", &o);
+        let out = dir.path().join(format!("run{k}"));
+        let (r, _) = run_to_dir(&m, &out, false, true).expect("run");
+        assert!(r.frames.rejected > 0 && r.frames.dropped > 0);
+        csv.push(std::fs::read(out.join("timeseries.csv")).expect("csv"));
+        summaries.push(std::fs::read(out.join("summary.json")).expect("json"));
+    }
+    assert!(csv[0].len() > 100_000);
+    assert!(csv[0] == csv[1], "same seed, different CSV");
+    assert!(summaries[0] == summaries[1], "same seed, different summary");
+    assert!(csv[0] != csv[2], "the seed changes nothing");
+}
+
+#[test]
+fn generated_strip_settles() {
+    let m = strip_model(30, 40.0);
+    let r = run(&m);
+    assert_eq!(r.outcome, Outcome::Converged, "{}", r.reason);
+}
