@@ -166,9 +166,12 @@ impl<'m> SampledSim<'m> {
         if r.bandwidth > 0.0 {
             delay += r.queue_limit;
         }
-        let ticks_in_flight = (delay / period).ceil() as usize + 2;
+        // Frames delayed beyond the run never arrive: size for at most the run.
+        let ticks_in_flight = (delay.min(model.duration) / period).ceil().min(1e4) as usize + 2;
         let links = model.graph.radio.total();
-        let capacity = links * FRAMES_PER_TICK * ticks_in_flight * 2;
+        let capacity = (links * FRAMES_PER_TICK * 2)
+            .saturating_mul(ticks_in_flight)
+            .min(1 << 20);
         let inboxes = (0..n)
             .map(|i| Vec::with_capacity(model.graph.radio.of(i).len() * FRAMES_PER_TICK * 4 + 8))
             .collect();

@@ -104,6 +104,9 @@ impl Checker<'_> {
     }
 }
 
+/// Largest number of RK4 steps of one run.
+const MAX_STEPS: f64 = 1e12;
+
 /// How many whole `dt` steps make `interval`, if it is a whole multiple.
 fn whole_steps(interval: f64, dt: f64) -> Option<usize> {
     let k = (interval / dt).round();
@@ -170,7 +173,16 @@ pub fn validate(s: &ScenarioFile, file: &str, default_name: &str) -> Result<Mode
                 format!("must be a whole number (≥ 1) of integration.dt = {dt} s"),
             ),
         }
-        if whole_steps(s.duration, dt).is_none() {
+        if s.duration / dt > MAX_STEPS {
+            c.err(
+                InvalidValue,
+                "integration.dt",
+                format!(
+                    "duration / dt = {:.3e} RK4 steps; at most {MAX_STEPS:e}",
+                    s.duration / dt
+                ),
+            );
+        } else if whole_steps(s.duration, dt).is_none() {
             c.err(
                 InvalidValue,
                 "duration",

@@ -132,7 +132,29 @@ fn bad_command_lines_exit_2_or_name_the_problem() {
         no_panic(&o);
         assert_eq!(o.status.code(), Some(2), "{args:?}");
     }
-    let cases: [(&[&str], i32, &str); 5] = [
+    let dir = tempfile::tempdir().expect("tempdir");
+    let never = dir.path().join("never").to_string_lossy().into_owned();
+    let cases: [(&[&str], i32, &str); 7] = [
+        (
+            &["validate", "paper", "--set", "integration.dt=1e-308"],
+            28,
+            "RK4 steps",
+        ),
+        (
+            &[
+                "run",
+                "paper",
+                "--duration",
+                "0.5",
+                "--no-plots",
+                "--set",
+                "radio.latency=1e308",
+                "--out",
+                &never,
+            ],
+            10,
+            "",
+        ),
         (
             &["validate", "paper", "--set", "radio.los=0.1"],
             21,
