@@ -290,6 +290,30 @@ mod tests {
     }
 
     #[test]
+    fn duplication_and_reordering() {
+        let mut m = model();
+        m.duplication = 1.0;
+        let mut r = Radio::new(&m, 2, 3, 16);
+        r.broadcast(0.0, 0, &[1], &[7]);
+        let mut inboxes = vec![Vec::new(); 2];
+        r.deliver(0.0, &mut inboxes);
+        assert_eq!(inboxes[1].len(), 2);
+        assert_eq!(r.stats().duplicated, 1);
+
+        let mut m = model();
+        m.reordering = 1.0;
+        m.reorder_delay = 0.05;
+        let mut r = Radio::new(&m, 2, 3, 16);
+        r.broadcast(0.0, 0, &[1], &[1]);
+        let mut inboxes = vec![Vec::new(); 2];
+        r.deliver(0.0, &mut inboxes);
+        assert!(inboxes[1].is_empty(), "held back");
+        r.deliver(0.05, &mut inboxes);
+        assert_eq!(inboxes[1].len(), 1);
+        assert_eq!(r.stats().reordered, 1);
+    }
+
+    #[test]
     fn corruption_flips_one_bit() {
         let mut m = model();
         m.corruption = 1.0;
