@@ -219,6 +219,10 @@ fn example_files_converge() {
         let r = run(&model(&path.to_string_lossy(), &[]));
         assert_eq!(r.outcome, Outcome::Converged, "{name}: {}", r.reason);
         // V jumps at the schedule switches; the running minimum restarts there.
-        assert!(r.v_max_increase_rel < 1.0, "{name}: {}", r.v_max_increase_rel);
+        assert!(
+            r.v_max_increase_rel < 1.0,
+            "{name}: {}",
+            r.v_max_increase_rel
+        );
     }
 }
