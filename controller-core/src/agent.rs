@@ -77,6 +77,42 @@ pub enum Fault {
     NonFinite,
 }
 
+impl core::fmt::Display for MeasurementError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::NonFinite => write!(
+                f,
+                "time, dt, velocity or partner offset is not finite (or dt < 0)"
+            ),
+            Self::BadBearing(id) => write!(
+                f,
+                "bearing to agent {id} is not a finite unit vector (or its rate is not finite)"
+            ),
+            Self::UnknownNeighbour(id) => {
+                write!(f, "bearing to agent {id}, which is not a neighbour")
+            }
+            Self::DuplicateBearing(id) => write!(f, "two bearings to agent {id}"),
+            Self::BadRange(id) => write!(f, "range to agent {id} is not finite and positive"),
+        }
+    }
+}
+
+impl core::fmt::Display for Fault {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::Measurement(e) => write!(f, "measurement refused: {e}"),
+            Self::MissingBearing(id) => write!(f, "no bearing to agent {id} this tick"),
+            Self::Stale(id) => write!(f, "agent {id} not heard within the timeout"),
+            Self::MissingData(id) => write!(f, "agent {id}'s frames lack data this step needs"),
+            Self::MissingPartnerOffset => {
+                write!(f, "leader without the partner's relative position")
+            }
+            Self::MissingRange(id) => write!(f, "no range to agent {id} (measured-distance mode)"),
+            Self::NonFinite => write!(f, "the computed force is not finite"),
+        }
+    }
+}
+
 /// The kind of output of a step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

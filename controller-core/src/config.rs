@@ -4,7 +4,9 @@
 use crate::Real;
 use serde::{Deserialize, Serialize};
 
-/// An agent identifier (unique within a formation).
+/// An agent identifier. It must be unique among the agents within two hops of each agent
+/// in the graph (frames name neighbours and their neighbours by id); a formation of at most
+/// 256 agents can simply number them.
 pub type AgentId = u8;
 
 /// Capacity of a piecewise-constant schedule (`v*`, `z*`).
@@ -231,4 +233,19 @@ pub enum ConfigError {
     BadParameter,
     /// The leader partner is this agent itself.
     BadLeader,
+}
+
+impl core::fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::NotInTriangle { triangle } => write!(f, "triangle {triangle} does not contain this agent"),
+            Self::RepeatedVertex { triangle } => write!(f, "triangle {triangle} repeats a vertex"),
+            Self::BadApex { triangle } => write!(f, "triangle {triangle}: an apex is not a vertex, or both angles share it"),
+            Self::InfeasibleAngles { triangle } => write!(f, "triangle {triangle}: desired angles outside (margin, 180° − margin) or summing to 180° or more"),
+            Self::BadGain { triangle } => write!(f, "triangle {triangle}: a gain is not finite or not positive"),
+            Self::TooManyNeighbours => write!(f, "more neighbours or triangles than the agent's capacity"),
+            Self::BadParameter => write!(f, "a scalar parameter is not finite or out of range"),
+            Self::BadLeader => write!(f, "the leader partner is the agent itself"),
+        }
+    }
 }

@@ -6,8 +6,8 @@
 //! 1. once: [`HostMsg::Configure`] → [`TargetMsg::Ready`] (or [`TargetMsg::Error`]);
 //! 2. per control tick: any number of [`HostMsg::Radio`] (frames the agent's radio
 //!    received), then one [`HostMsg::Step`] with the agent's own measurements →
-//!    any number of [`TargetMsg::Radio`] (frames to broadcast), then one
-//!    [`TargetMsg::Output`]. The host advances simulated time only after `Output`.
+//!    any number of [`TargetMsg::Radio`] (frames to broadcast), optionally one
+//!    [`TargetMsg::Estimates`], then one [`TargetMsg::Output`]. The host advances simulated time only after `Output`.
 //!
 //! All values are `f32`, as on the target.
 
@@ -160,6 +160,27 @@ impl LinkError {
     }
 }
 
+/// Largest number of estimates in one [`TargetMsg::Estimates`].
+pub const MAX_LINK_ESTIMATES: usize = 16;
+
+/// One owned estimate, reported to the host for diagnostics (see [`crate::OwnedEstimate`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LinkEstimate {
+    /// The angle's apex.
+    pub apex: AgentId,
+    /// The far vertex of the edge.
+    pub far: AgentId,
+    /// Triangle index in the agent's configuration.
+    pub triangle: u8,
+    /// Angle index (0 or 1).
+    pub angle: u8,
+    /// Edge index (0 or 1).
+    pub edge: u8,
+    /// `r̂`.
+    pub value: f32,
+}
+
 /// Target → host.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -173,6 +194,8 @@ pub enum TargetMsg {
     },
     /// A frame to broadcast.
     Radio(heapless::Vec<u8, MAX_FRAME_LEN>),
+    /// The estimates the agent owns after the step (sent before `Output`, optional).
+    Estimates(heapless::Vec<LinkEstimate, MAX_LINK_ESTIMATES>),
     /// End of a step.
     Output(LinkOutput),
     /// A refused message.

@@ -95,6 +95,29 @@ pub enum FrameError {
     Cobs,
 }
 
+impl core::fmt::Display for FrameError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::TooShort => write!(f, "frame shorter than header and CRC"),
+            Self::TooLong => write!(f, "frame longer than {MAX_FRAME_LEN} bytes"),
+            Self::BadCrc => write!(f, "CRC mismatch"),
+            Self::UnknownVersion(v) => write!(f, "unknown wire version {v}"),
+            Self::Malformed => write!(f, "malformed frame body"),
+            Self::UnknownSender(id) => write!(f, "sender {id} is not a neighbour"),
+            Self::OwnFrame => write!(f, "own frame"),
+            Self::StaleSequence { sender, seq } => write!(
+                f,
+                "stale or repeated sequence number {seq} from agent {sender}"
+            ),
+            Self::InvalidValue => write!(
+                f,
+                "non-finite value, non-unit bearing or non-positive estimate"
+            ),
+            Self::Cobs => write!(f, "COBS chunk does not decode"),
+        }
+    }
+}
+
 /// Builds one frame: header, then items while they fit, then the CRC.
 #[derive(Clone, Debug)]
 pub struct FrameWriter {
