@@ -30,6 +30,31 @@ pub struct Bearing {
     /// Unit vector from this robot towards the neighbour, in the world frame
     /// (rotate body-frame measurements with the robot's attitude first).
     pub direction: Vec2,
+    /// The bearing's rate of change (1/s), if the sensor measures it (e.g.
+    /// optical flow). `None`: the controller takes the finite difference of
+    /// successive bearings.
+    pub rate: Option<Vec2>,
+    /// The distance to the neighbour (m), if the robot has a range sensor
+    /// (only used by the controller's `Measured` estimator mode).
+    pub range: Option<f32>,
+}
+
+impl Bearing {
+    /// A bearing without rate or range: what most sensors give.
+    pub const fn new(neighbour: u8, direction: Vec2) -> Self {
+        Bearing {
+            neighbour,
+            direction,
+            rate: None,
+            range: None,
+        }
+    }
+}
+
+impl Default for Bearing {
+    fn default() -> Self {
+        Bearing::new(0, [0.0; 2])
+    }
 }
 
 /// A sensor that measures bearings (directions, no distances) to neighbours.
@@ -41,8 +66,18 @@ pub trait BearingSensor {
     /// written (at most `out.len()`; extra neighbours are dropped).
     ///
     /// Non-blocking: returns the most recent measurements, which may be the
-    /// same as in the previous call.
+    /// same as in the previous call. Bearings to robots that are not this
+    /// agent's neighbours are allowed (the control loop ignores them).
     fn read_bearings(&mut self, out: &mut [Bearing]) -> Result<usize, Self::Error>;
+
+    /// Leaders only: the position of the leader partner minus this robot's
+    /// own (m, world frame), from a relative-position sensor (SPEC S11).
+    ///
+    /// The default is `Ok(None)`: robots that are not leaders need not
+    /// implement it. A leader without it gets the controller's safe output.
+    fn partner_offset(&mut self) -> Result<Option<Vec2>, Self::Error> {
+        Ok(None)
+    }
 }
 
 /// A source of this robot's own velocity estimate (e.g. the state estimator
@@ -97,8 +132,21 @@ pub trait Clock {
     /// Seconds elapsed since the tick count `earlier` (0 if `earlier` is in
     /// the future). Precise for intervals below `u32::MAX` ticks.
     fn seconds_since(&self, earlier: u64) -> f32 {
-        let ticks = self.now_ticks().saturating_sub(earlier);
-        let ticks = u32::try_from(ticks).unwrap_or(u32::MAX);
-        ticks as f32 / self.tick_hz() as f32
+        ticks_to_seconds(self.now_ticks().saturating_sub(earlier), self.tick_hz())
     }
+
+    /// Seconds since boot (for the controller's schedules `v*(t)`, `z*(t)`).
+    fn seconds(&self) -> f32 {
+        ticks_to_seconds(self.now_ticks(), self.tick_hz())
+    }
+}
+
+/// `ticks / hz` in seconds, in `f32` without 64-bit float conversions
+/// (whole seconds and the remainder are converted separately).
+pub fn ticks_to_seconds(ticks: u64, hz: u32) -> f32 {
+    let hz64 = u64::from(hz.max(1));
+    let whole = u32::try_from(ticks / hz64).unwrap_or(u32::MAX);
+    // `ticks % hz64 < hz`, so it fits in a `u32`.
+    let frac = (ticks % hz64) as u32;
+    whole as f32 + frac as f32 / hz.max(1) as f32
 }

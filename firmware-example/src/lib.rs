@@ -25,8 +25,11 @@
 //! `core` code) but the binaries are stubs; see `docs/firmware.md`.
 #![no_std]
 
+pub mod app;
+pub mod boards;
 pub mod hal;
 pub mod measure;
+pub mod paper;
 pub mod stand_in;
 pub mod workload;
 

@@ -1,8 +1,8 @@
 //! Trivial implementations of the [`hal`](crate::hal) traits.
 //!
-//! They let the demo binary run the application loop under QEMU without any
-//! peripherals, and show the shape of a port. Everything is deterministic:
-//! the "world" advances by one tick per [`StepClock::advance`].
+//! They let the `firmware-example` binary run the application loop under
+//! QEMU without any peripherals, and show the shape of a port. Everything is
+//! deterministic: the clock advances by one tick per read.
 
 use crate::hal::{
     Actuator, Bearing, BearingSensor, Clock, Radio, Vec2, VelocitySource, MAX_FRAME_LEN,
@@ -15,39 +15,43 @@ pub enum StandInError {
     FrameTooLong,
 }
 
-/// A clock that advances only when told to: one tick per control step.
+/// A clock that advances by one tick every time it is read (stands in for a
+/// free-running hardware timer, so that [`run_agent`](crate::app::run_agent)
+/// can wait on it without interrupts).
 #[derive(Debug)]
-pub struct StepClock {
-    ticks: u64,
+pub struct PollClock {
+    ticks: core::cell::Cell<u64>,
     hz: u32,
 }
 
-impl StepClock {
+impl PollClock {
     /// A clock at tick 0 with `hz` ticks per second.
     pub const fn new(hz: u32) -> Self {
-        StepClock { ticks: 0, hz }
-    }
-
-    /// Advances by one tick.
-    pub fn advance(&mut self) {
-        self.ticks += 1;
+        PollClock {
+            ticks: core::cell::Cell::new(0),
+            hz,
+        }
     }
 }
 
-impl Clock for StepClock {
+impl Clock for PollClock {
     fn tick_hz(&self) -> u32 {
         self.hz
     }
 
     fn now_ticks(&self) -> u64 {
-        self.ticks
+        let t = self.ticks.get();
+        self.ticks.set(t + 1);
+        t
     }
 }
 
 /// Bearings to fixed neighbours from a fixed position.
 #[derive(Debug)]
 pub struct FixedBearings {
-    /// Directions to report, indexed by neighbour id.
+    /// Id of the neighbour of `directions[0]`; the others follow.
+    pub first_id: u8,
+    /// Directions to report, to neighbours `first_id`, `first_id + 1`, ….
     pub directions: [Vec2; 3],
 }
 
@@ -57,24 +61,20 @@ impl BearingSensor for FixedBearings {
     fn read_bearings(&mut self, out: &mut [Bearing]) -> Result<usize, Self::Error> {
         let n = out.len().min(self.directions.len());
         for (i, (slot, dir)) in out.iter_mut().zip(&self.directions).enumerate() {
-            *slot = Bearing {
-                neighbour: i as u8,
-                direction: *dir,
-            };
+            *slot = Bearing::new(self.first_id + i as u8, *dir);
         }
         Ok(n)
     }
 }
 
-/// A velocity source that integrates the applied force of a unit mass
-/// (fed by [`RecordingActuator`]).
+/// A velocity source that reports a settable velocity.
 #[derive(Debug, Default)]
-pub struct IntegratedVelocity {
+pub struct FixedVelocity {
     /// Current velocity, m/s.
     pub velocity: Vec2,
 }
 
-impl VelocitySource for IntegratedVelocity {
+impl VelocitySource for FixedVelocity {
     type Error = StandInError;
 
     fn velocity(&mut self) -> Result<Vec2, Self::Error> {
