@@ -1,87 +1,188 @@
 //! Measurement firmware for `scripts/firmware-check.sh`.
 //!
-//! For every configuration in [`STEP_CONFIGS`] it prepares the inputs, then
-//! runs [`control_step`] a few times, each as a measured region (instruction
-//! counts come from the QEMU plugin in `tools/qemu-insn/`). It prints one
-//! `FWCHECK region …` line per region id so the script can name the plugin's
-//! counts, reports peak stack use, and exits 0.
+//! For every configuration in [`STEP_CONFIGS`] (an agent in 1, 2, 4 and 8
+//! triangles) it builds the [`Bench`] (real agents, warm-up ticks, the
+//! neighbours' frames of the measured tick), then measures, as regions of the
+//! QEMU instruction-count plugin (`tools/qemu-insn/`):
+//!
+//! * `<name>`: the whole control step ([`Bench::control_step`]: decode and
+//!   receive the neighbours' frames, `Agent::step`, encode the own frames),
+//!   [`REPEATS`] times, each on a freshly built bench (same state);
+//! * `<name>-rx`, `<name>-step`, `<name>-tx`: the three parts separately, on
+//!   one more fresh bench (their sum is the whole step plus twice the marker
+//!   overhead).
+//!
+//! Every measured step must be nominal (`Status::Nominal`) with every
+//! neighbour frame accepted; otherwise it prints `FWCHECK error …` and exits
+//! 1 (a safe-output step is not a valid measurement).
 //!
 //! Output lines (defmt `println!`, independent of `DEFMT_LOG`):
 //!
 //! ```text
 //! FWCHECK region id=<id> name=<name> triangles=<n> repeats=<r>
+//! FWCHECK bench name=<name> triangles=<n> neighbours=<n> rx_frames=<n> rx_bytes=<n> tx_frames=<n> tx_bytes=<n> force=<x>,<y>
+//! FWCHECK error <reason>
 //! FWCHECK stack peak_bytes=<n> size_bytes=<n>
 //! FWCHECK done
 //! ```
 //!
 //! [`STEP_CONFIGS`]: firmware_example::workload::STEP_CONFIGS
-//! [`control_step`]: firmware_example::workload::control_step
+//! [`Bench`]: firmware_example::workload::Bench
+//! [`Bench::control_step`]: firmware_example::workload::Bench::control_step
 #![cfg_attr(target_os = "none", no_std, no_main)]
+
+/// Times the whole step of each configuration is measured (the script
+/// reports min and max; QEMU is deterministic, so they are equal).
+pub const REPEATS: u32 = 3;
 
 #[cfg(target_os = "none")]
 mod firmware {
+    use super::REPEATS;
+    use controller_core::StepOutput;
     use cortex_m_rt::entry;
-    use firmware_example::hal::Vec2;
     use firmware_example::measure::{self, MAX_REGIONS};
-    use firmware_example::workload::{control_step, Scenario, STEP_CONFIGS};
+    use firmware_example::workload::{Bench, StepConfig, StepCtx, StepResult, STEP_CONFIGS};
     use firmware_example::{rt, stack};
 
     /// Region id of the empty calibration region (marker overhead only).
     const OVERHEAD_ID: u8 = 0;
-    /// Times each configuration is measured (the script reports min and max;
-    /// the first run may differ from later ones on a real cache, never on
-    /// QEMU).
-    const REPEATS: u32 = 3;
+    /// Regions per configuration: whole step, rx, step, tx.
+    const REGIONS_PER_CONFIG: usize = 4;
 
     const _: () = assert!(
-        STEP_CONFIGS.len() < MAX_REGIONS,
-        "too many step configurations for the marker table"
+        REGIONS_PER_CONFIG * STEP_CONFIGS.len() < MAX_REGIONS,
+        "too many regions for the marker table"
     );
 
-    /// The single call site of a measured step (keeps the marker overhead
-    /// identical for every configuration and repetition).
+    /// The single call site of a measured whole step.
     #[inline(never)]
-    fn measured_step(id: u8, scenario: &Scenario) -> Vec2 {
-        measure::measured(id, scenario, control_step)
+    fn measured_step(id: u8, ctx: &mut StepCtx<'_>) -> StepResult {
+        measure::measured(id, ctx, |b| b.control_step())
+    }
+
+    #[inline(never)]
+    fn measured_rx(id: u8, ctx: &mut StepCtx<'_>) -> (u8, u8) {
+        measure::measured(id, ctx, |b| b.receive_all())
+    }
+
+    #[inline(never)]
+    fn measured_step_only(id: u8, ctx: &mut StepCtx<'_>) -> StepOutput<f32> {
+        measure::measured(id, ctx, |b| b.step_only())
+    }
+
+    #[inline(never)]
+    fn measured_tx(id: u8, ctx: &mut StepCtx<'_>) -> u8 {
+        measure::measured(id, ctx, |b| b.encode())
     }
 
     /// An empty measured region: the marker overhead alone.
     #[inline(never)]
-    fn measured_nothing(id: u8, scenario: &Scenario) -> &Scenario {
-        measure::measured(id, scenario, |s| s)
+    fn measured_nothing(id: u8, x: u32) -> u32 {
+        measure::measured(id, x, |x| x)
+    }
+
+    fn announce(id: u8, name: &str, suffix: &str, triangles: usize, repeats: u32) {
+        defmt::println!(
+            "FWCHECK region id={=u8} name={=str}{=str} triangles={=usize} repeats={=u32}",
+            id,
+            name,
+            suffix,
+            triangles,
+            repeats
+        );
+    }
+
+    fn fail(what: &str, cfg: &StepConfig) -> ! {
+        defmt::println!("FWCHECK error {=str}: {=str}", cfg.name, what);
+        rt::exit(rt::EXIT_FAILURE)
+    }
+
+    /// Rebuilds `bench` for `cfg` and returns what the measured step uses.
+    fn reset<'a>(bench: &'a mut Bench, cfg: &StepConfig) -> StepCtx<'a> {
+        match bench.reset(cfg) {
+            Ok(()) if bench.rx.overflow == 0 => {}
+            Ok(()) => fail("bench frame buffer overflow", cfg),
+            Err(e) => {
+                defmt::error!("bench {=str}: {}", cfg.name, e);
+                fail("bench could not be built", cfg)
+            }
+        }
+        match bench.ctx() {
+            Some(ctx) => ctx,
+            None => fail("bench without agent", cfg),
+        }
+    }
+
+    fn check(r: &StepResult, cfg: &StepConfig) {
+        if !r.valid() {
+            defmt::error!(
+                "{=str}: status {}, {=u8} frames rejected",
+                cfg.name,
+                r.output.status,
+                r.rejected
+            );
+            fail("the measured step is not nominal with all frames accepted (not a valid measurement)", cfg);
+        }
     }
 
     #[entry]
     fn main() -> ! {
-        defmt::println!(
-            "FWCHECK region id={=u8} name={=str} triangles={=usize} repeats={=u32}",
-            OVERHEAD_ID,
-            "overhead",
-            0,
-            REPEATS
-        );
-        let idle = Scenario::new(&STEP_CONFIGS[0]);
-        for _ in 0..REPEATS {
-            measured_nothing(OVERHEAD_ID, &idle);
+        announce(OVERHEAD_ID, "overhead", "", 0, REPEATS);
+        for i in 0..REPEATS {
+            measured_nothing(OVERHEAD_ID, i);
         }
 
-        let mut checksum = 0.0f32;
+        // One bench, rebuilt in place before every measured step.
+        let mut bench = Bench::empty();
         for (i, cfg) in STEP_CONFIGS.iter().enumerate() {
-            let id = (i + 1) as u8;
-            defmt::println!(
-                "FWCHECK region id={=u8} name={=str} triangles={=usize} repeats={=u32}",
-                id,
-                cfg.name,
-                cfg.triangles,
-                REPEATS
-            );
-            let scenario = Scenario::new(cfg);
-            for _ in 0..REPEATS {
-                let force = measured_step(id, &scenario);
-                checksum += force[0] + force[1];
+            let base = (1 + REGIONS_PER_CONFIG * i) as u8;
+            let (id_all, id_rx, id_step, id_tx) = (base, base + 1, base + 2, base + 3);
+
+            announce(id_all, cfg.name, "", cfg.triangles, REPEATS);
+            let mut last = None;
+            for rep in 0..REPEATS {
+                let mut ctx = reset(&mut bench, cfg);
+                let r = measured_step(id_all, &mut ctx);
+                check(&r, cfg);
+                if last.is_some_and(|l| l != r) {
+                    fail("repeated steps differ", cfg);
+                }
+                last = Some(r);
+                if rep == 0 {
+                    defmt::println!(
+                        "FWCHECK bench name={=str} triangles={=usize} neighbours={=usize} rx_frames={=usize} rx_bytes={=usize} tx_frames={=usize} tx_bytes={=usize} force={=f32},{=f32}",
+                        cfg.name,
+                        cfg.triangles,
+                        bench.inputs.bearings.len(),
+                        bench.rx.len(),
+                        bench.rx.bytes(),
+                        bench.tx.len(),
+                        bench.tx.bytes(),
+                        r.output.force.x,
+                        r.output.force.y
+                    );
+                }
+            }
+
+            // The breakdown, on one more fresh bench.
+            announce(id_rx, cfg.name, "-rx", cfg.triangles, 1);
+            announce(id_step, cfg.name, "-step", cfg.triangles, 1);
+            announce(id_tx, cfg.name, "-tx", cfg.triangles, 1);
+            let mut ctx = reset(&mut bench, cfg);
+            let (accepted, rejected) = measured_rx(id_rx, &mut ctx);
+            let output = measured_step_only(id_step, &mut ctx);
+            let sent = measured_tx(id_tx, &mut ctx);
+            let r = StepResult {
+                output,
+                accepted,
+                rejected,
+                sent,
+            };
+            check(&r, cfg);
+            if last != Some(r) {
+                fail("the breakdown's step differs from the whole step", cfg);
             }
         }
-        defmt::info!("checksum {=f32}", checksum);
 
         stack::report();
         defmt::println!("FWCHECK done");
