@@ -16,6 +16,10 @@
  *   marker=ADDR   address of the marker table (required; hex or decimal)
  *   regions=N     number of region ids in the table (default 32)
  *   out=FILE      write the lines to FILE instead of QEMU's log (stderr)
+ *   profile=ID    also count, per instruction address, the instructions
+ *                 executed inside region ID (all its occurrences), and print
+ *                 `qemu-insn profile pc=0x<addr> insns=<n>` lines at exit
+ *                 (scripts/firmware-profile.sh maps them to functions)
  *
  * Counting uses one callback per executed instruction, so the count is exact
  * and independent of how QEMU splits code into translation blocks. It
@@ -46,6 +50,13 @@ static uint64_t occurrences[MAX_REGIONS_LIMIT]; /* completed regions per id */
 static unsigned char open_region[MAX_REGIONS_LIMIT];
 static uint64_t errors;
 
+/* Optional per-address profile of one region (open addressing, pc -> count). */
+#define PROFILE_SLOTS (1u << 16)
+static int64_t profile_region = -1;
+static uint64_t profile_pc[PROFILE_SLOTS];
+static uint64_t profile_count[PROFILE_SLOTS];
+static uint64_t profile_dropped;
+
 static void emit(const char *line)
 {
     if (out_file) {
@@ -61,6 +72,26 @@ static void on_insn(unsigned int vcpu_index, void *userdata)
     (void)vcpu_index;
     (void)userdata;
     executed++;
+}
+
+static void on_insn_profiled(unsigned int vcpu_index, void *userdata)
+{
+    (void)vcpu_index;
+    executed++;
+    if (!open_region[profile_region]) {
+        return;
+    }
+    uint64_t pc = (uint64_t)(uintptr_t)userdata;
+    uint32_t h = (uint32_t)((pc >> 1) * 2654435761u) & (PROFILE_SLOTS - 1);
+    for (uint32_t i = 0; i < PROFILE_SLOTS; i++) {
+        uint32_t slot = (h + i) & (PROFILE_SLOTS - 1);
+        if (profile_count[slot] == 0 || profile_pc[slot] == pc) {
+            profile_pc[slot] = pc;
+            profile_count[slot]++;
+            return;
+        }
+    }
+    profile_dropped++;
 }
 
 static void on_mem(unsigned int vcpu_index, qemu_plugin_meminfo_t info, uint64_t vaddr, void *userdata)
@@ -102,7 +133,12 @@ static void on_translate(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
     size_t n = qemu_plugin_tb_n_insns(tb);
     for (size_t i = 0; i < n; i++) {
         struct qemu_plugin_insn *insn = qemu_plugin_tb_get_insn(tb, i);
-        qemu_plugin_register_vcpu_insn_exec_cb(insn, on_insn, QEMU_PLUGIN_CB_NO_REGS, NULL);
+        if (profile_region >= 0) {
+            void *pc = (void *)(uintptr_t)qemu_plugin_insn_vaddr(insn);
+            qemu_plugin_register_vcpu_insn_exec_cb(insn, on_insn_profiled, QEMU_PLUGIN_CB_NO_REGS, pc);
+        } else {
+            qemu_plugin_register_vcpu_insn_exec_cb(insn, on_insn, QEMU_PLUGIN_CB_NO_REGS, NULL);
+        }
         qemu_plugin_register_vcpu_mem_cb(insn, on_mem, QEMU_PLUGIN_CB_NO_REGS, QEMU_PLUGIN_MEM_W, NULL);
     }
 }
@@ -117,6 +153,18 @@ static void on_plugin_exit(qemu_plugin_id_t id, void *userdata)
             snprintf(line, sizeof line, "qemu-insn error: region=%" PRIu64 " never ended\n", r);
             emit(line);
         }
+    }
+    if (profile_region >= 0) {
+        for (uint32_t i = 0; i < PROFILE_SLOTS; i++) {
+            if (profile_count[i]) {
+                snprintf(line, sizeof line, "qemu-insn profile pc=0x%" PRIx64 " insns=%" PRIu64 "\n", profile_pc[i],
+                         profile_count[i]);
+                emit(line);
+            }
+        }
+        snprintf(line, sizeof line, "qemu-insn profile region=%" PRId64 " dropped=%" PRIu64 "\n", profile_region,
+                 profile_dropped);
+        emit(line);
     }
     snprintf(line, sizeof line, "qemu-insn total=%" PRIu64 " errors=%" PRIu64 "\n", executed, errors);
     emit(line);
@@ -141,6 +189,7 @@ QEMU_PLUGIN_EXPORT int qemu_plugin_install(qemu_plugin_id_t id, const qemu_info_
 {
     int have_marker = 0;
     const char *out_path = NULL;
+    uint64_t profile_id = 0;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         if (strncmp(a, "marker=", 7) == 0 && parse_u64(a + 7, &marker_base) == 0) {
@@ -150,13 +199,20 @@ QEMU_PLUGIN_EXPORT int qemu_plugin_install(qemu_plugin_id_t id, const qemu_info_
             /* parsed */
         } else if (strncmp(a, "out=", 4) == 0 && a[4] != '\0') {
             out_path = a + 4;
+        } else if (strncmp(a, "profile=", 8) == 0 && parse_u64(a + 8, &profile_id) == 0) {
+            profile_region = (int64_t)profile_id;
         } else {
-            fprintf(stderr, "qemu-insn: bad argument '%s' (expected marker=ADDR, regions=N, out=FILE)\n", a);
+            fprintf(stderr, "qemu-insn: bad argument '%s' (expected marker=ADDR, regions=N, out=FILE, profile=ID)\n", a);
             return -1;
         }
     }
     if (!have_marker) {
         fprintf(stderr, "qemu-insn: missing marker=ADDR (address of PH_INSN_MARKERS)\n");
+        return -1;
+    }
+    if (profile_region >= (int64_t)n_regions) {
+        fprintf(stderr, "qemu-insn: profile=%" PRId64 " is not a region id (regions=%" PRIu64 ")\n", profile_region,
+                n_regions);
         return -1;
     }
     if (info->system_emulation && info->system.max_vcpus > 1) {
