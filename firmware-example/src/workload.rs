@@ -131,7 +131,10 @@ impl<const N: usize> FrameBuf<N> {
     /// Appends one frame (counted in `overflow` if full or too long).
     #[inline]
     pub fn push(&mut self, frame: &[u8]) {
-        let slot = self.bytes.get_mut(self.count).and_then(|b| b.get_mut(..frame.len()));
+        let slot = self
+            .bytes
+            .get_mut(self.count)
+            .and_then(|b| b.get_mut(..frame.len()));
         match (slot, self.lens.get_mut(self.count)) {
             (Some(dst), Some(len)) => {
                 dst.copy_from_slice(frame);

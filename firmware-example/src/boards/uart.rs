@@ -8,7 +8,7 @@
 //! | --- | --- |
 //! | `Configure(AgentConfig<f32, 4>)` | `Ready { id, version }` or `Error(Config(code))` |
 //! | `Radio(frame)`, any number | (nothing; queued for the next `Step`) |
-//! | `Step(LinkStep)` | `Radio(frame)` for each frame to broadcast, then `Output(LinkOutput)` |
+//! | `Step(LinkStep)` | `Radio(frame)` for each frame to broadcast, `Estimates` (the estimates the agent owns after the step, if any), then `Output(LinkOutput)` |
 //! | `Finish` | `Finished { accepted, rejected }` (then the firmware exits 0) |
 //!
 //! Start-up: QEMU's USART drops the bytes that arrive before the firmware has
@@ -36,7 +36,8 @@
 //! [`Usart1`] (MCU only) is the STM32F4 USART1 polled without interrupts.
 
 use controller_core::link::{
-    HostMsg, LinkError, LinkOutput, LinkStep, TargetMsg, LINK_VERSION, MAX_LINK_MSG,
+    HostMsg, LinkError, LinkEstimate, LinkOutput, LinkStep, TargetMsg, LINK_VERSION,
+    MAX_LINK_ESTIMATES, MAX_LINK_MSG,
 };
 use controller_core::wire::{cobs_encode, CobsAccumulator};
 use controller_core::{Agent, AgentId};
@@ -227,6 +228,18 @@ impl<P: SerialPort> Session<P> {
             clock: LinkClock { us: now },
         };
         let report = control.tick(&mut board);
+        let mut estimates = heapless::Vec::<LinkEstimate, MAX_LINK_ESTIMATES>::new();
+        for e in control.agent().owned_estimates() {
+            // At most MT · 2 angles · 2 edges = 16 = MAX_LINK_ESTIMATES.
+            let _ = estimates.push(LinkEstimate {
+                apex: e.apex,
+                far: e.far,
+                triangle: e.triangle as u8,
+                angle: e.angle as u8,
+                edge: e.edge as u8,
+                value: e.value,
+            });
+        }
         let out = LinkOutput::new(
             board.actuator.force,
             report.output.status,
@@ -234,6 +247,9 @@ impl<P: SerialPort> Session<P> {
             report.frames_sent,
             control.agent().stats().rejected(),
         );
+        if !estimates.is_empty() {
+            send_msg(&mut self.port, &TargetMsg::Estimates(estimates));
+        }
         self.send(&TargetMsg::Output(out));
         Event::Ticked(report)
     }
@@ -250,9 +266,10 @@ impl<P: SerialPort> Session<P> {
 
 /// Encodes `msg` (postcard, then COBS with its `0` delimiter) and writes it.
 fn send_msg<P: SerialPort>(port: &mut P, msg: &TargetMsg) {
-    // A `TargetMsg` is at most a 60-byte frame plus a few bytes of tags.
-    let mut raw = [0u8; 2 * MAX_FRAME_LEN];
-    let mut cobs = [0u8; 2 * MAX_FRAME_LEN + 4];
+    // The largest `TargetMsg` is `Estimates`: 16 × (5 bytes + f32) + tags.
+    const RAW: usize = 192;
+    let mut raw = [0u8; RAW];
+    let mut cobs = [0u8; RAW + RAW / 254 + 2];
     let Ok(bytes) = postcard::to_slice(msg, &mut raw) else {
         return;
     };
