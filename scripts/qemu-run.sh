@@ -17,6 +17,10 @@
 #   QEMU_SYSTEM_ARM   QEMU binary (default qemu-system-arm)
 #   DEFMT_PRINT       defmt-print binary (default defmt-print)
 #   QEMU_RAW_OUT      if set, also save QEMU's raw (defmt-encoded) stdout there
+#   QEMU_SERIAL       backend of USART1 (QEMU's serial0), default `null`; e.g.
+#                     tcp:127.0.0.1:4444,server=on,wait=on,nodelay=on for the
+#                     qemu-uart firmware (stdout carries the defmt log, so the
+#                     serial port must not be stdio)
 set -euo pipefail
 
 if [[ $# -lt 1 ]]; then
@@ -41,12 +45,14 @@ if [[ ! -f $elf ]]; then
     exit 2
 fi
 
-# --foreground keeps QEMU in the terminal's process group (with
-# -nographic it configures the tty; in a background group it would stop on
-# SIGTTOU). -k: SIGKILL if SIGTERM did not end it.
+# --foreground keeps QEMU in the terminal's process group (in a background
+# group it could stop on SIGTTOU). -k: SIGKILL if SIGTERM did not end it.
+# No display, no monitor, USART1 on $QEMU_SERIAL: stdout carries only the
+# firmware's semihosting output (the defmt stream).
 # shellcheck disable=SC2054 # the commas are inside QEMU option values
 qemu_cmd=(timeout --foreground -k 5 "$limit"
-    "$qemu" -machine netduinoplus2 -nographic
+    "$qemu" -machine netduinoplus2 -display none -monitor none
+    -serial "${QEMU_SERIAL:-null}"
     -semihosting-config enable=on,target=native
     -kernel "$elf" "$@")
 

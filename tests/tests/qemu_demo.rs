@@ -1,0 +1,301 @@
+//! The `qemu-demo` firmware (the paper scenario simulated inside the firmware
+//! in `f32`, four agents exchanging real frames) against the host simulator's
+//! `f64` run of the same scenario.
+//!
+//! * `demo_converges_to_the_square`: the firmware exits 0 (converged, see
+//!   `firmware-example/src/bin/qemu-demo.rs` for its thresholds) and its final
+//!   relative positions `q_i − q_1` are the paper's square, `(0, 0)`,
+//!   `(−10, 10)`, `(10, 10)`, `(0, 20)`, within [`TOLERANCE`].
+//! * `demo_matches_host_sim`: the same relative positions agree with those of
+//!   `host-sim run paper` (its `summary.json`, `final_positions`) within
+//!   [`TOLERANCE`].
+//!
+//! Tolerance: 1e-2 m on a square of side 14 m. The demo stops as soon as all
+//! its angle errors are below 1e-4 rad and its leader error below 1e-3 m
+//! (about t = 68 s), so its shape is within about 2e-3 m of the target; the
+//! host simulator runs 100 s and is closer still.
+//!
+//! Both are ignored by default: they need `qemu-system-arm`, `defmt-print` and
+//! the release firmware (`cargo build -p firmware-example --target
+//! thumbv7em-none-eabihf --release --bin qemu-demo`); `scripts/test.sh` runs
+//! them with `--include-ignored`. The parsers and the comparison are checked
+//! by the plain tests at the end.
+//!
+//! Environment: `PH_QEMU_DEMO_ELF` (the firmware ELF), `QEMU_TIMEOUT` (passed
+//! to `scripts/qemu-run.sh`, default here 120 s), `PH_HOST_SIM_SUMMARY` (use
+//! this `summary.json` instead of running the host simulator).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::OnceLock;
+
+/// Largest difference of a relative position `q_i − q_1`, in metres.
+const TOLERANCE: f64 = 1e-2;
+
+/// The paper's target square, `q_i − q_1` (SPEC §9, `z* = q1 − q2 = (10, −10)`).
+const SQUARE: [[f64; 2]; 4] = [[0.0, 0.0], [-10.0, 10.0], [10.0, 10.0], [0.0, 20.0]];
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// Parses `DEMO final t=<t> rel=<x1>,<y1>;<x2>,<y2>;…` from the demo's output:
+/// returns `(t, [q_i − q_1])`.
+fn parse_demo_final(log: &str) -> Result<(f64, Vec<[f64; 2]>), String> {
+    let line = log
+        .lines()
+        .rev()
+        .find(|l| l.contains("DEMO final"))
+        .ok_or("no 'DEMO final' line in the demo's output")?;
+    let field = |name: &str| -> Result<&str, String> {
+        let start = line
+            .find(&format!("{name}="))
+            .ok_or(format!("no '{name}=' in {line:?}"))?
+            + name.len()
+            + 1;
+        Ok(line[start..].split_whitespace().next().unwrap_or(""))
+    };
+    let t: f64 = field("t")?
+        .parse()
+        .map_err(|e| format!("bad t in {line:?}: {e}"))?;
+    let rel = field("rel")?
+        .split(';')
+        .map(|pair| {
+            let xy: Vec<f64> = pair
+                .split(',')
+                .map(|x| {
+                    x.trim()
+                        .parse::<f64>()
+                        .map_err(|e| format!("bad number {x:?}: {e}"))
+                })
+                .collect::<Result<_, _>>()?;
+            match xy[..] {
+                [x, y] => Ok([x, y]),
+                _ => Err(format!("expected x,y, got {pair:?}")),
+            }
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    Ok((t, rel))
+}
+
+/// Extracts `final_positions: [[x, y], …]` from a `summary.json` (a minimal
+/// parser for that one field: an array of arrays of numbers).
+fn parse_final_positions(json: &str) -> Result<Vec<[f64; 2]>, String> {
+    let key = "\"final_positions\"";
+    let at = json
+        .find(key)
+        .ok_or("summary.json has no \"final_positions\"")?
+        + key.len();
+    let rest = json[at..].trim_start();
+    let rest = rest
+        .strip_prefix(':')
+        .ok_or("expected ':' after \"final_positions\"")?;
+    let rest = rest.trim_start();
+    let rest = rest
+        .strip_prefix('[')
+        .ok_or("final_positions is not an array")?;
+    let mut out = Vec::new();
+    let mut s = rest.trim_start();
+    loop {
+        if let Some(r) = s.strip_prefix(']') {
+            let _ = r;
+            return Ok(out);
+        }
+        let inner = s
+            .strip_prefix('[')
+            .ok_or(format!("expected '[' at {:?}", &s[..s.len().min(20)]))?;
+        let end = inner.find(']').ok_or("unterminated position")?;
+        let xy: Vec<f64> = inner[..end]
+            .split(',')
+            .map(|x| {
+                x.trim()
+                    .parse::<f64>()
+                    .map_err(|e| format!("bad number {x:?}: {e}"))
+            })
+            .collect::<Result<_, _>>()?;
+        match xy[..] {
+            [x, y] => out.push([x, y]),
+            _ => return Err(format!("a position has {} components", xy.len())),
+        }
+        s = inner[end + 1..].trim_start();
+        s = s.strip_prefix(',').unwrap_or(s).trim_start();
+    }
+}
+
+/// `q_i − q_1` of absolute positions.
+fn relative(positions: &[[f64; 2]]) -> Vec<[f64; 2]> {
+    let p0 = positions.first().copied().unwrap_or([0.0; 2]);
+    positions
+        .iter()
+        .map(|p| [p[0] - p0[0], p[1] - p0[1]])
+        .collect()
+}
+
+/// Largest distance between corresponding relative positions.
+fn max_difference(a: &[[f64; 2]], b: &[[f64; 2]]) -> Result<f64, String> {
+    if a.len() != b.len() {
+        return Err(format!("{} positions against {}", a.len(), b.len()));
+    }
+    Ok(a.iter()
+        .zip(b)
+        .map(|(p, q)| (p[0] - q[0]).hypot(p[1] - q[1]))
+        .fold(0.0, f64::max))
+}
+
+struct DemoRun {
+    code: Option<i32>,
+    log: String,
+}
+
+/// Runs the demo under QEMU once per test binary (shared by the tests).
+fn demo() -> &'static DemoRun {
+    static RUN: OnceLock<DemoRun> = OnceLock::new();
+    RUN.get_or_init(|| {
+        let elf = std::env::var_os("PH_QEMU_DEMO_ELF")
+            .map(PathBuf::from)
+            .unwrap_or_else(|| root().join("target/thumbv7em-none-eabihf/release/qemu-demo"));
+        assert!(
+            elf.is_file(),
+            "{} not found: build it with `cargo build -p firmware-example --target thumbv7em-none-eabihf --release --bin qemu-demo`",
+            elf.display()
+        );
+        let timeout = std::env::var("QEMU_TIMEOUT").unwrap_or_else(|_| "120".into());
+        let out = Command::new("bash")
+            .arg(root().join("scripts/qemu-run.sh"))
+            .arg(&elf)
+            .env("QEMU_TIMEOUT", timeout)
+            .output()
+            .expect("run scripts/qemu-run.sh");
+        let mut log = String::from_utf8_lossy(&out.stdout).into_owned();
+        log.push_str(&String::from_utf8_lossy(&out.stderr));
+        DemoRun {
+            code: out.status.code(),
+            log,
+        }
+    })
+}
+
+/// The host simulator's final positions of the `paper` scenario.
+fn host_sim_final_positions() -> Vec<[f64; 2]> {
+    let summary = match std::env::var_os("PH_HOST_SIM_SUMMARY") {
+        Some(p) => PathBuf::from(p),
+        None => {
+            let dir =
+                std::env::temp_dir().join(format!("ph-qemu-demo-host-sim-{}", std::process::id()));
+            let _ = std::fs::remove_dir_all(&dir);
+            std::fs::create_dir_all(&dir).expect("temporary directory");
+            let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+            let out = Command::new(cargo)
+                .current_dir(root())
+                .args([
+                    "run",
+                    "--release",
+                    "-p",
+                    "host-sim",
+                    "--",
+                    "run",
+                    "paper",
+                    "--out",
+                ])
+                .arg(&dir)
+                .arg("--quiet")
+                .output()
+                .expect("run cargo");
+            assert!(
+                out.status.success(),
+                "host-sim run paper failed ({}):\n{}{}",
+                out.status,
+                String::from_utf8_lossy(&out.stdout),
+                String::from_utf8_lossy(&out.stderr)
+            );
+            dir.join("summary.json")
+        }
+    };
+    let json = std::fs::read_to_string(&summary)
+        .unwrap_or_else(|e| panic!("cannot read {}: {e}", summary.display()));
+    parse_final_positions(&json).unwrap_or_else(|e| panic!("{}: {e}", summary.display()))
+}
+
+#[test]
+#[ignore = "needs qemu-system-arm and the firmware ELF; run by scripts/test.sh"]
+fn demo_converges_to_the_square() {
+    let run = demo();
+    assert_eq!(
+        run.code,
+        Some(0),
+        "qemu-demo did not exit 0 (not converged?):\n{}",
+        run.log
+    );
+    let (t, rel) = parse_demo_final(&run.log).unwrap_or_else(|e| panic!("{e}\n{}", run.log));
+    let d = max_difference(&rel, &SQUARE).expect("four agents");
+    println!("qemu-demo: converged at t = {t} s, q_i - q_1 = {rel:?}, max |difference to the square| = {d:.2e} m");
+    assert!(
+        d <= TOLERANCE,
+        "final shape {rel:?} is {d} m from the square {SQUARE:?}"
+    );
+}
+
+#[test]
+#[ignore = "needs qemu-system-arm and the firmware ELF; run by scripts/test.sh"]
+fn demo_matches_host_sim() {
+    let run = demo();
+    assert_eq!(run.code, Some(0), "qemu-demo did not exit 0:\n{}", run.log);
+    let (_, firmware) = parse_demo_final(&run.log).unwrap_or_else(|e| panic!("{e}\n{}", run.log));
+    let host = relative(&host_sim_final_positions());
+    let d = max_difference(&firmware, &host).unwrap_or_else(|e| panic!("{e}"));
+    println!("qemu-demo (f32) vs host-sim (f64): q_i - q_1 firmware {firmware:?}, host {host:?}, max difference {d:.2e} m");
+    assert!(
+        d <= TOLERANCE,
+        "firmware {firmware:?} and host-sim {host:?} differ by {d} m > {TOLERANCE} m"
+    );
+}
+
+// ------------------------------------------------------------------ plain tests
+
+const DEMO_OUTPUT: &str = "INFO  t=5.0 s: angle error 0.07 rad\n\
+DEMO final t=67.87 rel=0.0,0.0;-9.999017,9.999824;9.999203,9.998219;0.00097146025,19.998024\n\
+DEMO result converged=true t=67.87\n";
+
+const SUMMARY: &str = r#"{
+  "scenario": "paper",
+  "converged": true,
+  "final_positions": [ [300.9, 302.2], [290.90000001, 312.2],
+    [310.9, 312.2] ,[300.9,322.2] ],
+  "final_velocities": [[3.0, 3.0], [3.0, 3.0], [3.0, 3.0], [3.0, 3.0]]
+}"#;
+
+#[test]
+fn parses_the_demo_line() {
+    let (t, rel) = parse_demo_final(DEMO_OUTPUT).expect("parse");
+    assert_eq!(t, 67.87);
+    assert_eq!(rel.len(), 4);
+    assert_eq!(rel[1], [-9.999017, 9.999824]);
+    assert!(parse_demo_final("no such line").is_err());
+    assert!(parse_demo_final("DEMO final t=1 rel=1,2;3").is_err());
+}
+
+#[test]
+fn parses_final_positions_of_a_summary() {
+    let p = parse_final_positions(SUMMARY).expect("parse");
+    assert_eq!(p.len(), 4);
+    assert_eq!(p[1], [290.90000001, 312.2]);
+    assert!(parse_final_positions("{\"final_positions\": [[1, 2, 3]]}").is_err());
+    assert!(parse_final_positions("{}").is_err());
+    assert!(parse_final_positions("{\"final_positions\":[]}")
+        .expect("empty")
+        .is_empty());
+}
+
+#[test]
+fn compares_relative_positions() {
+    let (_, firmware) = parse_demo_final(DEMO_OUTPUT).expect("parse");
+    let host = relative(&parse_final_positions(SUMMARY).expect("parse"));
+    assert!((host[3][1] - 20.0).abs() < 1e-9);
+    let d = max_difference(&firmware, &host).expect("same length");
+    assert!(d > 1e-3 && d < TOLERANCE, "{d}");
+    assert!(max_difference(&firmware, &SQUARE).expect("same length") < TOLERANCE);
+    // A mirrored square is far off.
+    let mirrored: Vec<[f64; 2]> = SQUARE.iter().map(|p| [-p[0], p[1]]).collect();
+    assert!(max_difference(&firmware, &mirrored).expect("same length") > 10.0);
+    assert!(max_difference(&firmware, &host[..3]).is_err());
+}
