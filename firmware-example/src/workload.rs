@@ -18,15 +18,20 @@
 //! estimates) and a far vertex of `k` more; it is also a leader (S11, partner
 //! `r_0`) and tracks `v*` (S12): every term of the law is exercised.
 //!
-//! [`Bench::new`] builds the fan deterministically: all agents move at
+//! [`Bench::reset`] builds the fan deterministically: all agents move at
 //! constant, distinct velocities near the desired shape; the centre and the
 //! rim agents (real `controller-core` agents) run [`WARMUP_TICKS`] ticks
 //! before the measured one, and the frames the rim agents broadcast in the
-//! measured tick are kept (see [`Bench::reset`] for how). The centre has not
-//! heard anybody before the measured tick: its step is nominal (checked by
-//! the `measure` binary) because the frames it decodes first carry
-//! everything it needs. The bench then holds the centre's state, the frames
-//! its neighbours broadcast in the measured tick and its own measurements.
+//! measured tick are kept. The rim agents run one at a time (keeping all
+//! nine alive at once would take 8 KiB of RAM) and hear nobody, so they
+//! answer with their safe output and hold their estimates at `r̂(0)`; their
+//! frames are nonetheless complete (velocity, the bearings and bearing rates
+//! their far vertices need, the estimates they own), which is all that the
+//! centre's receive and step depend on. The centre has not heard anybody
+//! before the measured tick: its step is nominal (checked by the `measure`
+//! binary) because the frames it decodes first carry everything it needs.
+//! The bench then holds the centre's state, the frames its neighbours
+//! broadcast in the measured tick and its own measurements.
 
 use controller_core::{
     Agent, AgentConfig, AgentId, AngleConfig, BearingMeasurement, ConfigError, LeaderConfig,
@@ -456,13 +461,9 @@ impl Bench {
     ///
     /// The centre runs [`WARMUP_TICKS`] ticks on its own measurements (so
     /// that its finite-difference bearing rates are non-zero). Each rim agent
-    /// then runs `WARMUP_TICKS + 1` ticks, one agent at a time (keeping all
-    /// nine rim agents alive at once would take 8 KiB of RAM), and the frames
-    /// it broadcasts in its last tick go to [`Bench::rx`]. The rim agents
-    /// hear nobody, so they answer with their safe output and hold their
-    /// estimates at `r̂(0)`; their frames are nonetheless complete (velocity,
-    /// the bearings and rates their far vertices need, the estimates they
-    /// own), which is all that the centre's receive and step depend on.
+    /// then runs `WARMUP_TICKS + 1` ticks, one agent at a time, and the frames
+    /// it broadcasts in its last tick go to [`Bench::rx`] (see the module
+    /// docs).
     #[inline(never)]
     fn prepare(&mut self, fan: &Fan) -> Result<(), BenchError> {
         let Some(centre) = self.agent.as_mut() else {

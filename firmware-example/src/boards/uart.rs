@@ -33,7 +33,8 @@
 //! `Step`'s `time` and advances by each `Step`'s `dt` (rounded to 1 µs).
 //!
 //! The protocol logic ([`Session`]) is generic over a [`SerialPort`];
-//! [`Usart1`] (MCU only) is the STM32F4 USART1 polled without interrupts.
+//! `Usart1` (MCU builds only) is the STM32F4 USART1, polled, sleeping in
+//! `wfi` while it waits for a byte.
 
 use controller_core::link::{
     HostMsg, LinkError, LinkEstimate, LinkOutput, LinkStep, TargetMsg, LINK_VERSION,
