@@ -1,5 +1,6 @@
 //! Host-in-the-loop over the emulated UART: the `qemu-uart` firmware under QEMU
-//! (netduinoplus2, USART1 on a loopback TCP socket) runs agent 3 of the paper
+//! (netduinoplus2, USART1 connected to a loopback TCP socket this test listens
+//! on, `nodelay=on`) runs agent 3 of the paper
 //! scenario in lock step with agents 1, 2 and 4 simulated here in `f64`.
 //!
 //! Checks: the handshake (`Configure` → `Ready`), that every `Step` gets the
@@ -150,7 +151,8 @@ impl Qemu {
             ])
             .args(["-semihosting-config", "enable=on,target=native"])
             .arg("-serial")
-            .arg(format!("tcp:127.0.0.1:{port},server=on,wait=on,nodelay=on"))
+            // QEMU connects to the test's listening socket (no port race).
+            .arg(format!("tcp:127.0.0.1:{port},nodelay=on"))
             .arg("-kernel")
             .arg(elf)
             .stdin(Stdio::null())
@@ -205,18 +207,28 @@ struct Link {
 }
 
 impl Link {
-    fn connect(port: u16) -> Link {
+    /// Accepts QEMU's connection to `listener` (QEMU connects while it
+    /// starts; the deadline only guards against a QEMU that never does).
+    fn accept(listener: &TcpListener, qemu: &mut Qemu) -> Link {
+        listener.set_nonblocking(true).expect("nonblocking");
         let deadline = Instant::now() + Duration::from_secs(20);
         let stream = loop {
-            match TcpStream::connect(("127.0.0.1", port)) {
-                Ok(s) => break s,
-                Err(e) if Instant::now() < deadline => {
-                    let _ = e;
+            match listener.accept() {
+                Ok((s, _)) => break s,
+                Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {
+                    if let Ok(Some(status)) = qemu.child.try_wait() {
+                        panic!("QEMU exited ({status}) before connecting; see target/qemu-tests/qemu-uart.stderr.txt");
+                    }
+                    assert!(
+                        Instant::now() < deadline,
+                        "QEMU did not connect to the serial socket within 20 s"
+                    );
                     std::thread::yield_now();
                 }
-                Err(e) => panic!("cannot connect to QEMU's serial port {port}: {e}"),
+                Err(e) => panic!("accept: {e}"),
             }
         };
+        stream.set_nonblocking(false).expect("blocking");
         stream.set_nodelay(true).expect("nodelay");
         stream.set_read_timeout(Some(READ_GUARD)).expect("timeout");
         Link {
@@ -333,13 +345,11 @@ fn uart_agent_in_the_loop() {
     let out_dir = root().join("target/qemu-tests");
     std::fs::create_dir_all(&out_dir).expect("output directory");
 
-    // A free loopback port (released just before QEMU binds it).
-    let port = TcpListener::bind("127.0.0.1:0")
-        .and_then(|l| l.local_addr())
-        .expect("free port")
-        .port();
+    // The test listens on a free loopback port; QEMU's USART1 connects to it.
+    let listener = TcpListener::bind("127.0.0.1:0").expect("listen on a loopback port");
+    let port = listener.local_addr().expect("local address").port();
     let mut qemu = Qemu::start(&elf, port, &out_dir);
-    let mut link = Link::connect(port);
+    let mut link = Link::accept(&listener, &mut qemu);
     link.wait_announce();
 
     // Handshake.
