@@ -4,7 +4,7 @@
 use crate::config::{AgentConfig, AgentId, ConfigError, EstimatorMode, LeaderRole, Schedule};
 use crate::geometry::AngleGeometry;
 use crate::law;
-use crate::wire::{decode_frame, FrameError, FrameWriter, WireItem};
+use crate::wire::{check_frame, FrameError, FrameWriter, WireItem};
 use crate::{FrameStats, Real, Vec2};
 
 /// No neighbour slot (the vertex is this agent itself).
@@ -206,9 +206,12 @@ struct AngleState<T: Real> {
     remote_estimate: Option<T>,
 }
 
-#[derive(Clone, Copy, Debug)]
-struct Neighbour<T: Real> {
+#[derive(Clone, Debug)]
+struct Neighbour<T: Real, const MT: usize> {
     id: AgentId,
+    /// Angles (flat index `2·triangle + angle`) whose apex is this neighbour and of which
+    /// this agent is a far vertex: where its bearing and estimate items go.
+    apex_of: heapless::Vec<u8, MT>,
     /// Is in a triangle with this agent (needs a bearing every tick).
     in_triangle: bool,
     /// Some triangle neighbour needs this agent's bearing to it (far vertex of own apex angle).
@@ -234,7 +237,7 @@ struct Neighbour<T: Real> {
 pub struct Agent<T: Real, const MT: usize, const NB: usize> {
     config: AgentConfig<T, MT>,
     angles: heapless::Vec<[AngleState<T>; 2], MT>,
-    neighbours: heapless::Vec<Neighbour<T>, NB>,
+    neighbours: heapless::Vec<Neighbour<T, MT>, NB>,
     partner_slot: usize,
     time: T,
     velocity: Vec2<T>,
@@ -279,7 +282,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     pub fn new(config: AgentConfig<T, MT>) -> Result<Self, ConfigError> {
         Self::check_parameters(&config)?;
         let me = config.id;
-        let mut neighbours: heapless::Vec<Neighbour<T>, NB> = heapless::Vec::new();
+        let mut neighbours: heapless::Vec<Neighbour<T, MT>, NB> = heapless::Vec::new();
         let mut angles = heapless::Vec::new();
         for (ti, tri) in config.triangles.iter().enumerate() {
             Self::check_triangle(me, ti, tri, &config.limits)?;
@@ -314,6 +317,13 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                             n.bearing_needed = true;
                         }
                     }
+                } else if let Some(n) = neighbours.get_mut(slots[0]) {
+                    // At most one controlled angle per triangle has this apex: ≤ MT entries.
+                    let flat =
+                        u8::try_from(2 * ti + ai).map_err(|_| ConfigError::TooManyNeighbours)?;
+                    n.apex_of
+                        .push(flat)
+                        .map_err(|_| ConfigError::TooManyNeighbours)?;
                 }
                 if let Some(p) = pair.get_mut(ai) {
                     *p = Some(AngleState {
@@ -434,7 +444,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     }
 
     fn add_neighbour(
-        list: &mut heapless::Vec<Neighbour<T>, NB>,
+        list: &mut heapless::Vec<Neighbour<T, MT>, NB>,
         id: AgentId,
         in_triangle: bool,
     ) -> Result<usize, ConfigError> {
@@ -446,6 +456,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         }
         list.push(Neighbour {
             id,
+            apex_of: heapless::Vec::new(),
             in_triangle,
             bearing_needed: false,
             heard: false,
@@ -558,7 +569,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
 
     // ---------------------------------------------------------------- control law
 
-    fn neighbour(&self, slot: usize) -> Option<&Neighbour<T>> {
+    fn neighbour(&self, slot: usize) -> Option<&Neighbour<T, MT>> {
         self.neighbours.get(slot)
     }
 
@@ -866,7 +877,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 send(writer.finish());
                 count += 1;
                 seq = seq.wrapping_add(1);
-                writer = FrameWriter::new(id, seq);
+                writer.reset(id, seq);
                 // A single item always fits in an empty frame.
                 let _ = writer.push(&wire);
             }
@@ -889,7 +900,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     }
 
     fn receive_inner(&mut self, bytes: &[u8]) -> Result<(), FrameError> {
-        let frame = decode_frame(bytes, self.config.limits.bearing_tolerance.as_f32())?;
+        let frame = check_frame(bytes)?;
         let sender = frame.header.sender;
         if sender == self.config.id {
             return Err(FrameError::OwnFrame);
@@ -898,7 +909,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         let timeout = self.config.limits.neighbour_timeout;
         let n = self
             .neighbours
-            .get_mut(slot)
+            .get(slot)
             .ok_or(FrameError::UnknownSender(sender))?;
         let seq = frame.header.seq;
         if let Some(last) = n.last_seq {
@@ -909,11 +920,15 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 return Err(FrameError::StaleSequence { sender, seq });
             }
         }
-        n.last_seq = Some(seq);
-        n.heard = true;
-        n.age = T::zero();
-        for item in &frame.items {
-            self.apply(sender, slot, Item::from_wire(item));
+        // Whole frame valid before anything is applied.
+        frame.validate(self.config.limits.bearing_tolerance.as_f32())?;
+        if let Some(n) = self.neighbours.get_mut(slot) {
+            n.last_seq = Some(seq);
+            n.heard = true;
+            n.age = T::zero();
+        }
+        for item in frame.items().flatten() {
+            self.apply(sender, slot, Item::from_wire(&item));
         }
         Ok(())
     }
@@ -933,32 +948,36 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
 
     fn apply(&mut self, sender: AgentId, slot: usize, item: Item<T>) {
         let me = self.config.id;
-        match item {
+        let Some(n) = self.neighbours.get_mut(slot) else {
+            return;
+        };
+        let (other, update): (AgentId, Item<T>) = match item {
             Item::Velocity(v) => {
-                if let Some(n) = self.neighbours.get_mut(slot) {
-                    n.velocity = Some(v);
-                }
+                n.velocity = Some(v);
+                return;
             }
-            Item::Bearing { to, s, rate } => {
-                for a in self.angles.iter_mut().flatten() {
-                    if let Role::Far(k) = a.role {
-                        if a.apex == sender && pick(&a.far, 1 - k.min(1)) == to {
-                            a.remote_bearing = Some((s, rate));
-                        }
-                    }
-                }
+            Item::Bearing { to, .. } => (to, item),
+            Item::Estimate { far, other, .. } if far == me => (other, item),
+            Item::Estimate { .. } => return,
+        };
+        // Only the angles whose apex is the sender and of which this agent is a far vertex.
+        for &flat in &n.apex_of {
+            let flat = usize::from(flat);
+            let Some(a) = self
+                .angles
+                .get_mut(flat / 2)
+                .and_then(|t| t.get_mut(flat % 2))
+            else {
+                continue;
+            };
+            let Role::Far(k) = a.role else { continue };
+            if a.apex != sender || pick(&a.far, 1 - k.min(1)) != other {
+                continue;
             }
-            Item::Estimate { far, other, r } => {
-                if far != me {
-                    return;
-                }
-                for a in self.angles.iter_mut().flatten() {
-                    if let Role::Far(k) = a.role {
-                        if a.apex == sender && pick(&a.far, 1 - k.min(1)) == other {
-                            a.remote_estimate = Some(r);
-                        }
-                    }
-                }
+            match update {
+                Item::Bearing { s, rate, .. } => a.remote_bearing = Some((s, rate)),
+                Item::Estimate { r, .. } => a.remote_estimate = Some(r),
+                Item::Velocity(_) => {}
             }
         }
     }

@@ -23,6 +23,8 @@ pub const MAX_ITEMS_PER_FRAME: usize = 8;
 pub const MAX_COBS_LEN: usize = MAX_FRAME_LEN + MAX_FRAME_LEN / 254 + 2;
 
 const CRC_LEN: usize = 2;
+/// CRC-16/IBM-3740, byte-wise table (512 B of flash). The slice-by-16 table was measured
+/// on target: 13 % fewer CRC instructions on 30–60-byte frames for 8.7 KiB more flash.
 const CRC16: crc::Crc<u16> = crc::Crc::<u16>::new(&crc::CRC_16_IBM_3740);
 
 /// The start of every frame.
@@ -134,16 +136,20 @@ impl FrameWriter {
             len: 0,
             items: 0,
         };
+        w.reset(sender, seq);
+        w
+    }
+
+    /// Starts a new frame in the same buffer.
+    pub fn reset(&mut self, sender: AgentId, seq: u16) {
         let header = FrameHeader {
             version: WIRE_VERSION,
             sender,
             seq,
         };
+        self.items = 0;
         // The header is at most 5 bytes: it always fits.
-        if let Ok(used) = postcard::to_slice(&header, &mut w.buf) {
-            w.len = used.len();
-        }
-        w
+        self.len = postcard::to_slice(&header, &mut self.buf).map_or(0, |used| used.len());
     }
 
     /// Appends `item` if it fits (leaving room for the CRC); returns whether it did.
@@ -189,9 +195,60 @@ pub struct Frame {
     pub items: heapless::Vec<WireItem, MAX_ITEMS_PER_FRAME>,
 }
 
-/// Decodes one frame and checks length, CRC, version and item values (finite, unit
-/// bearings within `bearing_tolerance` on `|s|²`, positive estimates). Never panics.
-pub fn decode_frame(bytes: &[u8], bearing_tolerance: f32) -> Result<Frame, FrameError> {
+/// A frame whose length, CRC and version are checked; its items are decoded lazily, in
+/// place, by [`FrameView::items`] (no copy of the frame).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FrameView<'a> {
+    /// The header.
+    pub header: FrameHeader,
+    items: &'a [u8],
+}
+
+impl<'a> FrameView<'a> {
+    /// Iterates the items; a malformed item ends the iteration with an error.
+    pub fn items(&self) -> Items<'a> {
+        Items { rest: self.items }
+    }
+
+    /// Checks every item (decodes and values) without keeping them.
+    pub fn validate(&self, bearing_tolerance: f32) -> Result<(), FrameError> {
+        for item in self.items() {
+            if !item_valid(&item?, bearing_tolerance) {
+                return Err(FrameError::InvalidValue);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Iterator over the items of a [`FrameView`].
+#[derive(Clone, Debug)]
+pub struct Items<'a> {
+    rest: &'a [u8],
+}
+
+impl Iterator for Items<'_> {
+    type Item = Result<WireItem, FrameError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.rest.is_empty() {
+            return None;
+        }
+        Some(match postcard::take_from_bytes::<WireItem>(self.rest) {
+            Ok((item, rest)) => {
+                self.rest = rest;
+                Ok(item)
+            }
+            Err(_) => {
+                self.rest = &[];
+                Err(FrameError::Malformed)
+            }
+        })
+    }
+}
+
+/// Checks length, CRC and version of one frame and returns a view of it. Never panics.
+pub fn check_frame(bytes: &[u8]) -> Result<FrameView<'_>, FrameError> {
     if bytes.len() > MAX_FRAME_LEN {
         return Err(FrameError::TooLong);
     }
@@ -207,22 +264,28 @@ pub fn decode_frame(bytes: &[u8], bearing_tolerance: f32) -> Result<Frame, Frame
     if CRC16.checksum(body) != expected {
         return Err(FrameError::BadCrc);
     }
-    let (header, mut rest): (FrameHeader, &[u8]) =
+    let (header, items): (FrameHeader, &[u8]) =
         postcard::take_from_bytes(body).map_err(|_| FrameError::TooShort)?;
     if header.version != WIRE_VERSION {
         return Err(FrameError::UnknownVersion(header.version));
     }
+    Ok(FrameView { header, items })
+}
+
+/// Decodes one frame completely and checks length, CRC, version and item values (finite,
+/// unit bearings within `bearing_tolerance` on `|s|²`, positive estimates). Never panics.
+/// (Agents use the copy-free [`check_frame`] + [`FrameView::validate`] instead.)
+pub fn decode_frame(bytes: &[u8], bearing_tolerance: f32) -> Result<Frame, FrameError> {
+    let view = check_frame(bytes)?;
+    view.validate(bearing_tolerance)?;
     let mut items = heapless::Vec::new();
-    while !rest.is_empty() {
-        let (item, r): (WireItem, &[u8]) =
-            postcard::take_from_bytes(rest).map_err(|_| FrameError::Malformed)?;
-        if !item_valid(&item, bearing_tolerance) {
-            return Err(FrameError::InvalidValue);
-        }
-        items.push(item).map_err(|_| FrameError::Malformed)?;
-        rest = r;
+    for item in view.items() {
+        items.push(item?).map_err(|_| FrameError::Malformed)?;
     }
-    Ok(Frame { header, items })
+    Ok(Frame {
+        header: view.header,
+        items,
+    })
 }
 
 fn finite2(v: &[f32; 2]) -> bool {
