@@ -7,8 +7,8 @@
 //!   relative positions `q_i − q_1` are the paper's square, `(0, 0)`,
 //!   `(−10, 10)`, `(10, 10)`, `(0, 20)`, within [`TOLERANCE`].
 //! * `demo_matches_host_sim`: the same relative positions agree with those of
-//!   `host-sim run paper` (its `summary.json`, `final_positions`) within
-//!   [`TOLERANCE`].
+//!   `cargo run --release -p host-sim -- run paper --out <tmp> --quiet
+//!   --no-plots` (its `summary.json`, `final_positions`) within [`TOLERANCE`].
 //!
 //! Tolerance: 1e-2 m on a square of side 14 m. The demo stops as soon as all
 //! its angle errors are below 1e-4 rad and its leader error below 1e-3 m
@@ -198,7 +198,8 @@ fn host_sim_final_positions() -> Vec<[f64; 2]> {
                     "--out",
                 ])
                 .arg(&dir)
-                .arg("--quiet")
+                // The plots take most of the run time (about 50 s of 50 s).
+                .args(["--quiet", "--no-plots"])
                 .output()
                 .expect("run cargo");
             assert!(
