@@ -27,7 +27,12 @@ cargo build -p controller-core --target thumbv7em-none-eabihf --release --featur
 cargo clippy -p firmware-example --target thumbv7em-none-eabihf --release --all-targets -- -D warnings
 
 step "host tests (controller-core, host-sim, cross-crate tests)"
-cargo test --workspace
+cargo test
 
-step "firmware under QEMU: sizes, instructions per step, stack, no soft f64"
+step "firmware under QEMU: sizes, instructions per step, stack, no soft f64, demo, UART session"
 bash scripts/firmware-check.sh
+
+step "QEMU tests: demo vs host-sim, UART link, host-in-the-loop runs"
+cargo build -p firmware-example --target thumbv7em-none-eabihf --release --bins
+cargo test -p ph-formation-tests --test qemu_demo --test qemu_uart -- --include-ignored
+cargo test -p host-sim --test hil -- --include-ignored
