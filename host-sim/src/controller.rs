@@ -3,9 +3,11 @@
 //! The simulator gives a controller what the agent's own sensors measured and the frames
 //! its radio received since the last tick; the controller returns a force and the frames
 //! to broadcast. [`LocalCore`] runs a `controller-core` [`Agent`](controller_core::Agent)
-//! in process; a remote implementation (e.g. a controller in QEMU behind a UART) can
-//! implement [`AgentController`] the same way.
+//! in process; [`crate::hil::controller::HilController`] runs it on an emulated target
+//! behind a UART. Remote controllers answer in two phases ([`AgentController::start_tick`],
+//! [`AgentController::finish_tick`]) so that several compute at once.
 
+use crate::hil::{HilError, LinkStats};
 use crate::model::CoreAgent;
 use crate::radio::RadioFrame;
 use controller_core::{FrameStats, Measurements, OwnedEstimate, StepOutput};
@@ -34,6 +36,44 @@ pub trait AgentController {
 
     /// Counters of received frames.
     fn frame_stats(&self) -> FrameStats;
+
+    /// First phase of a tick: like [`Self::tick`], but a remote controller only sends
+    /// its inputs and returns `Ok(None)`; the simulator then collects the output with
+    /// [`Self::finish_tick`] after starting every other agent's tick. The default runs
+    /// the whole tick at once.
+    fn start_tick(
+        &mut self,
+        inbox: &[RadioFrame],
+        m: &Measurements<'_, f64>,
+        outbox: &mut Vec<RadioFrame>,
+    ) -> Result<Option<StepOutput<f64>>, HilError> {
+        Ok(Some(self.tick(inbox, m, outbox)))
+    }
+
+    /// Second phase of a tick that [`Self::start_tick`] left pending: appends the frames
+    /// to broadcast to `outbox` and returns the force command.
+    fn finish_tick(&mut self, outbox: &mut Vec<RadioFrame>) -> Result<StepOutput<f64>, HilError> {
+        let _ = outbox;
+        Err(HilError::Usage(format!(
+            "agent {}: finish_tick without a pending tick",
+            self.id()
+        )))
+    }
+
+    /// A failure kept by [`Self::tick`] (which cannot return one), if any.
+    fn take_error(&mut self) -> Option<HilError> {
+        None
+    }
+
+    /// End of the run (a remote controller says goodbye to its target).
+    fn finish(&mut self) -> Result<(), HilError> {
+        Ok(())
+    }
+
+    /// Link figures of a remote controller.
+    fn link_stats(&self) -> Option<LinkStats> {
+        None
+    }
 }
 
 /// A `controller-core` agent running in the simulator's process.

@@ -18,6 +18,61 @@ pub mod exit_code {
     pub const ESTIMATE_COLLAPSE: u8 = 12;
     /// The state became non-finite, too fast, or `V` grew without bound.
     pub const DIVERGED: u8 = 13;
+    /// Host-in-the-loop: `qemu-system-arm` not found.
+    pub const HIL_NO_QEMU: u8 = 30;
+    /// Host-in-the-loop: the firmware ELF not found.
+    pub const HIL_NO_FIRMWARE: u8 = 31;
+    /// Host-in-the-loop: QEMU did not start or connect, exited, or closed the link.
+    pub const HIL_TARGET_FAILED: u8 = 32;
+    /// Host-in-the-loop: the firmware did not answer within the timeout.
+    pub const HIL_TIMEOUT: u8 = 33;
+    /// Host-in-the-loop: a corrupt link frame or a message out of protocol.
+    pub const HIL_CORRUPT: u8 = 34;
+    /// Host-in-the-loop: the agent's configuration does not fit the firmware, or the
+    /// firmware refused it.
+    pub const HIL_REFUSED: u8 = 35;
+}
+
+/// Why a run stopped without a result.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RunError {
+    /// Setup or output failure (exit code [`exit_code::IO`]).
+    Failed(String),
+    /// A host-in-the-loop failure (its own exit code).
+    Hil(crate::hil::HilError),
+}
+
+impl RunError {
+    /// The process exit code.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Self::Failed(_) => exit_code::IO,
+            Self::Hil(e) => e.exit_code(),
+        }
+    }
+}
+
+impl fmt::Display for RunError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Failed(s) => f.write_str(s),
+            Self::Hil(e) => write!(f, "host-in-the-loop: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for RunError {}
+
+impl From<String> for RunError {
+    fn from(s: String) -> Self {
+        Self::Failed(s)
+    }
+}
+
+impl From<crate::hil::HilError> for RunError {
+    fn from(e: crate::hil::HilError) -> Self {
+        Self::Hil(e)
+    }
 }
 
 /// What is wrong with a scenario; each kind has its own exit code.

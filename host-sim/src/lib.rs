@@ -12,6 +12,8 @@
 //! * [`plant`], [`sensors`], [`radio`], [`controller`]: the pieces of one run.
 //! * [`diagnostics`]: V (S13), errors, failure detection; [`output`]: `timeseries.csv`
 //!   and `summary.json`; [`plot`]: the figures; [`cli`]: the command line.
+//! * [`hil`]: host-in-the-loop, some agents' controllers as firmware in QEMU behind an
+//!   emulated UART (`docs/hil.md`).
 //!
 //! Schemas: `docs/scenarios.md` (input) and `docs/outputs.md` (output, exit codes).
 
@@ -24,6 +26,7 @@ pub mod controller;
 pub mod diagnostics;
 pub mod error;
 pub mod graph;
+pub mod hil;
 pub mod model;
 pub mod output;
 pub mod plant;

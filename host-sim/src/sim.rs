@@ -5,13 +5,15 @@
 use crate::continuous::ContinuousSim;
 use crate::controller::{AgentController, LocalCore};
 use crate::diagnostics::{resolve_estimates, Diagnostics, EstimateInfo, Event, Monitor, Outcome};
+use crate::error::RunError;
+use crate::hil::{HilError, LinkStats};
 use crate::model::Model;
 use crate::output::{Recorder, Row};
 use crate::plant::Plant;
 use crate::radio::{Radio, RadioFrame};
 use crate::scenario::{BearingRate, Estimator, Mode};
 use crate::sensors::Sensors;
-use controller_core::{BearingMeasurement, Fault, Measurements, Status, Vec2};
+use controller_core::{BearingMeasurement, Fault, Measurements, Status, StepOutput, Vec2};
 use std::time::Instant;
 
 /// Cumulative frame counters of a run (link copies; see `docs/outputs.md`).
@@ -101,6 +103,12 @@ pub trait Engine {
     fn frame_counts(&self) -> FrameCounts;
     /// Controller counters so far.
     fn control_stats(&self) -> ControlStats;
+    /// A controller failure that ends the run (a host-in-the-loop target that stopped
+    /// answering or sent a corrupt frame), taken once; checked after every
+    /// [`Self::control`].
+    fn take_error(&mut self) -> Option<HilError> {
+        None
+    }
 }
 
 /// The sampled-data simulator.
@@ -112,7 +120,9 @@ pub struct SampledSim<'m> {
     sensors: Sensors,
     radio: Radio,
     inboxes: Vec<Vec<RadioFrame>>,
-    outbox: Vec<RadioFrame>,
+    outboxes: Vec<Vec<RadioFrame>>,
+    outputs: Vec<Option<StepOutput<f64>>>,
+    error: Option<HilError>,
     forces: Vec<Vec2<f64>>,
     bearings: Vec<BearingMeasurement<f64>>,
     partner: Vec<Option<usize>>,
@@ -191,7 +201,11 @@ impl<'m> SampledSim<'m> {
             sensors: Sensors::new(&model.sensors, model.seed),
             radio: Radio::new(&model.radio, n, model.seed, capacity),
             inboxes,
-            outbox: Vec::with_capacity(4 * FRAMES_PER_TICK),
+            outboxes: (0..n)
+                .map(|_| Vec::with_capacity(4 * FRAMES_PER_TICK))
+                .collect(),
+            outputs: vec![None; n],
+            error: None,
             forces: vec![Vec2::zeros(); n],
             bearings: Vec::with_capacity(model.graph.triangle.max_degree()),
             partner,
@@ -217,10 +231,33 @@ impl<'m> SampledSim<'m> {
             }
         }
     }
+
+    /// Ends every controller's session (host-in-the-loop targets get `Finish`).
+    pub fn finish_controllers(&mut self) -> Result<(), HilError> {
+        for c in &mut self.controllers {
+            c.finish()?;
+        }
+        Ok(())
+    }
+
+    /// The link figures of the remote controllers, in agent order.
+    pub fn link_stats(&self) -> Vec<LinkStats> {
+        self.controllers
+            .iter()
+            .filter_map(|c| c.link_stats())
+            .collect()
+    }
 }
 
 impl Engine for SampledSim<'_> {
+    /// Two phases: every agent is measured in agent order and its tick started (local
+    /// controllers complete it at once, remote ones only send their inputs), then every
+    /// output is collected and every agent's frames broadcast, in agent order (so the
+    /// random streams are drawn in the same order as without remote controllers).
     fn control(&mut self, t: f64) {
+        if self.error.is_some() {
+            return;
+        }
         let model = self.model;
         self.radio.deliver(t, &mut self.inboxes);
         let dt = self.last_tick.map_or(0.0, |p| t - p);
@@ -247,10 +284,28 @@ impl Engine for SampledSim<'_> {
                 bearings: &self.bearings,
                 partner_offset,
             };
-            self.outbox.clear();
-            let out = self.controllers[i].tick(&self.inboxes[i], &m, &mut self.outbox);
+            self.outboxes[i].clear();
+            match self.controllers[i].start_tick(&self.inboxes[i], &m, &mut self.outboxes[i]) {
+                Ok(out) => self.outputs[i] = out,
+                Err(e) => {
+                    self.error = Some(e);
+                    return;
+                }
+            }
             self.inboxes[i].clear();
-            for f in &self.outbox {
+        }
+        for i in 0..model.n() {
+            let out = match self.outputs[i].take() {
+                Some(out) => out,
+                None => match self.controllers[i].finish_tick(&mut self.outboxes[i]) {
+                    Ok(out) => out,
+                    Err(e) => {
+                        self.error = Some(e);
+                        return;
+                    }
+                },
+            };
+            for f in &self.outboxes[i] {
                 self.radio
                     .broadcast(t, i, model.graph.radio.of(i), f.as_bytes());
             }
@@ -311,6 +366,13 @@ impl Engine for SampledSim<'_> {
     fn control_stats(&self) -> ControlStats {
         self.stats
     }
+
+    fn take_error(&mut self) -> Option<HilError> {
+        if self.error.is_none() {
+            self.error = self.controllers.iter_mut().find_map(|c| c.take_error());
+        }
+        self.error.take()
+    }
 }
 
 /// Everything a run found (written to `summary.json` by [`crate::output`]).
@@ -363,6 +425,8 @@ pub struct RunResult {
     pub steps: usize,
     /// Wall-clock seconds.
     pub wall_seconds: f64,
+    /// Link figures of the host-in-the-loop agents (empty without).
+    pub hil: Vec<LinkStats>,
 }
 
 fn signed_area(q: &[Vec2<f64>], t: [usize; 3]) -> f64 {
@@ -382,7 +446,7 @@ pub fn run(
     match model.mode {
         Mode::Sampled => {
             let mut e = SampledSim::new(model)?;
-            drive(model, &mut e, recorder, progress, warnings)
+            drive(model, &mut e, recorder, progress, warnings).map_err(|e| e.to_string())
         }
         Mode::Continuous => {
             if model.sensors.is_noisy() {
@@ -396,20 +460,21 @@ pub fn run(
                     .push("continuous mode: the radio settings are ignored (no radio)".to_owned());
             }
             let mut e = ContinuousSim::new(model)?;
-            drive(model, &mut e, recorder, progress, warnings)
+            drive(model, &mut e, recorder, progress, warnings).map_err(|e| e.to_string())
         }
     }
 }
 
 /// The time loop: control ticks, RK4 steps, diagnostics at every control instant and
-/// every log instant, logging, failure detection.
+/// every log instant, logging, failure detection. A controller failure
+/// ([`Engine::take_error`]) ends it with [`RunError::Hil`].
 pub fn drive(
     model: &Model,
     engine: &mut dyn Engine,
     recorder: &mut dyn Recorder,
     progress: &mut dyn FnMut(f64),
     warnings: Vec<String>,
-) -> Result<RunResult, String> {
+) -> Result<RunResult, RunError> {
     let started = Instant::now();
     let total = model.total_steps();
     let spt = model.steps_per_tick.max(1);
@@ -428,6 +493,10 @@ pub fn drive(
         let tick = k.is_multiple_of(spt);
         if tick {
             engine.control(t);
+            if let Some(e) = engine.take_error() {
+                let _ = recorder.finish();
+                return Err(RunError::Hil(e));
+            }
         }
         let log = k.is_multiple_of(log_every) || k == total;
         if tick || log {
@@ -498,5 +567,6 @@ pub fn drive(
         warnings,
         steps,
         wall_seconds: started.elapsed().as_secs_f64(),
+        hil: Vec::new(),
     })
 }
