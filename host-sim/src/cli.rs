@@ -1,7 +1,8 @@
 //! The command line: `host-sim [run|validate|list|plot]` (exit codes in
 //! [`crate::error::exit_code`] and `docs/outputs.md`).
 
-use crate::error::{exit_code, ScenarioErrors};
+use crate::error::{exit_code, RunError, ScenarioErrors};
+use crate::hil::{self, HilOptions};
 use crate::model::Model;
 use crate::output::{summary_json, write_summary, CsvRecorder};
 use crate::scenario::BUILTINS;
@@ -69,6 +70,17 @@ pub struct RunArgs {
     /// Do not draw the plots.
     #[arg(long)]
     pub no_plots: bool,
+    /// Run agent ID's controller as firmware on an emulated STM32F405 (QEMU), over an
+    /// emulated UART; repeat for more agents (see docs/hil.md).
+    #[arg(long = "hil", value_name = "ID")]
+    pub hil: Vec<u8>,
+    /// Firmware ELF for --hil [default: $HOST_SIM_FIRMWARE, else
+    /// WORKSPACE/target/thumbv7em-none-eabihf/release/qemu-uart].
+    #[arg(long, value_name = "PATH")]
+    pub firmware: Option<PathBuf>,
+    /// Seconds an emulated agent may take to answer one control tick (--hil).
+    #[arg(long, value_name = "S", default_value_t = hil::DEFAULT_TIMEOUT_S)]
+    pub hil_timeout: f64,
 }
 
 impl RunArgs {
@@ -103,6 +115,9 @@ pub fn execute(cli: Cli) -> u8 {
                 seed: None,
                 set: Vec::new(),
                 no_plots: false,
+                hil: Vec::new(),
+                firmware: None,
+                hil_timeout: hil::DEFAULT_TIMEOUT_S,
             },
             quiet,
         ),
@@ -203,6 +218,17 @@ pub fn run_to_dir(
     plots: bool,
     quiet: bool,
 ) -> Result<(RunResult, Vec<PathBuf>), String> {
+    run_to_dir_with(model, out, plots, quiet, None).map_err(|e| e.to_string())
+}
+
+/// [`run_to_dir`], with some agents on emulated targets when `hil` is given.
+pub fn run_to_dir_with(
+    model: &Model,
+    out: &Path,
+    plots: bool,
+    quiet: bool,
+    hil: Option<&HilOptions>,
+) -> Result<(RunResult, Vec<PathBuf>), RunError> {
     std::fs::create_dir_all(out)
         .map_err(|e| format!("cannot create output directory {}: {e}", out.display()))?;
     // The estimate layout (for the CSV header) comes from the agents' own configurations.
@@ -221,7 +247,10 @@ pub fn run_to_dir(
         total: model.duration,
         bar: None,
     };
-    let result = sim::run(model, &mut recorder, &mut |t| progress.update(t));
+    let result = match hil {
+        Some(h) => hil::run(model, h, &mut recorder, &mut |t| progress.update(t)),
+        None => sim::run(model, &mut recorder, &mut |t| progress.update(t)).map_err(RunError::from),
+    };
     progress.finish();
     let result = result?;
     let summary = summary_json(model, &result, &layout);
@@ -247,7 +276,18 @@ fn run_command(args: &RunArgs, quiet: bool) -> u8 {
         .out
         .clone()
         .unwrap_or_else(|| Path::new("out").join(&model.name));
-    match run_to_dir(&model, &out, !args.no_plots, quiet) {
+    let hil_options = if args.hil.is_empty() {
+        None
+    } else {
+        match hil_options(args, &model, &out) {
+            Ok(h) => Some(h),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return e.exit_code();
+            }
+        }
+    };
+    match run_to_dir_with(&model, &out, !args.no_plots, quiet, hil_options.as_ref()) {
         Ok((r, files)) => {
             for w in &r.warnings {
                 eprintln!("warning: {w}");
@@ -259,9 +299,28 @@ fn run_command(args: &RunArgs, quiet: bool) -> u8 {
         }
         Err(e) => {
             eprintln!("error: {e}");
-            exit_code::IO
+            e.exit_code()
         }
     }
+}
+
+/// Checks the `--hil` arguments (agent ids, timeout, firmware ELF, QEMU) before anything
+/// is written.
+fn hil_options(args: &RunArgs, model: &Model, out: &Path) -> Result<HilOptions, hil::HilError> {
+    hil::agent_indices(model, &args.hil)?;
+    let opts = HilOptions::qemu(
+        args.hil.clone(),
+        args.firmware.clone(),
+        out,
+        args.hil_timeout,
+    )?;
+    if let hil::Launcher::Qemu {
+        program, firmware, ..
+    } = &opts.launcher
+    {
+        hil::preflight(program, firmware)?;
+    }
+    Ok(opts)
 }
 
 fn g(x: f64) -> String {
@@ -345,8 +404,29 @@ fn print_table(m: &Model, r: &RunResult, out: &Path, n_files: usize) {
             ),
         ),
         ("saturated outputs", r.control.saturated.to_string()),
-        ("output", format!("{} ({n_files} files)", out.display())),
     ];
+    for h in &r.hil {
+        rows.push((
+            "emulated agent",
+            format!(
+                "{}: {} ticks, {} / {} frames and {} / {} bytes to / from the target, {:.1} s in round trips",
+                h.agent,
+                h.ticks,
+                h.frames_to_target,
+                h.frames_from_target,
+                h.bytes_to_target,
+                h.bytes_from_target,
+                h.wall_s
+            ),
+        ));
+    }
+    if !r.hil.is_empty() && r.final_time > 0.0 {
+        rows.push((
+            "wall-clock per simulated s",
+            format!("{:.3} s", r.wall_seconds / r.final_time),
+        ));
+    }
+    rows.extend([("output", format!("{} ({n_files} files)", out.display()))]);
     if !r.orientation_kept.iter().all(|&k| k) {
         rows.push((
             "mirror flips",

@@ -3,6 +3,7 @@
 
 use crate::diagnostics::{EstimateInfo, Snapshot};
 use crate::error::exit_code;
+use crate::hil::LinkStats;
 use crate::model::Model;
 use crate::sim::{FrameCounts, RunResult};
 use controller_core::Vec2;
@@ -190,7 +191,7 @@ pub fn summary_json(model: &Model, r: &RunResult, estimates: &[EstimateInfo]) ->
         .control
         .last_fault
         .map(|(t, i, f)| json!({ "t": t, "agent": id(i), "fault": format!("{f:?}") }));
-    json!({
+    let mut v = json!({
         "scenario": model.name,
         "source": model.source,
         "description": model.description,
@@ -263,6 +264,43 @@ pub fn summary_json(model: &Model, r: &RunResult, estimates: &[EstimateInfo]) ->
         },
         "warnings": r.warnings,
         "steps": r.steps,
+    });
+    // Host-in-the-loop runs only (wall-clock figures would make summaries of the same
+    // seed differ).
+    if let (false, Some(obj)) = (r.hil.is_empty(), v.as_object_mut()) {
+        obj.insert(
+            "hil".to_owned(),
+            Value::Array(r.hil.iter().map(hil_json).collect()),
+        );
+        obj.insert("wall_s".to_owned(), fin(r.wall_seconds));
+        obj.insert(
+            "wall_s_per_sim_s".to_owned(),
+            if r.final_time > 0.0 {
+                fin(r.wall_seconds / r.final_time)
+            } else {
+                Value::Null
+            },
+        );
+    }
+    v
+}
+
+fn hil_json(h: &LinkStats) -> Value {
+    json!({
+        "agent": h.agent,
+        "frames_to_target": h.frames_to_target,
+        "frames_from_target": h.frames_from_target,
+        "bytes_to_target": h.bytes_to_target,
+        "bytes_from_target": h.bytes_from_target,
+        "radio_frames_to_target": h.radio_to_target,
+        "radio_frames_from_target": h.radio_from_target,
+        "ticks": h.ticks,
+        "wall_s": fin(h.wall_s),
+        "startup_s": fin(h.startup_s),
+        "estimates_from": h.estimates_source(),
+        "target_frames_accepted": h.target_accepted,
+        "target_frames_rejected": h.target_rejected,
+        "exit_code": h.exit_code,
     })
 }
 
