@@ -81,6 +81,9 @@ pub struct RunArgs {
     /// Seconds an emulated agent may take to answer one control tick (--hil).
     #[arg(long, value_name = "S", default_value_t = hil::DEFAULT_TIMEOUT_S)]
     pub hil_timeout: f64,
+    /// Do not pin each QEMU to one CPU (--hil; pinned round robin by default, Linux).
+    #[arg(long)]
+    pub hil_no_pin: bool,
 }
 
 impl RunArgs {
@@ -118,6 +121,7 @@ pub fn execute(cli: Cli) -> u8 {
                 hil: Vec::new(),
                 firmware: None,
                 hil_timeout: hil::DEFAULT_TIMEOUT_S,
+                hil_no_pin: false,
             },
             quiet,
         ),

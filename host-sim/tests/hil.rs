@@ -49,6 +49,7 @@ fn fake(agents: &[u8], behaviour: FakeBehaviour, timeout_s: f64) -> HilOptions {
         agents: agents.to_vec(),
         launcher: Launcher::Fake(behaviour),
         timeout: Duration::from_secs_f64(timeout_s),
+        pin: false,
     }
 }
 

@@ -271,6 +271,9 @@ pub struct HilOptions {
     pub launcher: Launcher,
     /// Per-reply timeout.
     pub timeout: Duration,
+    /// Pin each QEMU to one CPU, round robin over the CPUs this process may use (Linux;
+    /// see [`qemu::allowed_cpus`]).
+    pub pin: bool,
 }
 
 impl HilOptions {
@@ -290,6 +293,7 @@ impl HilOptions {
                 log_dir: log_dir.to_owned(),
             },
             timeout: timeout(timeout_s)?,
+            pin: true,
         })
     }
 }
@@ -435,6 +439,7 @@ fn launch(
     launcher: &Launcher,
     qemu_path: Option<&Path>,
     startup: Duration,
+    cpu: Option<usize>,
 ) -> Result<(Link, TargetHandle, Instant, Instant), HilError> {
     let start_err = |reason: String| HilError::Start { agent, reason };
     let listener = TcpListener::bind(("127.0.0.1", 0))
@@ -450,13 +455,14 @@ fn launch(
             firmware, log_dir, ..
         } => {
             let qemu = qemu_path.ok_or_else(|| start_err("no QEMU binary".to_owned()))?;
-            let mut p = QemuProcess::spawn(qemu, firmware, port, agent, log_dir).map_err(|e| {
-                start_err(format!(
-                    "cannot run {} (logs in {}): {e}",
-                    qemu.display(),
-                    log_dir.display()
-                ))
-            })?;
+            let mut p =
+                QemuProcess::spawn(qemu, firmware, port, agent, log_dir, cpu).map_err(|e| {
+                    start_err(format!(
+                        "cannot run {} (logs in {}): {e}",
+                        qemu.display(),
+                        log_dir.display()
+                    ))
+                })?;
             let s = p.accept(&listener, deadline).map_err(|e| {
                 start_err(format!(
                     "{e} (QEMU {}, port {port}, {} s; messages in {})",
@@ -522,10 +528,25 @@ pub fn controllers(
     };
     let startup = opts.timeout.max(Duration::from_secs_f64(STARTUP_TIMEOUT_S));
     // Start every target first (they boot in parallel), then configure each.
+    let cpus = if opts.pin {
+        qemu::allowed_cpus()
+    } else {
+        Vec::new()
+    };
     let mut launched = Vec::with_capacity(indices.len());
-    for &i in &indices {
+    for (k, &i) in indices.iter().enumerate() {
         let id = model.agents[i].id;
-        launched.push(launch(id, &opts.launcher, qemu_path.as_deref(), startup)?);
+        let cpu = match cpus.len() {
+            0 | 1 => None,
+            n => cpus.get(k % n).copied(),
+        };
+        launched.push(launch(
+            id,
+            &opts.launcher,
+            qemu_path.as_deref(),
+            startup,
+            cpu,
+        )?);
     }
     let mut hil: Vec<Option<HilController>> = Vec::with_capacity(indices.len());
     for ((&i, config), (link, target, started, startup)) in
