@@ -35,7 +35,7 @@ use std::sync::OnceLock;
 /// One plotted line: `(t, value)` points.
 type Series = Vec<(f64, f64)>;
 
-use plotters::coord::Shift;
+use plotters::coord::{CoordTranslate, Shift};
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -71,8 +71,6 @@ const SNAPSHOTS: usize = 5;
 const FONT_BYTES: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 const FONT_ASSET: &str = "host-sim/assets/DejaVuSans.ttf";
 const FONT: &str = "sans-serif";
-/// Height of the title band at the top of each figure.
-const HEADER_H: u32 = 84;
 
 /// Columns of `timeseries.csv` that every run must have (besides the
 /// per-agent, per-angle and per-estimate ones).
@@ -684,7 +682,7 @@ fn render(
     let png = dir.join(format!("{}.png", figure.stem()));
     {
         let root = BitMapBackend::new(&png, IMAGE_SIZE).into_drawing_area();
-        draw_figure(figure, &root, run).map_err(|e| draw_err(&png, &e))?;
+        draw_figure(figure, &root, run, true).map_err(|e| draw_err(&png, &e))?;
         root.present().map_err(|e| draw_err(&png, &e))?;
     }
     written.push(png);
@@ -692,7 +690,7 @@ fn render(
     let svg = dir.join(format!("{}.svg", figure.stem()));
     {
         let root = SVGBackend::new(&svg, IMAGE_SIZE).into_drawing_area();
-        draw_figure(figure, &root, run).map_err(|e| draw_err(&svg, &e))?;
+        draw_figure(figure, &root, run, false).map_err(|e| draw_err(&svg, &e))?;
         root.present().map_err(|e| draw_err(&svg, &e))?;
     }
     written.push(svg);
@@ -703,16 +701,17 @@ fn draw_figure<DB: DrawingBackend>(
     figure: Figure,
     root: &DrawingArea<DB, Shift>,
     run: &Run,
+    bitmap: bool,
 ) -> DrawResult
 where
     DB::ErrorType: 'static,
 {
     match figure {
-        Figure::Trajectories => draw_trajectories(root, run),
-        Figure::AngleErrors => draw_angle_errors(root, run),
-        Figure::Energy => draw_energy(root, run),
-        Figure::Estimates => draw_estimates(root, run),
-        Figure::Maneuvers => draw_maneuvers(root, run),
+        Figure::Trajectories => draw_trajectories(root, run, bitmap),
+        Figure::AngleErrors => draw_angle_errors(root, run, bitmap),
+        Figure::Energy => draw_energy(root, run, bitmap),
+        Figure::Estimates => draw_estimates(root, run, bitmap),
+        Figure::Maneuvers => draw_maneuvers(root, run, bitmap),
     }
 }
 
@@ -738,6 +737,66 @@ const DARK: RGBColor = RGBColor(20, 20, 20);
 
 fn colour(i: usize) -> RGBColor {
     PALETTE[i % PALETTE.len()]
+}
+
+/// Draws the polyline `pts` (in `area`'s coordinates), `width` pixels wide,
+/// solid or dashed.
+///
+/// On bitmaps a wide line is drawn as `width × width` one-pixel lines offset
+/// by a pixel each: plotters fills wide polylines as one polygon whose inner
+/// corners grow long spikes wherever the line turns sharply (a jump, a dip
+/// on a log axis). SVG strokes are drawn by the viewer and are fine.
+fn stroke<DB, CT>(
+    area: &DrawingArea<DB, CT>,
+    pts: &[CT::From],
+    colour: RGBColor,
+    width: u32,
+    dashed: bool,
+    bitmap: bool,
+) -> DrawResult
+where
+    DB: DrawingBackend,
+    DB::ErrorType: 'static,
+    CT: CoordTranslate,
+    CT::From: Clone,
+{
+    const DASH: (i32, i32) = (9, 6);
+    if pts.len() < 2 {
+        return Ok(());
+    }
+    if !bitmap || width <= 1 {
+        let style = colour.stroke_width(width);
+        if dashed {
+            area.draw(&DashedPathElement::new(pts.to_vec(), DASH.0, DASH.1, style))?;
+        } else {
+            area.draw(&PathElement::new(pts.to_vec(), style))?;
+        }
+        return Ok(());
+    }
+    let pixels = area.strip_coord_spec();
+    let (bx, by) = pixels.get_base_pixel();
+    let mut base: Vec<(i32, i32)> = pts
+        .iter()
+        .map(|p| {
+            let (x, y) = area.map_coordinate(p);
+            (x - bx, y - by)
+        })
+        .collect();
+    base.dedup();
+    let w = i32::try_from(width).unwrap_or(1);
+    let lo = -(w - 1) / 2;
+    let style = colour.stroke_width(1);
+    for dx in lo..lo + w {
+        for dy in lo..lo + w {
+            let shifted: Vec<(i32, i32)> = base.iter().map(|&(x, y)| (x + dx, y + dy)).collect();
+            if dashed {
+                pixels.draw(&DashedPathElement::new(shifted, DASH.0, DASH.1, style))?;
+            } else {
+                pixels.draw(&PathElement::new(shifted, style))?;
+            }
+        }
+    }
+    Ok(())
 }
 
 /// How a legend entry's key is drawn.
@@ -772,6 +831,7 @@ const LEGEND_KEY_W: i32 = 34;
 fn with_legend<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     entries: &[Entry],
+    bitmap: bool,
 ) -> Result<DrawingArea<DB, Shift>, Box<dyn StdError>>
 where
     DB::ErrorType: 'static,
@@ -785,13 +845,20 @@ where
     let max_w = w / 3;
     let legend_w = (text_w + LEGEND_KEY_W as u32 + 40).clamp(170, max_w);
     let (plot, legend) = area.split_horizontally(w - legend_w);
-    draw_legend(&legend, entries, legend_w - LEGEND_KEY_W as u32 - 40)?;
+    let labels: Vec<String> = entries.iter().map(|e| drawable(&e.label, bitmap)).collect();
+    draw_legend(
+        &legend,
+        entries,
+        &labels,
+        legend_w - LEGEND_KEY_W as u32 - 40,
+    )?;
     Ok(plot)
 }
 
 fn draw_legend<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     entries: &[Entry],
+    labels: &[String],
     max_text_w: u32,
 ) -> DrawResult
 where
@@ -842,7 +909,7 @@ where
         let label = if i + 1 == shown && shown < entries.len() {
             format!("… and {} more", entries.len() - shown + 1)
         } else {
-            fit_text(area, &e.label, &font, max_text_w)?
+            fit_text(area, &labels[i], &font, max_text_w)?
         };
         let x = if matches!(e.key, Key::None) {
             x0
@@ -852,6 +919,25 @@ where
         area.draw(&Text::new(label, (x, y), text_style.clone()))?;
     }
     Ok(())
+}
+
+/// `text` as it can be drawn: plotters' bitmap text renderer has no
+/// shaping, so a combining mark lands after its letter instead of on it.
+/// For bitmaps a combining circumflex is spelled out ("r̂" → "rhat") and other
+/// combining marks are dropped; SVG text is drawn by the viewer and kept.
+fn drawable(text: &str, bitmap: bool) -> String {
+    if !bitmap {
+        return text.to_string();
+    }
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '\u{302}' => out.push_str("hat"),
+            '\u{300}'..='\u{36f}' => {}
+            _ => out.push(c),
+        }
+    }
+    out
 }
 
 /// `text`, shortened with "…" until it fits in `max_w` pixels.
@@ -877,6 +963,46 @@ where
     Ok("…".to_string())
 }
 
+/// `text` broken at spaces into at most `max_lines` lines of at most `max_w`
+/// pixels; the last line ends in "…" if text is left over.
+fn wrap<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    text: &str,
+    font: &TextStyle<'_>,
+    max_w: u32,
+    max_lines: usize,
+) -> Result<Vec<String>, Box<dyn StdError>>
+where
+    DB::ErrorType: 'static,
+{
+    let mut lines: Vec<String> = Vec::new();
+    let mut current = String::new();
+    let mut words = text.split(' ').peekable();
+    while let Some(word) = words.next() {
+        let candidate = if current.is_empty() {
+            word.to_string()
+        } else {
+            format!("{current} {word}")
+        };
+        if current.is_empty() || area.estimate_text_size(&candidate, font)?.0 <= max_w {
+            current = candidate;
+            continue;
+        }
+        if lines.len() + 1 == max_lines {
+            // Last line: take the rest and cut it to fit.
+            let rest: Vec<&str> = std::iter::once(word).chain(words).collect();
+            current = format!("{current} {}", rest.join(" "));
+            break;
+        }
+        lines.push(std::mem::replace(&mut current, word.to_string()));
+    }
+    lines.push(current);
+    lines
+        .into_iter()
+        .map(|l| fit_text(area, &l, font, max_w))
+        .collect()
+}
+
 fn json_text(v: &serde_json::Value) -> String {
     match v {
         serde_json::Value::String(s) => s.clone(),
@@ -891,6 +1017,7 @@ fn frame<DB: DrawingBackend>(
     run: &Run,
     what: &str,
     note: &str,
+    bitmap: bool,
 ) -> Result<DrawingArea<DB, Shift>, Box<dyn StdError>>
 where
     DB::ErrorType: 'static,
@@ -908,7 +1035,7 @@ where
         size -= 1;
     }
     let title_font = TextStyle::from((FONT, size).into_font());
-    let title = fit_text(root, &title, &title_font, w - 24)?;
+    let title = fit_text(root, &drawable(&title, bitmap), &title_font, w - 24)?;
     let centre = Pos::new(HPos::Center, VPos::Center);
     root.draw(&Text::new(
         title,
@@ -916,11 +1043,17 @@ where
         title_font.color(&BLACK).pos(centre),
     ))?;
 
-    let mut parts = Vec::new();
+    // Subtitle: the outcome reason, then the run's settings.
+    let sub_font = TextStyle::from((FONT, 16).into_font());
+    let mut lines = Vec::new();
     match s.outcome_reason.as_deref() {
-        Some(r) if !r.is_empty() => parts.push(format!("{}: {r}", s.outcome)),
+        Some(r) if !r.is_empty() => {
+            let reason = drawable(&format!("{}: {r}", s.outcome), bitmap);
+            lines = wrap(root, &reason, &sub_font, w - 24, 2)?;
+        }
         _ => {}
     }
+    let mut parts = Vec::new();
     if let Some(m) = &s.mode {
         parts.push(format!("mode: {}", json_text(m)));
     }
@@ -932,14 +1065,17 @@ where
         run.agent_ids.len(),
         s.edges.len()
     ));
-    let sub_font = TextStyle::from((FONT, 16).into_font());
-    let subtitle = fit_text(root, &parts.join("  ·  "), &sub_font, w - 24)?;
-    root.draw(&Text::new(
-        subtitle,
-        (w as i32 / 2, 58),
-        sub_font.color(&RGBColor(80, 80, 80)).pos(centre),
-    ))?;
-    Ok(root.split_vertically(HEADER_H).1)
+    lines.push(drawable(&parts.join("  ·  "), bitmap));
+    for (i, line) in lines.iter().enumerate() {
+        let line = fit_text(root, line, &sub_font, w - 24)?;
+        root.draw(&Text::new(
+            line,
+            (w as i32 / 2, 56 + 22 * i as i32),
+            sub_font.color(&RGBColor(80, 80, 80)).pos(centre),
+        ))?;
+    }
+    let header_h = 46 + 22 * lines.len() as u32 + 14;
+    Ok(root.split_vertically(header_h).1)
 }
 
 // --- Ranges and points -------------------------------------------------------------
@@ -1041,7 +1177,11 @@ fn desc_style() -> TextStyle<'static> {
 
 // --- The figures ------------------------------------------------------------
 
-fn draw_trajectories<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, run: &Run) -> DrawResult
+fn draw_trajectories<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    run: &Run,
+    bitmap: bool,
+) -> DrawResult
 where
     DB::ErrorType: 'static,
 {
@@ -1051,7 +1191,7 @@ where
     } else {
         String::new()
     };
-    let area = frame(root, run, "trajectories and formation", &note)?;
+    let area = frame(root, run, "trajectories and formation", &note, bitmap)?;
 
     // Legend.
     let mut entries = Vec::new();
@@ -1090,13 +1230,13 @@ where
     if run.edges.len() < run.summary.edges.len() {
         entries.push(entry(
             format!(
-                "{} edges with unknown ids not drawn",
+                "edges with unknown ids (not drawn): {}",
                 run.summary.edges.len() - run.edges.len()
             ),
             Key::None,
         ));
     }
-    let plot = with_legend(&area, &entries)?;
+    let plot = with_legend(&area, &entries, bitmap)?;
 
     // Equal-aspect ranges covering paths and snapshots.
     let xs = run
@@ -1133,30 +1273,34 @@ where
         .light_line_style(BLACK.mix(0.04))
         .draw()?;
 
-    // Paths.
-    for (i, p) in run.paths.iter().enumerate() {
-        let pts = points(&p.x, &p.y);
-        chart.draw_series(LineSeries::new(pts, colour(i).mix(0.85).stroke_width(2)))?;
-    }
-    // Snapshots: edges, then nodes, then leaders on top.
-    let radius = if n > 100 { 2 } else { 4 };
+    // Snapshot edges, then the paths over them, then the snapshot nodes, then
+    // the leaders on top.
+    let valid = |s: &Snapshot, a: usize| s.pos.get(a).filter(|p| sane(p.0) && sane(p.1)).copied();
     for (s, shade) in run.snapshots.iter().zip(&shades) {
-        let ok = |a: usize| s.pos.get(a).filter(|p| sane(p.0) && sane(p.1)).copied();
         chart.draw_series(run.edges.iter().filter_map(|&(a, b)| {
             Some(PathElement::new(
-                vec![ok(a)?, ok(b)?],
+                vec![valid(s, a)?, valid(s, b)?],
                 shade.stroke_width(1),
             ))
         }))?;
+    }
+    for (i, p) in run.paths.iter().enumerate() {
+        let pts = points(&p.x, &p.y);
+        stroke(chart.plotting_area(), &pts, colour(i), 2, false, bitmap)?;
+    }
+    let radius = if n > 100 { 2 } else { 4 };
+    for (s, shade) in run.snapshots.iter().zip(&shades) {
         chart.draw_series(
             (0..s.pos.len())
-                .filter_map(ok)
+                .filter_map(|a| valid(s, a))
                 .map(|p| Circle::new(p, radius, shade.filled())),
         )?;
+    }
+    for s in &run.snapshots {
         chart.draw_series(
             run.leaders
                 .iter()
-                .filter_map(|&l| ok(l))
+                .filter_map(|&l| valid(s, l))
                 .map(|p| TriangleMarker::new(p, radius + 5, LEADER.filled())),
         )?;
     }
@@ -1186,7 +1330,11 @@ fn fmt_time(t: f64) -> String {
     }
 }
 
-fn draw_angle_errors<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, run: &Run) -> DrawResult
+fn draw_angle_errors<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    run: &Run,
+    bitmap: bool,
+) -> DrawResult
 where
     DB::ErrorType: 'static,
 {
@@ -1195,7 +1343,7 @@ where
     } else {
         String::new()
     };
-    let area = frame(root, run, "angle errors", &note)?;
+    let area = frame(root, run, "angle errors", &note, bitmap)?;
 
     let series: Vec<Vec<(f64, f64)>> = run
         .angles
@@ -1226,7 +1374,7 @@ where
         format!("values < {ANGLE_FLOOR:.0e} drawn at it"),
         Key::None,
     ));
-    let plot = with_legend(&area, &entries)?;
+    let plot = with_legend(&area, &entries, bitmap)?;
 
     let (t0, t1) = time_range(&run.t);
     let (y0, y1) = log_range(
@@ -1255,23 +1403,24 @@ where
 
     let width = if run.angles.len() > 10 { 1 } else { 2 };
     for (i, pts) in series.into_iter().enumerate() {
-        chart.draw_series(LineSeries::new(pts, colour(i).mix(0.9).stroke_width(width)))?;
+        stroke(chart.plotting_area(), &pts, colour(i), width, false, bitmap)?;
     }
-    chart.draw_series(LineSeries::new(max_series, DARK.stroke_width(3)))?;
-    chart.draw_series(DashedLineSeries::new(
-        [(t0, ANGLE_THRESHOLD), (t1, ANGLE_THRESHOLD)],
-        10,
-        6,
-        LEADER.stroke_width(2),
-    ))?;
+    let area = chart.plotting_area();
+    stroke(area, &max_series, DARK, 3, false, bitmap)?;
+    let threshold = [(t0, ANGLE_THRESHOLD), (t1, ANGLE_THRESHOLD)];
+    stroke(area, &threshold, LEADER, 2, true, bitmap)?;
     Ok(())
 }
 
-fn draw_energy<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, run: &Run) -> DrawResult
+fn draw_energy<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    run: &Run,
+    bitmap: bool,
+) -> DrawResult
 where
     DB::ErrorType: 'static,
 {
-    let area = frame(root, run, "energy V(t)", "")?;
+    let area = frame(root, run, "energy V(t)", "", bitmap)?;
 
     let min_pos = run
         .energy
@@ -1307,7 +1456,7 @@ where
             Key::None,
         ));
     }
-    let plot = with_legend(&area, &entries)?;
+    let plot = with_legend(&area, &entries, bitmap)?;
 
     let (t0, t1) = time_range(&run.t);
     let (y0, y1) = log_range(drawn.iter().flat_map(|d| d.0.iter().map(|p| p.1)));
@@ -1326,14 +1475,18 @@ where
         .bold_line_style(BLACK.mix(0.12))
         .light_line_style(BLACK.mix(0.04))
         .draw()?;
-    // Terms first, V on top.
-    for (pts, c, width) in drawn.into_iter().rev() {
-        chart.draw_series(LineSeries::new(pts, c.stroke_width(width)))?;
+    // V first (thick), the terms over it, so that a term equal to V shows.
+    for (pts, c, width) in drawn {
+        stroke(chart.plotting_area(), &pts, c, width, false, bitmap)?;
     }
     Ok(())
 }
 
-fn draw_estimates<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, run: &Run) -> DrawResult
+fn draw_estimates<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    run: &Run,
+    bitmap: bool,
+) -> DrawResult
 where
     DB::ErrorType: 'static,
 {
@@ -1348,17 +1501,17 @@ where
     } else {
         String::new()
     };
-    let area = frame(root, run, "distance estimates", &note)?;
+    let area = frame(root, run, "distance estimates", &note, bitmap)?;
 
     let mut entries = vec![
-        entry("estimate r̂ (solid)", Key::Line(DARK, 2)),
+        entry("estimated distance (solid)", Key::Line(DARK, 2)),
         entry("true distance r (dashed)", Key::Dashed(DARK, 2)),
         entry("owner: apex→far (other far)", Key::None),
     ];
     for (i, e) in run.estimates.iter().enumerate() {
         entries.push(entry(e.label.clone(), Key::Line(colour(i), 3)));
     }
-    let plot = with_legend(&area, &entries)?;
+    let plot = with_legend(&area, &entries, bitmap)?;
 
     let series: Vec<(Series, Series)> = run
         .estimates
@@ -1386,17 +1539,21 @@ where
         .light_line_style(BLACK.mix(0.04))
         .draw()?;
     for (i, (rhat, r)) in series.into_iter().enumerate() {
-        chart.draw_series(DashedLineSeries::new(r, 9, 6, colour(i).stroke_width(2)))?;
-        chart.draw_series(LineSeries::new(rhat, colour(i).stroke_width(2)))?;
+        stroke(chart.plotting_area(), &r, colour(i), 2, true, bitmap)?;
+        stroke(chart.plotting_area(), &rhat, colour(i), 2, false, bitmap)?;
     }
     Ok(())
 }
 
-fn draw_maneuvers<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, run: &Run) -> DrawResult
+fn draw_maneuvers<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    run: &Run,
+    bitmap: bool,
+) -> DrawResult
 where
     DB::ErrorType: 'static,
 {
-    let area = frame(root, run, "maneuvers", "")?;
+    let area = frame(root, run, "maneuvers", "", bitmap)?;
     let disp = points(&run.t, &run.disp_err);
     let vel = points(&run.t, &run.vel_err);
     let dist = points(&run.t, &run.min_dist);
@@ -1421,7 +1578,7 @@ where
             Key::Line(colour(2), 2),
         ),
     ];
-    let plot = with_legend(&area, &entries)?;
+    let plot = with_legend(&area, &entries, bitmap)?;
     let (_, h) = plot.dim_in_pixel();
     let (upper, lower) = plot.split_vertically(h * 55 / 100);
     let (t0, t1) = time_range(&run.t);
@@ -1441,8 +1598,8 @@ where
         .bold_line_style(BLACK.mix(0.12))
         .light_line_style(BLACK.mix(0.04))
         .draw()?;
-    chart.draw_series(LineSeries::new(disp, colour(0).stroke_width(2)))?;
-    chart.draw_series(LineSeries::new(vel, colour(1).stroke_width(2)))?;
+    stroke(chart.plotting_area(), &disp, colour(0), 2, false, bitmap)?;
+    stroke(chart.plotting_area(), &vel, colour(1), 2, false, bitmap)?;
 
     let (y0, y1) = lin_range(dist.iter().map(|p| p.1).chain([0.0]));
     let mut chart = ChartBuilder::on(&lower)
@@ -1459,6 +1616,412 @@ where
         .bold_line_style(BLACK.mix(0.12))
         .light_line_style(BLACK.mix(0.04))
         .draw()?;
-    chart.draw_series(LineSeries::new(dist, colour(2).stroke_width(2)))?;
+    stroke(chart.plotting_area(), &dist, colour(2), 2, false, bitmap)?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::fmt::Write as _;
+
+    /// Shape of a synthetic run.
+    struct Synth {
+        agents: usize,
+        rows: usize,
+        angles: usize,
+        estimates: usize,
+    }
+
+    /// Writes a synthetic `timeseries.csv` and `summary.json` into `dir`:
+    /// agents (ids 1..=n) spiral onto a ring, errors decay, a few values are
+    /// NaN, inf, empty or exactly zero.
+    fn write_run(dir: &Path, s: &Synth) {
+        let ids: Vec<usize> = (1..=s.agents).collect();
+        let mut header: Vec<String> = REQUIRED.iter().map(|c| (*c).to_string()).collect();
+        header.extend(["frames_sent", "frames_dropped", "frames_rejected"].map(String::from));
+        for i in &ids {
+            header.extend([
+                format!("x_{i}"),
+                format!("y_{i}"),
+                format!("vx_{i}"),
+                format!("vy_{i}"),
+            ]);
+        }
+        let triple = |k: usize| {
+            (
+                1 + k % s.agents,
+                1 + (k + 1) % s.agents,
+                1 + (k + 2) % s.agents,
+            )
+        };
+        for k in 0..s.angles {
+            let (u, v, w) = triple(k);
+            header.push(format!("angle_err_{u}_{v}_{w}"));
+        }
+        for k in 0..s.estimates {
+            let (u, f, w) = triple(k);
+            header.push(format!("rhat_{u}_{u}_{f}_{w}"));
+            header.push(format!("r_{u}_{u}_{f}_{w}"));
+        }
+        let mut csv = header.join(",");
+        csv.push('\n');
+        for row in 0..s.rows {
+            let t = 0.01 * row as f64;
+            let e = (-0.5 * t).exp();
+            let mut v = vec![
+                3.0 * e,
+                e,
+                e,
+                if t > 1.0 { 0.0 } else { e },
+                if row == 3 { f64::NAN } else { 0.5 * e },
+                0.3 * e,
+                2.0 * e,
+                e,
+                1.0 - 0.5 * e,
+                row as f64,
+                0.0,
+                0.0,
+            ];
+            let mut line = format!("{t}");
+            for x in v.drain(..) {
+                let _ = write!(line, ",{x}");
+            }
+            for (a, _) in ids.iter().enumerate() {
+                let phase = a as f64 * std::f64::consts::TAU / s.agents as f64;
+                let r = 5.0 + 2.0 * e;
+                let _ = write!(
+                    line,
+                    ",{},{},0,0",
+                    r * (phase + 0.1 * t).cos(),
+                    r * (phase + 0.1 * t).sin()
+                );
+            }
+            for k in 0..s.angles {
+                let x = 0.2 * e * (t + k as f64).cos();
+                if row == 5 && k == 0 {
+                    line.push_str(",inf");
+                } else if row == 6 && k == 0 {
+                    line.push(',');
+                } else if t > 2.0 && k == 0 {
+                    line.push_str(",0");
+                } else {
+                    let _ = write!(line, ",{x}");
+                }
+            }
+            for k in 0..s.estimates {
+                let r = 2.0 + 0.1 * k as f64;
+                let _ = write!(line, ",{},{r}", r + e * (t + k as f64).sin());
+            }
+            csv.push_str(&line);
+            csv.push('\n');
+        }
+        std::fs::write(dir.join("timeseries.csv"), csv).unwrap();
+        let edges: Vec<[usize; 2]> = (0..s.agents)
+            .map(|a| [1 + a, 1 + (a + 1) % s.agents])
+            .collect();
+        let summary = serde_json::json!({
+            "scenario": "unit-ring",
+            "outcome": "converged",
+            "outcome_reason": "every angle error below 0.001 rad; estimate r\u{302} ok",
+            "agents": ids,
+            "edges": edges,
+            "leaders": [1, 2],
+            "mode": "sampled",
+            "estimator": "shared",
+            "extra_field": {"ignored": true},
+        });
+        std::fs::write(dir.join("summary.json"), summary.to_string()).unwrap();
+    }
+
+    fn small() -> Synth {
+        Synth {
+            agents: 4,
+            rows: 300,
+            angles: 3,
+            estimates: 4,
+        }
+    }
+
+    /// Rewrites the CSV header through `f`.
+    fn edit_header(dir: &Path, f: impl Fn(&str) -> String) {
+        let path = dir.join("timeseries.csv");
+        let text = std::fs::read_to_string(&path).unwrap();
+        let (header, rest) = text.split_once('\n').unwrap();
+        std::fs::write(&path, format!("{}\n{rest}", f(header))).unwrap();
+    }
+
+    #[test]
+    fn writes_every_figure_as_png_and_svg_with_titles() {
+        let dir = tempfile::tempdir().unwrap();
+        write_run(dir.path(), &small());
+        let files = plot_run(dir.path()).unwrap();
+        let titles = [
+            ("trajectories", "trajectories and formation"),
+            ("angle_errors", "angle errors"),
+            ("energy", "energy V(t)"),
+            ("estimates", "distance estimates"),
+            ("maneuvers", "maneuvers"),
+        ];
+        let expected: Vec<PathBuf> = titles
+            .iter()
+            .flat_map(|(stem, _)| {
+                ["png", "svg"].map(|ext| dir.path().join(format!("{stem}.{ext}")))
+            })
+            .collect();
+        assert_eq!(files, expected);
+        for (stem, what) in titles {
+            let png = std::fs::read(dir.path().join(format!("{stem}.png"))).unwrap();
+            assert!(
+                png.starts_with(b"\x89PNG\r\n\x1a\n"),
+                "{stem}.png signature"
+            );
+            assert!(png.len() > 10_000, "{stem}.png is {} bytes", png.len());
+            let svg = std::fs::read_to_string(dir.path().join(format!("{stem}.svg"))).unwrap();
+            assert!(svg.contains("<svg"), "{stem}.svg");
+            let title = format!("unit-ring — {what} — outcome: converged");
+            assert!(svg.contains(&title), "{stem}.svg lacks `{title}`");
+            // The SVG keeps the combining circumflex; only bitmaps spell it out.
+            assert!(svg.contains("r\u{302} ok"), "{stem}.svg subtitle");
+        }
+        let legend = std::fs::read_to_string(dir.path().join("angle_errors.svg")).unwrap();
+        assert!(legend.contains("∠2-1-3") && legend.contains("threshold 1e-3 rad"));
+        let legend = std::fs::read_to_string(dir.path().join("estimates.svg")).unwrap();
+        assert!(legend.contains("1: 1→2 (3)") && legend.contains("4: 4→1 (2)"));
+    }
+
+    #[test]
+    fn a_large_run_is_thinned_and_says_so() {
+        let dir = tempfile::tempdir().unwrap();
+        let s = Synth {
+            agents: 120,
+            rows: 4321,
+            angles: 130,
+            estimates: 20,
+        };
+        write_run(dir.path(), &s);
+        let run = load_run(dir.path()).unwrap();
+        assert!(run.t.len() <= MAX_POINTS + 1, "{} rows kept", run.t.len());
+        assert_eq!(run.t.first(), Some(&0.0));
+        assert_eq!(run.t.last(), Some(&(0.01 * 4320.0)));
+        assert_eq!(run.snapshots.len(), 5);
+        assert_eq!(run.snapshots[0].t, 0.0);
+        assert_eq!(run.snapshots[4].t, 0.01 * 4320.0);
+        assert!(run.snapshots.iter().all(|s| s.pos.len() == 120));
+        assert_eq!(run.edges.len(), 120);
+        assert_eq!(run.leaders, [0, 1]);
+        assert!(run.paths.len() <= MAX_AGENT_PATHS + 2);
+        assert!(run.paths.iter().all(|p| p.x.len() == run.t.len()));
+        assert_eq!((run.angles.len(), run.n_angles), (MAX_ANGLES, 130));
+        assert_eq!((run.estimates.len(), run.n_estimates), (MAX_ESTIMATES, 20));
+
+        plot_run(dir.path()).unwrap();
+        let read = |f: &str| std::fs::read_to_string(dir.path().join(f)).unwrap();
+        let n = run.paths.len();
+        assert!(read("trajectories.svg").contains(&format!("paths of {n} of 120 agents shown")));
+        assert!(read("angle_errors.svg").contains("50 of 130 angles shown"));
+        assert!(read("estimates.svg").contains("first 12 of 20 estimates shown"));
+    }
+
+    #[test]
+    fn a_missing_column_is_named() {
+        let cases: [(&str, &str); 4] = [
+            ("V_est", "W_est"),
+            ("t", "time"),
+            ("y_3", "z_3"),
+            ("r_2_2_3_4", "s_2_2_3_4"),
+        ];
+        for (column, renamed) in cases {
+            let dir = tempfile::tempdir().unwrap();
+            write_run(dir.path(), &small());
+            edit_header(dir.path(), |h| {
+                h.split(',')
+                    .map(|c| if c == column { renamed } else { c })
+                    .collect::<Vec<_>>()
+                    .join(",")
+            });
+            match plot_run(dir.path()) {
+                Err(e @ PlotError::MissingColumn { .. }) => {
+                    let msg = e.to_string();
+                    assert!(msg.contains(&format!("`{column}`")), "{msg}");
+                    assert!(msg.contains("timeseries.csv"), "{msg}");
+                }
+                other => panic!("{column}: expected MissingColumn, got {other:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn an_agent_in_the_summary_without_columns_is_named() {
+        let dir = tempfile::tempdir().unwrap();
+        write_run(dir.path(), &small());
+        let path = dir.path().join("summary.json");
+        let mut summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        summary["agents"] = serde_json::json!([1, 2, 3, 4, 9]);
+        std::fs::write(&path, summary.to_string()).unwrap();
+        let e = plot_run(dir.path()).unwrap_err();
+        assert!(e.to_string().ends_with("missing column `x_9`"), "{e}");
+    }
+
+    #[test]
+    fn an_empty_csv_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        write_run(dir.path(), &small());
+        let csv = dir.path().join("timeseries.csv");
+        let header = std::fs::read_to_string(&csv)
+            .unwrap()
+            .lines()
+            .next()
+            .unwrap()
+            .to_string();
+        for (content, reason) in [
+            (String::new(), "no header row"),
+            (format!("{header}\n"), "no data row"),
+            (
+                format!(
+                    "{header}\n{}\n",
+                    vec!["NaN"; header.split(',').count()].join(",")
+                ),
+                "no data row",
+            ),
+        ] {
+            std::fs::write(&csv, content).unwrap();
+            match plot_run(dir.path()) {
+                Err(e @ PlotError::Empty { .. }) => {
+                    let msg = e.to_string();
+                    assert!(
+                        msg.contains("timeseries.csv") && msg.contains(reason),
+                        "{msg}"
+                    );
+                }
+                other => panic!("expected Empty, got {other:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn bad_inputs_are_named_errors() {
+        // A field that is not a number.
+        let dir = tempfile::tempdir().unwrap();
+        write_run(dir.path(), &small());
+        let csv = dir.path().join("timeseries.csv");
+        let text = std::fs::read_to_string(&csv).unwrap();
+        let mut lines: Vec<String> = text.lines().map(String::from).collect();
+        let mut fields: Vec<&str> = lines[3].split(',').collect();
+        fields[1] = "oops";
+        lines[3] = fields.join(",");
+        std::fs::write(&csv, lines.join("\n")).unwrap();
+        let e = plot_run(dir.path()).unwrap_err();
+        assert!(matches!(e, PlotError::BadValue { line: 4, .. }), "{e:?}");
+        assert!(
+            e.to_string().contains("column `V`: `oops` is not a number"),
+            "{e}"
+        );
+
+        // A row with too few fields.
+        lines[3] = "0.5,1,2".to_string();
+        std::fs::write(&csv, lines.join("\n")).unwrap();
+        let e = plot_run(dir.path()).unwrap_err();
+        assert!(
+            matches!(e, PlotError::Csv { .. }) && e.to_string().contains("timeseries.csv"),
+            "{e}"
+        );
+
+        // No summary, then a summary without `agents`.
+        let dir = tempfile::tempdir().unwrap();
+        write_run(dir.path(), &small());
+        let summary = dir.path().join("summary.json");
+        std::fs::remove_file(&summary).unwrap();
+        let e = plot_run(dir.path()).unwrap_err();
+        assert!(
+            matches!(e, PlotError::Io { .. }) && e.to_string().contains("summary.json"),
+            "{e}"
+        );
+        std::fs::write(
+            &summary,
+            r#"{"scenario": "s", "outcome": "o", "edges": []}"#,
+        )
+        .unwrap();
+        let e = plot_run(dir.path()).unwrap_err();
+        assert!(
+            e.to_string().contains("summary.json") && e.to_string().contains("agents"),
+            "{e}"
+        );
+
+        // An output that cannot be written.
+        let dir = tempfile::tempdir().unwrap();
+        write_run(dir.path(), &small());
+        std::fs::create_dir(dir.path().join("energy.png")).unwrap();
+        let e = plot_run(dir.path()).unwrap_err();
+        assert!(
+            matches!(e, PlotError::Draw { .. }) && e.to_string().contains("energy.png"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn odd_but_valid_inputs_still_plot() {
+        // Null leaders, no angles, no estimates, an edge to an unknown agent,
+        // one data row, constant and all-NaN series.
+        let dir = tempfile::tempdir().unwrap();
+        write_run(
+            dir.path(),
+            &Synth {
+                agents: 2,
+                rows: 1,
+                angles: 0,
+                estimates: 0,
+            },
+        );
+        let summary = serde_json::json!({
+            "scenario": "odd", "outcome": "timeout", "agents": [1, 2],
+            "edges": [[1, 2], [2, 7]], "leaders": null,
+        });
+        std::fs::write(dir.path().join("summary.json"), summary.to_string()).unwrap();
+        assert_eq!(plot_run(dir.path()).unwrap().len(), 10);
+        let svg = std::fs::read_to_string(dir.path().join("estimates.svg")).unwrap();
+        assert!(svg.contains("no estimates in this run"));
+        let svg = std::fs::read_to_string(dir.path().join("trajectories.svg")).unwrap();
+        assert!(svg.contains("edges with unknown ids (not drawn): 1"));
+    }
+
+    #[test]
+    fn thinning_keeps_first_last_and_at_most_max_points() {
+        for valid in [1, 2, 5, 1999, 2000, 2001, 4001, 12_345, 100_000] {
+            let thin = Thinning::new(valid);
+            let kept = (0..valid).filter(|&v| thin.keeps(v)).count();
+            assert_eq!(kept, thin.kept(), "{valid}");
+            assert!(kept <= MAX_POINTS + 1, "{valid}: {kept}");
+            assert!(thin.keeps(0) && thin.keeps(valid - 1));
+            let snaps = thin.snapshots();
+            assert_eq!(snaps.first(), Some(&0));
+            assert_eq!(snaps.last(), Some(&(kept - 1)));
+            assert_eq!(snaps.len(), kept.min(SNAPSHOTS), "{valid}");
+        }
+        assert_eq!(spread(1000, 50).len(), 50);
+        assert_eq!(spread(1000, 50).last(), Some(&999));
+        assert_eq!(spread(7, 50), (0..7).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn labels_and_ranges() {
+        assert_eq!(angle_label("3_1_2"), "∠1-3-2");
+        assert_eq!(angle_label("odd"), "odd");
+        assert_eq!(estimate_label("1_1_2_3"), "1: 1→2 (3)");
+        assert_eq!(
+            drawable("estimate r\u{302} of e\u{301}dge", true),
+            "estimate rhat of edge"
+        );
+        assert_eq!(drawable("r\u{302}", false), "r\u{302}");
+        assert_eq!(log_label(&1e-3), "1e-3");
+        assert_eq!(log_label(&2e-3), "2.0e-3");
+        assert_eq!(lin_range([f64::NAN, f64::INFINITY]), (0.0, 1.0));
+        assert_eq!(lin_range([0.0, 0.0]), (-1.0, 1.0));
+        let (lo, hi) = lin_range([2.0, 2.0, 1e200]);
+        assert!(lo < 2.0 && hi > 2.0 && hi < 3.0);
+        let (lo, hi) = log_range([0.0, -1.0, 1e-9, 1e-3]);
+        assert!(lo > 0.0 && lo < 1e-9 && hi > 1e-3);
+        assert_eq!(log_range([0.0]), (0.1, 10.0));
+    }
 }
