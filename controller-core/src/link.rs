@@ -11,7 +11,7 @@
 //!
 //! All values are `f32`, as on the target.
 
-use crate::agent::{Fault, Status};
+use crate::agent::{Agent, BearingMeasurement, Fault, OwnedEstimate, Status};
 use crate::config::{AgentConfig, AgentId, ConfigError};
 use crate::wire::{FrameError, MAX_FRAME_LEN};
 use serde::{Deserialize, Serialize};
@@ -35,6 +35,18 @@ pub struct LinkBearing {
     pub rate: Option<[f32; 2]>,
     /// Measured range, if any.
     pub range: Option<f32>,
+}
+
+impl LinkBearing {
+    /// The core's form of this bearing.
+    pub fn measurement(&self) -> BearingMeasurement<f32> {
+        BearingMeasurement {
+            neighbour: self.neighbour,
+            bearing: crate::Vec2::new(self.s[0], self.s[1]),
+            rate: self.rate.map(|r| crate::Vec2::new(r[0], r[1])),
+            range: self.range,
+        }
+    }
 }
 
 /// One control tick's own measurements (see [`crate::Measurements`]).
@@ -179,6 +191,32 @@ pub struct LinkEstimate {
     pub edge: u8,
     /// `r̂`.
     pub value: f32,
+}
+
+impl From<OwnedEstimate<f32>> for LinkEstimate {
+    fn from(e: OwnedEstimate<f32>) -> Self {
+        let small = |x: usize| u8::try_from(x).unwrap_or(u8::MAX);
+        Self {
+            apex: e.apex,
+            far: e.far,
+            triangle: small(e.triangle),
+            angle: small(e.angle),
+            edge: small(e.edge),
+            value: e.value,
+        }
+    }
+}
+
+/// The estimates `agent` owns, in link form (at most [`MAX_LINK_ESTIMATES`]; an agent in
+/// at most 4 triangles owns at most 16).
+pub fn link_estimates<const MT: usize, const NB: usize>(
+    agent: &Agent<f32, MT, NB>,
+) -> heapless::Vec<LinkEstimate, MAX_LINK_ESTIMATES> {
+    agent
+        .owned_estimates()
+        .take(MAX_LINK_ESTIMATES)
+        .map(LinkEstimate::from)
+        .collect()
 }
 
 /// Target → host.

@@ -301,16 +301,8 @@ impl Reference {
             None => 0.0,
         };
         self.last_us = Some(now_us);
-        let bearings: Vec<BearingMeasurement<f32>> = step
-            .bearings
-            .iter()
-            .map(|b| BearingMeasurement {
-                neighbour: b.neighbour,
-                bearing: Vec2::new(b.s[0], b.s[1]),
-                rate: b.rate.map(|r| Vec2::new(r[0], r[1])),
-                range: b.range,
-            })
-            .collect();
+        let bearings: Vec<BearingMeasurement<f32>> =
+            step.bearings.iter().map(LinkBearing::measurement).collect();
         let out = self.agent.step(&Measurements {
             time: us_to_seconds(now_us),
             dt,

@@ -37,8 +37,7 @@
 //! `wfi` while it waits for a byte.
 
 use controller_core::link::{
-    HostMsg, LinkError, LinkEstimate, LinkOutput, LinkStep, TargetMsg, LINK_VERSION,
-    MAX_LINK_ESTIMATES, MAX_LINK_MSG,
+    link_estimates, HostMsg, LinkError, LinkOutput, LinkStep, TargetMsg, LINK_VERSION, MAX_LINK_MSG,
 };
 use controller_core::wire::{cobs_encode, CobsAccumulator};
 use controller_core::{Agent, AgentId};
@@ -229,18 +228,8 @@ impl<P: SerialPort> Session<P> {
             clock: LinkClock { us: now },
         };
         let report = control.tick(&mut board);
-        let mut estimates = heapless::Vec::<LinkEstimate, MAX_LINK_ESTIMATES>::new();
-        for e in control.agent().owned_estimates() {
-            // At most MT · 2 angles · 2 edges = 16 = MAX_LINK_ESTIMATES.
-            let _ = estimates.push(LinkEstimate {
-                apex: e.apex,
-                far: e.far,
-                triangle: e.triangle as u8,
-                angle: e.angle as u8,
-                edge: e.edge as u8,
-                value: e.value,
-            });
-        }
+        // At most MT · 2 angles · 2 edges = 16 = MAX_LINK_ESTIMATES.
+        let estimates = link_estimates(control.agent());
         let out = LinkOutput::new(
             board.actuator.force,
             report.output.status,

@@ -5,7 +5,7 @@
 
 use super::link::{Link, RecvError, TARGET_MT};
 use controller_core::link::{
-    HostMsg, LinkError, LinkEstimate, LinkOutput, TargetMsg, LINK_VERSION, MAX_LINK_ESTIMATES,
+    link_estimates, HostMsg, LinkBearing, LinkError, LinkOutput, TargetMsg, LINK_VERSION,
 };
 use controller_core::{Agent, BearingMeasurement, Measurements, Vec2};
 use std::net::TcpStream;
@@ -112,16 +112,8 @@ pub fn serve(stream: TcpStream, behaviour: FakeBehaviour) -> Result<(), String> 
                 for f in queue.drain(..) {
                     let _ = a.receive(&f);
                 }
-                let bearings: Vec<BearingMeasurement<f32>> = s
-                    .bearings
-                    .iter()
-                    .map(|b| BearingMeasurement {
-                        neighbour: b.neighbour,
-                        bearing: Vec2::new(b.s[0], b.s[1]),
-                        rate: b.rate.map(|r| Vec2::new(r[0], r[1])),
-                        range: b.range,
-                    })
-                    .collect();
+                let bearings: Vec<BearingMeasurement<f32>> =
+                    s.bearings.iter().map(LinkBearing::measurement).collect();
                 let out = a.step(&Measurements {
                     time: s.time,
                     dt: s.dt,
@@ -138,18 +130,7 @@ pub fn serve(stream: TcpStream, behaviour: FakeBehaviour) -> Result<(), String> 
                 }
                 // As the firmware: only an agent that owns estimates reports them.
                 if behaviour.send_estimates && a.owned_estimates().next().is_some() {
-                    let mut est: heapless::Vec<LinkEstimate, MAX_LINK_ESTIMATES> =
-                        heapless::Vec::new();
-                    for e in a.owned_estimates() {
-                        let _ = est.push(LinkEstimate {
-                            apex: e.apex,
-                            far: e.far,
-                            triangle: e.triangle as u8,
-                            angle: e.angle as u8,
-                            edge: e.edge as u8,
-                            value: e.value,
-                        });
-                    }
+                    let est = link_estimates(a);
                     link.queue_value(&TargetMsg::Estimates(est))?;
                 }
                 let o = LinkOutput::new(
