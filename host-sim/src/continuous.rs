@@ -161,15 +161,7 @@ impl<'m> ContinuousSim<'m> {
             y.extend_from_slice(&[a.position[0], a.position[1], a.velocity[0], a.velocity[1]]);
         }
         y.extend(info.iter().map(|_| model.initial_estimate));
-        let partner = (0..n)
-            .map(|i| {
-                model.leader.as_ref().and_then(|l| match i {
-                    _ if i == l.a => Some(l.b),
-                    _ if i == l.b => Some(l.a),
-                    _ => None,
-                })
-            })
-            .collect();
+        let partner = model.partners();
         let mut sim = Self {
             model,
             rhs: Rhs {

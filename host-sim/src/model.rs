@@ -219,6 +219,19 @@ pub struct Model {
 }
 
 impl Model {
+    /// For each agent index, its leader partner's index (`None` for non-leaders).
+    pub fn partners(&self) -> Vec<Option<usize>> {
+        (0..self.agents.len())
+            .map(|i| {
+                self.leader.as_ref().and_then(|l| match i {
+                    _ if i == l.a => Some(l.b),
+                    _ if i == l.b => Some(l.a),
+                    _ => None,
+                })
+            })
+            .collect()
+    }
+
     /// Number of agents.
     pub fn n(&self) -> usize {
         self.agents.len()

@@ -48,27 +48,28 @@ impl Recorder for NullRecorder {
     }
 }
 
+/// The columns of `timeseries.csv` before the per-agent, per-angle and per-estimate ones
+/// (docs/outputs.md).
+pub const BASE_COLUMNS: [&str; 13] = [
+    "t",
+    "V",
+    "V_kin",
+    "V_ang",
+    "V_lead",
+    "V_est",
+    "max_angle_err",
+    "disp_err",
+    "vel_err",
+    "min_dist",
+    "frames_sent",
+    "frames_dropped",
+    "frames_rejected",
+];
+
 /// The column names of `timeseries.csv` for `model` with these estimates.
 pub fn csv_header(model: &Model, estimates: &[EstimateInfo]) -> Vec<String> {
     let id = |i: usize| model.agents[i].id;
-    let mut h: Vec<String> = [
-        "t",
-        "V",
-        "V_kin",
-        "V_ang",
-        "V_lead",
-        "V_est",
-        "max_angle_err",
-        "disp_err",
-        "vel_err",
-        "min_dist",
-        "frames_sent",
-        "frames_dropped",
-        "frames_rejected",
-    ]
-    .iter()
-    .map(|s| (*s).to_owned())
-    .collect();
+    let mut h: Vec<String> = BASE_COLUMNS.iter().map(|s| (*s).to_owned()).collect();
     for a in &model.agents {
         for c in ["x", "y", "vx", "vy"] {
             h.push(format!("{c}_{}", a.id));

@@ -74,18 +74,10 @@ const FONT: &str = "sans-serif";
 
 /// Columns of `timeseries.csv` that every run must have (besides the
 /// per-agent, per-angle and per-estimate ones).
-const REQUIRED: [&str; 10] = [
-    "t",
-    "V",
-    "V_kin",
-    "V_ang",
-    "V_lead",
-    "V_est",
-    "max_angle_err",
-    "disp_err",
-    "vel_err",
-    "min_dist",
-];
+const REQUIRED: [&str; 10] = {
+    let b = crate::output::BASE_COLUMNS;
+    [b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7], b[8], b[9]]
+};
 
 /// Why plotting a run failed. Every variant names the file concerned.
 #[derive(Debug, thiserror::Error)]

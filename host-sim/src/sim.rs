@@ -185,15 +185,7 @@ impl<'m> SampledSim<'m> {
         let inboxes = (0..n)
             .map(|i| Vec::with_capacity(model.graph.radio.of(i).len() * FRAMES_PER_TICK * 4 + 8))
             .collect();
-        let partner = (0..n)
-            .map(|i| {
-                model.leader.as_ref().and_then(|l| match i {
-                    _ if i == l.a => Some(l.b),
-                    _ if i == l.b => Some(l.a),
-                    _ => None,
-                })
-            })
-            .collect();
+        let partner = model.partners();
         Ok(Self {
             model,
             controllers,
