@@ -1159,6 +1159,26 @@ const CHART_MARGIN: u32 = 14;
 const X_LABEL_AREA: u32 = 56;
 const Y_LABEL_AREA: u32 = 96;
 
+/// The house style of every time-series panel's mesh: axis descriptions, fonts, grid.
+fn styled_mesh<'m, 'a, 'b, X, Y, XT, YT, DB>(
+    mesh: &'m mut plotters::chart::MeshStyle<'a, 'b, X, Y, DB>,
+    y_desc: &str,
+) -> &'m mut plotters::chart::MeshStyle<'a, 'b, X, Y, DB>
+where
+    X: plotters::coord::ranged1d::Ranged<ValueType = XT>
+        + plotters::coord::ranged1d::ValueFormatter<XT>,
+    Y: plotters::coord::ranged1d::Ranged<ValueType = YT>
+        + plotters::coord::ranged1d::ValueFormatter<YT>,
+    DB: DrawingBackend,
+{
+    mesh.x_desc("time t (s)")
+        .y_desc(y_desc)
+        .label_style(label_style())
+        .axis_desc_style(desc_style())
+        .bold_line_style(BLACK.mix(0.12))
+        .light_line_style(BLACK.mix(0.04))
+}
+
 fn label_style() -> TextStyle<'static> {
     (FONT, 15).into_font().color(&BLACK)
 }
@@ -1382,15 +1402,8 @@ where
         .x_label_area_size(X_LABEL_AREA)
         .y_label_area_size(Y_LABEL_AREA)
         .build_cartesian_2d(t0..t1, (y0..y1).log_scale())?;
-    chart
-        .configure_mesh()
-        .x_desc("time t (s)")
-        .y_desc("|angle error| (rad)")
+    styled_mesh(&mut chart.configure_mesh(), "|angle error| (rad)")
         .y_label_formatter(&log_label)
-        .label_style(label_style())
-        .axis_desc_style(desc_style())
-        .bold_line_style(BLACK.mix(0.12))
-        .light_line_style(BLACK.mix(0.04))
         .draw()?;
 
     let width = if run.angles.len() > 10 { 1 } else { 2 };
@@ -1457,15 +1470,8 @@ where
         .x_label_area_size(X_LABEL_AREA)
         .y_label_area_size(Y_LABEL_AREA)
         .build_cartesian_2d(t0..t1, (y0..y1).log_scale())?;
-    chart
-        .configure_mesh()
-        .x_desc("time t (s)")
-        .y_desc("energy")
+    styled_mesh(&mut chart.configure_mesh(), "energy")
         .y_label_formatter(&log_label)
-        .label_style(label_style())
-        .axis_desc_style(desc_style())
-        .bold_line_style(BLACK.mix(0.12))
-        .light_line_style(BLACK.mix(0.04))
         .draw()?;
     // V first (thick), the terms over it, so that a term equal to V shows.
     for (pts, c, width) in drawn {
@@ -1521,15 +1527,7 @@ where
         .x_label_area_size(X_LABEL_AREA)
         .y_label_area_size(Y_LABEL_AREA)
         .build_cartesian_2d(t0..t1, y0..y1)?;
-    chart
-        .configure_mesh()
-        .x_desc("time t (s)")
-        .y_desc("distance (m)")
-        .label_style(label_style())
-        .axis_desc_style(desc_style())
-        .bold_line_style(BLACK.mix(0.12))
-        .light_line_style(BLACK.mix(0.04))
-        .draw()?;
+    styled_mesh(&mut chart.configure_mesh(), "distance (m)").draw()?;
     for (i, (rhat, r)) in series.into_iter().enumerate() {
         stroke(chart.plotting_area(), &r, colour(i), 2, true, bitmap)?;
         stroke(chart.plotting_area(), &rhat, colour(i), 2, false, bitmap)?;
@@ -1581,15 +1579,7 @@ where
         .x_label_area_size(X_LABEL_AREA)
         .y_label_area_size(Y_LABEL_AREA)
         .build_cartesian_2d(t0..t1, y0..y1)?;
-    chart
-        .configure_mesh()
-        .x_desc("time t (s)")
-        .y_desc("leader error (m, m/s)")
-        .label_style(label_style())
-        .axis_desc_style(desc_style())
-        .bold_line_style(BLACK.mix(0.12))
-        .light_line_style(BLACK.mix(0.04))
-        .draw()?;
+    styled_mesh(&mut chart.configure_mesh(), "leader error (m, m/s)").draw()?;
     stroke(chart.plotting_area(), &disp, colour(0), 2, false, bitmap)?;
     stroke(chart.plotting_area(), &vel, colour(1), 2, false, bitmap)?;
 
@@ -1599,15 +1589,7 @@ where
         .x_label_area_size(X_LABEL_AREA)
         .y_label_area_size(Y_LABEL_AREA)
         .build_cartesian_2d(t0..t1, y0..y1)?;
-    chart
-        .configure_mesh()
-        .x_desc("time t (s)")
-        .y_desc("min distance (m)")
-        .label_style(label_style())
-        .axis_desc_style(desc_style())
-        .bold_line_style(BLACK.mix(0.12))
-        .light_line_style(BLACK.mix(0.04))
-        .draw()?;
+    styled_mesh(&mut chart.configure_mesh(), "min distance (m)").draw()?;
     stroke(chart.plotting_area(), &dist, colour(2), 2, false, bitmap)?;
     Ok(())
 }
