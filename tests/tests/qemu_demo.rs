@@ -78,48 +78,15 @@ fn parse_demo_final(log: &str) -> Result<(f64, Vec<[f64; 2]>), String> {
     Ok((t, rel))
 }
 
-/// Extracts `final_positions: [[x, y], …]` from a `summary.json` (a minimal
-/// parser for that one field: an array of arrays of numbers).
+/// Extracts `final_positions: [[x, y], …]` from a `summary.json`.
 fn parse_final_positions(json: &str) -> Result<Vec<[f64; 2]>, String> {
-    let key = "\"final_positions\"";
-    let at = json
-        .find(key)
-        .ok_or("summary.json has no \"final_positions\"")?
-        + key.len();
-    let rest = json[at..].trim_start();
-    let rest = rest
-        .strip_prefix(':')
-        .ok_or("expected ':' after \"final_positions\"")?;
-    let rest = rest.trim_start();
-    let rest = rest
-        .strip_prefix('[')
-        .ok_or("final_positions is not an array")?;
-    let mut out = Vec::new();
-    let mut s = rest.trim_start();
-    loop {
-        if let Some(r) = s.strip_prefix(']') {
-            let _ = r;
-            return Ok(out);
-        }
-        let inner = s
-            .strip_prefix('[')
-            .ok_or(format!("expected '[' at {:?}", &s[..s.len().min(20)]))?;
-        let end = inner.find(']').ok_or("unterminated position")?;
-        let xy: Vec<f64> = inner[..end]
-            .split(',')
-            .map(|x| {
-                x.trim()
-                    .parse::<f64>()
-                    .map_err(|e| format!("bad number {x:?}: {e}"))
-            })
-            .collect::<Result<_, _>>()?;
-        match xy[..] {
-            [x, y] => out.push([x, y]),
-            _ => return Err(format!("a position has {} components", xy.len())),
-        }
-        s = inner[end + 1..].trim_start();
-        s = s.strip_prefix(',').unwrap_or(s).trim_start();
+    #[derive(serde::Deserialize)]
+    struct Summary {
+        final_positions: Vec<[f64; 2]>,
     }
+    serde_json::from_str::<Summary>(json)
+        .map(|s| s.final_positions)
+        .map_err(|e| format!("summary.json: {e}"))
 }
 
 /// `q_i − q_1` of absolute positions.
