@@ -31,6 +31,7 @@
 
 pub mod agent;
 pub mod config;
+pub mod crc16;
 pub mod energy;
 pub mod geometry;
 pub mod law;

@@ -10,22 +10,30 @@
 //! Values travel as `f32`. For `f64` agents this rounds every value to the nearest `f32`:
 //! relative error at most 2⁻²⁴ ≈ 6·10⁻⁸ per component (tested in `tests/wire.rs`).
 
-use crate::AgentId;
+use crate::{crc16, AgentId};
 use serde::{Deserialize, Serialize};
 
 /// Largest encoded frame, in bytes (Crazyflie P2P payload limit).
 pub const MAX_FRAME_LEN: usize = 60;
 /// The wire-format version this crate writes and accepts.
-pub const WIRE_VERSION: u8 = 1;
-/// Largest number of items one frame can hold (the smallest item is 7 bytes).
+pub const WIRE_VERSION: u8 = 2;
+/// More items than one frame can hold (the smallest item is 9 bytes).
 pub const MAX_ITEMS_PER_FRAME: usize = 8;
 /// Largest COBS-encoded frame including the trailing zero delimiter.
 pub const MAX_COBS_LEN: usize = MAX_FRAME_LEN + MAX_FRAME_LEN / 254 + 2;
 
 const CRC_LEN: usize = 2;
-/// CRC-16/IBM-3740, byte-wise table (512 B of flash). The slice-by-16 table was measured
-/// on target: 13 % fewer CRC instructions on 30–60-byte frames for 8.7 KiB more flash.
-const CRC16: crc::Crc<u16> = crc::Crc::<u16>::new(&crc::CRC_16_IBM_3740);
+/// Header bytes before the sequence number (version, sender).
+const HEADER_FIXED: usize = 2;
+
+/// Postcard variant indices of [`WireItem`] (one varint byte each).
+const TAG_VELOCITY: u8 = 0;
+const TAG_ANGLE: u8 = 1;
+const TAG_ANGLE_BEARINGS: u8 = 2;
+/// Encoded lengths (variant index included).
+const LEN_VELOCITY: usize = 9;
+const LEN_ANGLE: usize = 43;
+const LEN_ANGLE_BEARINGS: usize = 35;
 
 /// The start of every frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -39,30 +47,35 @@ pub struct FrameHeader {
     pub seq: u16,
 }
 
-/// One piece of what an agent broadcasts (SPEC §6 needs all three).
+/// One piece of what an agent broadcasts (SPEC §6): its velocity, and for every
+/// controlled angle of which it is the apex, what the angle's two far vertices need.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum WireItem {
-    /// The sender's velocity `v_n` (world frame).
+    /// The sender's velocity `v_n` (world frame): for the range rates S3 of its
+    /// neighbours' estimators and the leader's `ż` (S11).
     Velocity([f32; 2]),
-    /// The sender's bearing `s_{n,to}` to neighbour `to`, and its rate `ṡ_{n,to}`.
-    Bearing {
-        /// The neighbour.
-        to: AgentId,
-        /// Unit bearing.
-        s: [f32; 2],
-        /// Bearing rate.
-        rate: [f32; 2],
+    /// A controlled angle `α = (n; far[0], far[1])` whose apex `n` is the sender, with the
+    /// estimates it owns (shared estimators, SPEC §6): far vertex `far[k]` takes the
+    /// other far vertex's bearing and rate (S4, S5, S6) and `r[k]` (S8).
+    Angle {
+        /// The far vertices `v`, `w`.
+        far: [AgentId; 2],
+        /// Unit bearings `[s_nv, s_nw]`.
+        s: [[f32; 2]; 2],
+        /// Bearing rates `[ṡ_nv, ṡ_nw]`.
+        rate: [[f32; 2]; 2],
+        /// Estimates `[r̂_{α,nv}, r̂_{α,nw}] > 0`.
+        r: [f32; 2],
     },
-    /// The sender's (apex) estimate `r̂_{α,e}` for the edge to `far`, in the angle whose
-    /// other far vertex is `other`.
-    Estimate {
-        /// The far vertex of the edge (the receiver that needs it).
-        far: AgentId,
-        /// The angle's other far vertex.
-        other: AgentId,
-        /// `r̂ > 0`.
-        r: f32,
+    /// The same angle without estimates (`PerAgent` and `Measured` modes).
+    AngleBearings {
+        /// The far vertices `v`, `w`.
+        far: [AgentId; 2],
+        /// Unit bearings `[s_nv, s_nw]`.
+        s: [[f32; 2]; 2],
+        /// Bearing rates `[ṡ_nv, ṡ_nw]`.
+        rate: [[f32; 2]; 2],
     },
 }
 
@@ -148,8 +161,7 @@ impl FrameWriter {
             seq,
         };
         self.items = 0;
-        // The header is at most 5 bytes: it always fits.
-        self.len = postcard::to_slice(&header, &mut self.buf).map_or(0, |used| used.len());
+        self.len = header.encode(&mut self.buf);
     }
 
     /// Appends `item` if it fits (leaving room for the CRC); returns whether it did.
@@ -160,13 +172,13 @@ impl FrameWriter {
         let Some(rest) = self.buf.get_mut(self.len..MAX_FRAME_LEN - CRC_LEN) else {
             return false;
         };
-        match postcard::to_slice(item, rest) {
-            Ok(used) => {
-                self.len += used.len();
+        match item.encode(rest) {
+            Some(used) => {
+                self.len += used;
                 self.items += 1;
                 true
             }
-            Err(_) => false,
+            None => false,
         }
     }
 
@@ -177,7 +189,7 @@ impl FrameWriter {
 
     /// Appends the CRC and returns the finished frame bytes.
     pub fn finish(&mut self) -> &[u8] {
-        let crc = CRC16.checksum(self.buf.get(..self.len).unwrap_or(&[]));
+        let crc = crc16::checksum(self.buf.get(..self.len).unwrap_or(&[]));
         if let Some(dst) = self.buf.get_mut(self.len..self.len + CRC_LEN) {
             dst.copy_from_slice(&crc.to_le_bytes());
             self.len += CRC_LEN;
@@ -205,6 +217,11 @@ pub struct FrameView<'a> {
 }
 
 impl<'a> FrameView<'a> {
+    /// The encoded items (everything between the header and the CRC).
+    pub(crate) fn item_bytes(&self) -> &'a [u8] {
+        self.items
+    }
+
     /// Iterates the items; a malformed item ends the iteration with an error.
     pub fn items(&self) -> Items<'a> {
         Items { rest: self.items }
@@ -234,12 +251,9 @@ impl Iterator for Items<'_> {
         if self.rest.is_empty() {
             return None;
         }
-        Some(match postcard::take_from_bytes::<WireItem>(self.rest) {
-            Ok((item, rest)) => {
-                self.rest = rest;
-                Ok(item)
-            }
-            Err(_) => {
+        Some(match WireItem::decode(&mut self.rest) {
+            Some(item) => Ok(item),
+            None => {
                 self.rest = &[];
                 Err(FrameError::Malformed)
             }
@@ -261,11 +275,11 @@ pub fn check_frame(bytes: &[u8]) -> Result<FrameView<'_>, FrameError> {
         *crc.first().ok_or(FrameError::TooShort)?,
         *crc.get(1).ok_or(FrameError::TooShort)?,
     ]);
-    if CRC16.checksum(body) != expected {
+    if crc16::checksum(body) != expected {
         return Err(FrameError::BadCrc);
     }
-    let (header, items): (FrameHeader, &[u8]) =
-        postcard::take_from_bytes(body).map_err(|_| FrameError::TooShort)?;
+    let mut items = body;
+    let header = FrameHeader::decode(&mut items).ok_or(FrameError::TooShort)?;
     if header.version != WIRE_VERSION {
         return Err(FrameError::UnknownVersion(header.version));
     }
@@ -292,13 +306,210 @@ fn finite2(v: &[f32; 2]) -> bool {
     v[0].is_finite() && v[1].is_finite()
 }
 
-fn item_valid(item: &WireItem, tol: f32) -> bool {
+fn unit(s: &[f32; 2], tol: f32) -> bool {
+    finite2(s) && ((s[0] * s[0] + s[1] * s[1]) - 1.0).abs() <= tol
+}
+
+fn bearings_valid(s: &[[f32; 2]; 2], rate: &[[f32; 2]; 2], tol: f32) -> bool {
+    unit(&s[0], tol) && unit(&s[1], tol) && finite2(&rate[0]) && finite2(&rate[1])
+}
+
+/// Values of an item are acceptable: finite, unit bearings within `tol` on `|s|²`, and
+/// positive estimates.
+pub(crate) fn item_valid(item: &WireItem, tol: f32) -> bool {
     match item {
         WireItem::Velocity(v) => finite2(v),
-        WireItem::Bearing { s, rate, .. } => {
-            finite2(s) && finite2(rate) && ((s[0] * s[0] + s[1] * s[1]) - 1.0).abs() <= tol
+        WireItem::Angle { s, rate, r, .. } => {
+            bearings_valid(s, rate, tol)
+                && r[0].is_finite()
+                && r[1].is_finite()
+                && r[0] > 0.0
+                && r[1] > 0.0
         }
-        WireItem::Estimate { r, .. } => r.is_finite() && *r > 0.0,
+        WireItem::AngleBearings { s, rate, .. } => bearings_valid(s, rate, tol),
+    }
+}
+
+// ---------------------------------------------------------------- postcard codec
+//
+// Frames are encoded and decoded by hand, in exactly postcard's format: the serde derives
+// on `FrameHeader` and `WireItem` describe the same bytes, and `tests/wire.rs` checks both
+// directions against `postcard` itself on random input. The generic serde path costs
+// several times more instructions per item on the Cortex-M4. The postcard rules used:
+// `u8` is one raw byte; `u16` and `u32` are LEB128 varints (at most 3 and 5 bytes, the
+// last byte at most 0x03 and 0x0F, longer-than-needed forms accepted); `f32` is 4
+// little-endian bytes; an enum is its variant index (a `u32` varint) followed by its
+// fields; structs and arrays are their fields in order.
+
+/// Takes the next `N` bytes.
+#[inline(always)]
+fn take<const N: usize>(rest: &mut &[u8]) -> Option<[u8; N]> {
+    let (head, tail) = rest.split_first_chunk::<N>()?;
+    *rest = tail;
+    Some(*head)
+}
+
+/// Postcard `u16`/`u32` varint of at most `MAX` bytes whose last byte is at most `LAST`.
+#[inline(always)]
+fn take_varint<const MAX: u32, const LAST: u8>(rest: &mut &[u8]) -> Option<u32> {
+    let mut out = 0u32;
+    for i in 0..MAX {
+        let [b] = take::<1>(rest)?;
+        out |= u32::from(b & 0x7F) << (7 * i);
+        if b & 0x80 == 0 {
+            return (i + 1 < MAX || b <= LAST).then_some(out);
+        }
+    }
+    None
+}
+
+/// The `f32` at byte `at` of `b` (constant offsets: the check compiles away).
+#[inline(always)]
+fn get_f32(b: &[u8], at: usize) -> f32 {
+    match b.get(at..at + 4) {
+        Some(&[b0, b1, b2, b3]) => f32::from_le_bytes([b0, b1, b2, b3]),
+        _ => 0.0,
+    }
+}
+
+#[inline(always)]
+fn get_pair(b: &[u8], at: usize) -> [f32; 2] {
+    [get_f32(b, at), get_f32(b, at + 4)]
+}
+
+#[inline(always)]
+fn set_f32(b: &mut [u8], at: usize, x: f32) {
+    if let Some(d) = b.get_mut(at..at + 4) {
+        d.copy_from_slice(&x.to_le_bytes());
+    }
+}
+
+#[inline(always)]
+fn set_pair(b: &mut [u8], at: usize, x: &[f32; 2]) {
+    set_f32(b, at, x[0]);
+    set_f32(b, at + 4, x[1]);
+}
+
+impl FrameHeader {
+    /// Largest encoded header (`seq` takes up to 3 varint bytes).
+    pub const MAX_LEN: usize = HEADER_FIXED + 3;
+
+    /// Writes the postcard encoding into `out`; returns its length.
+    fn encode(&self, out: &mut [u8; MAX_FRAME_LEN]) -> usize {
+        let s = self.seq;
+        let (lo, mid, hi) = ((s & 0x7F) as u8, ((s >> 7) & 0x7F) as u8, (s >> 14) as u8);
+        out[0] = self.version;
+        out[1] = self.sender;
+        if s < 0x80 {
+            out[2] = lo;
+            3
+        } else if s < 0x4000 {
+            out[2] = lo | 0x80;
+            out[3] = mid;
+            4
+        } else {
+            out[2] = lo | 0x80;
+            out[3] = mid | 0x80;
+            out[4] = hi;
+            5
+        }
+    }
+
+    /// Decodes a header from the front of `rest`.
+    fn decode(rest: &mut &[u8]) -> Option<Self> {
+        let [version, sender] = take::<HEADER_FIXED>(rest)?;
+        let seq = take_varint::<3, 0x03>(rest)?;
+        Some(Self {
+            version,
+            sender,
+            seq: seq as u16,
+        })
+    }
+}
+
+impl WireItem {
+    /// Length of the encoding in bytes (variant index + fields).
+    pub const fn encoded_len(&self) -> usize {
+        match self {
+            WireItem::Velocity(_) => LEN_VELOCITY,
+            WireItem::Angle { .. } => LEN_ANGLE,
+            WireItem::AngleBearings { .. } => LEN_ANGLE_BEARINGS,
+        }
+    }
+
+    /// Writes the postcard encoding at the start of `out`; `None` if it does not fit.
+    fn encode(&self, out: &mut [u8]) -> Option<usize> {
+        let len = self.encoded_len();
+        let b = out.get_mut(..len)?;
+        match self {
+            WireItem::Velocity(v) => {
+                if let Some(t) = b.first_mut() {
+                    *t = TAG_VELOCITY;
+                }
+                set_pair(b, 1, v);
+            }
+            WireItem::Angle { far, s, rate, r } => {
+                encode_angle(b, TAG_ANGLE, far, s, rate);
+                set_pair(b, 35, r);
+            }
+            WireItem::AngleBearings { far, s, rate } => {
+                encode_angle(b, TAG_ANGLE_BEARINGS, far, s, rate);
+            }
+        }
+        Some(len)
+    }
+
+    /// Decodes one item from the front of `rest` (`None`: malformed or truncated).
+    pub(crate) fn decode(rest: &mut &[u8]) -> Option<Self> {
+        let tag = take_varint::<5, 0x0F>(rest)?;
+        let len = match tag {
+            0 => LEN_VELOCITY,
+            1 => LEN_ANGLE,
+            2 => LEN_ANGLE_BEARINGS,
+            _ => return None,
+        } - 1;
+        let (b, tail) = rest.split_at_checked(len)?;
+        *rest = tail;
+        Some(match tag {
+            0 => WireItem::Velocity(get_pair(b, 0)),
+            1 => WireItem::Angle {
+                far: angle_far(b),
+                s: [get_pair(b, 2), get_pair(b, 10)],
+                rate: [get_pair(b, 18), get_pair(b, 26)],
+                r: get_pair(b, 34),
+            },
+            _ => WireItem::AngleBearings {
+                far: angle_far(b),
+                s: [get_pair(b, 2), get_pair(b, 10)],
+                rate: [get_pair(b, 18), get_pair(b, 26)],
+            },
+        })
+    }
+}
+
+/// Variant index, far vertices, bearings and rates of an angle item (fields in order).
+#[inline(always)]
+fn encode_angle(
+    b: &mut [u8],
+    tag: u8,
+    far: &[AgentId; 2],
+    s: &[[f32; 2]; 2],
+    rate: &[[f32; 2]; 2],
+) {
+    if let Some(h) = b.get_mut(..3) {
+        h.copy_from_slice(&[tag, far[0], far[1]]);
+    }
+    set_pair(b, 3, &s[0]);
+    set_pair(b, 11, &s[1]);
+    set_pair(b, 19, &rate[0]);
+    set_pair(b, 27, &rate[1]);
+}
+
+#[inline(always)]
+fn angle_far(b: &[u8]) -> [AgentId; 2] {
+    match b.get(..2) {
+        Some(&[v, w]) => [v, w],
+        _ => [0, 0],
     }
 }
 

@@ -10,8 +10,10 @@ fn broadcast_rate(a: &mut ph_formation_tests::HostAgent<f64>) -> Option<Vec2<f64
     a.frames(|bytes| {
         let f = decode_frame(bytes, 1e-3).expect("own frame decodes");
         for it in f.items {
-            if let WireItem::Bearing { to: 2, rate: r, .. } = it {
-                rate = Some(Vec2::new(f64::from(r[0]), f64::from(r[1])));
+            if let WireItem::Angle { far, rate: r, .. } = it {
+                if let Some(k) = far.iter().position(|&v| v == 2) {
+                    rate = Some(Vec2::new(f64::from(r[k][0]), f64::from(r[k][1])));
+                }
             }
         }
     });

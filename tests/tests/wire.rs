@@ -1,7 +1,9 @@
 //! Wire frames between agents: round trip, size limit, rejection of corrupt, stale,
 //! repeated, foreign and non-finite frames, and fuzzing of the decoder.
 
-use controller_core::wire::{decode_frame, FrameWriter, WireItem, MAX_FRAME_LEN, WIRE_VERSION};
+use controller_core::wire::{
+    decode_frame, FrameHeader, FrameWriter, WireItem, MAX_FRAME_LEN, WIRE_VERSION,
+};
 use controller_core::{FrameError, Measurements, Vec2};
 use ph_formation_tests::{
     bearings, fan, fan_positions, rng, sense_and_exchange, strip, strip_positions, Formation,
@@ -144,6 +146,17 @@ fn own_and_unknown_senders_are_rejected() {
     assert_eq!(agents[0].stats().unknown_sender, 2);
 }
 
+/// An angle item from agent 2 for agent 1: its second bearing is `s1`, one rate `rate`, the
+/// estimates `r`.
+fn angle(s1: [f32; 2], rate: [f32; 2], r: [f32; 2]) -> WireItem {
+    WireItem::Angle {
+        far: [1, 3],
+        s: [[1.0, 0.0], s1],
+        rate: [[0.0; 2], rate],
+        r,
+    }
+}
+
 /// A frame with a valid CRC around arbitrary header and item bytes.
 fn with_crc(body: &[u8]) -> Vec<u8> {
     let crc = crc::Crc::<u16>::new(&crc::CRC_16_IBM_3740).checksum(body);
@@ -165,35 +178,17 @@ fn unknown_version_and_invalid_values_are_rejected() {
     let bad_items = [
         WireItem::Velocity([f32::NAN, 0.0]),
         WireItem::Velocity([0.0, f32::INFINITY]),
-        WireItem::Bearing {
-            to: 3,
-            s: [0.0, 0.0],
-            rate: [0.0, 0.0],
-        },
-        WireItem::Bearing {
-            to: 3,
-            s: [0.6, 0.9],
-            rate: [0.0, 0.0],
-        },
-        WireItem::Bearing {
-            to: 3,
-            s: [1.0, 0.0],
-            rate: [f32::NAN, 0.0],
-        },
-        WireItem::Estimate {
-            far: 1,
-            other: 3,
-            r: 0.0,
-        },
-        WireItem::Estimate {
-            far: 1,
-            other: 3,
-            r: -1.0,
-        },
-        WireItem::Estimate {
-            far: 1,
-            other: 3,
-            r: f32::NAN,
+        angle([0.0, 0.0], [0.0; 2], [1.0; 2]),
+        angle([0.6, 0.9], [0.0; 2], [1.0; 2]),
+        angle([1.0, 0.0], [f32::NAN, 0.0], [1.0; 2]),
+        angle([1.0, 0.0], [0.0, f32::INFINITY], [1.0; 2]),
+        angle([1.0, 0.0], [0.0; 2], [0.0, 1.0]),
+        angle([1.0, 0.0], [0.0; 2], [1.0, -1.0]),
+        angle([1.0, 0.0], [0.0; 2], [f32::NAN, 1.0]),
+        WireItem::AngleBearings {
+            far: [1, 3],
+            s: [[1.0, 0.0], [0.0, 2.0]],
+            rate: [[0.0; 2]; 2],
         },
     ];
     for (k, item) in bad_items.iter().enumerate() {
@@ -242,17 +237,10 @@ proptest! {
     /// Arbitrary well-formed item sequences round-trip through a frame exactly.
     #[test]
     fn writer_and_decoder_round_trip(
-        sender in any::<u8>(), seq in any::<u16>(),
+        sender in any::<u8>(), seq in any::<u16>(), item in item_strategy(),
         vel in proptest::array::uniform2(-1e3f32..1e3),
-        angle in 0.0f32..std::f32::consts::TAU, rate in proptest::array::uniform2(-10f32..10.0),
-        r in 0.01f32..100.0, to in any::<u8>(),
     ) {
-        let s = [libm::cosf(angle), libm::sinf(angle)];
-        let items = [
-            WireItem::Velocity(vel),
-            WireItem::Bearing { to, s, rate },
-            WireItem::Estimate { far: to, other: sender, r },
-        ];
+        let items = [WireItem::Velocity(vel), item];
         let mut w = FrameWriter::new(sender, seq);
         for it in &items {
             prop_assert!(w.push(it));
@@ -264,6 +252,167 @@ proptest! {
         prop_assert_eq!(frame.header.seq, seq);
         prop_assert_eq!(&frame.items[..], &items[..]);
     }
+
+    /// The hand-written encoder writes exactly what `postcard` writes, and the CRC is
+    /// CRC-16/IBM-3740 as the `crc` crate computes it.
+    #[test]
+    fn frames_are_postcard_bytes(
+        sender in any::<u8>(), seq in any::<u16>(),
+        items in proptest::collection::vec(item_strategy(), 0..3),
+    ) {
+        let mut w = FrameWriter::new(sender, seq);
+        let mut expected = postcard::to_allocvec(&FrameHeader { version: WIRE_VERSION, sender, seq }).expect("encode");
+        for it in &items {
+            if w.push(it) {
+                expected.extend(postcard::to_allocvec(it).expect("encode"));
+            }
+        }
+        let bytes = w.finish().to_vec();
+        prop_assert_eq!(&bytes[..bytes.len() - 2], &expected[..]);
+        prop_assert_eq!(bytes, with_crc(&expected));
+    }
+
+    /// On any bytes behind a valid CRC, the hand-written decoder accepts exactly what
+    /// `postcard` accepts, with the same values (bit for bit, NaNs included).
+    #[test]
+    fn decoder_agrees_with_postcard(body in body_strategy()) {
+        let frame = with_crc(&body);
+        let ours = decode_frame(&frame, f32::INFINITY);
+        let theirs = postcard_decode(&body);
+        match (ours, theirs) {
+            (Ok(f), Some((h, items))) => {
+                prop_assert_eq!(f.header, h);
+                prop_assert_eq!(bits(&f.items), bits(&items));
+            }
+            (Err(FrameError::InvalidValue), Some(_)) => {} // NaN/∞ values: postcard decodes them
+            (Err(FrameError::UnknownVersion(_)), Some((h, _))) => prop_assert_ne!(h.version, WIRE_VERSION),
+            (Err(_), None) => {}
+            (ours, theirs) => prop_assert!(false, "ours {:?}, postcard {:?}", ours, theirs),
+        }
+    }
+}
+
+/// Valid items of every kind, with random values.
+fn item_strategy() -> impl Strategy<Value = WireItem> {
+    let unit = (0.0f32..std::f32::consts::TAU).prop_map(|a| [libm::cosf(a), libm::sinf(a)]);
+    let pair = proptest::array::uniform2(-10f32..10.0);
+    (
+        0..3u8,
+        proptest::array::uniform2(any::<u8>()),
+        [unit.clone(), unit],
+        [pair.clone(), pair],
+        proptest::array::uniform2(0.01f32..100.0),
+    )
+        .prop_map(|(kind, far, s, rate, r)| match kind {
+            0 => WireItem::Velocity(rate[0]),
+            1 => WireItem::Angle { far, s, rate, r },
+            _ => WireItem::AngleBearings { far, s, rate },
+        })
+}
+
+/// Frame bodies: random bytes, and valid bodies with a few random byte changes, cuts and
+/// non-canonical varints.
+fn body_strategy() -> impl Strategy<Value = Vec<u8>> {
+    prop_oneof![
+        valid_body(),
+        mutated_body(),
+        proptest::collection::vec(any::<u8>(), 0..58),
+        // A non-canonical (two-byte) variant index, or a long sequence number.
+        Just(vec![
+            WIRE_VERSION,
+            1,
+            0x81,
+            0x80,
+            0x01,
+            0x80,
+            0x00,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0
+        ]),
+        Just(vec![WIRE_VERSION, 1, 0xff, 0xff, 0x03]),
+        Just(vec![WIRE_VERSION, 1, 0xff, 0xff, 0x04]),
+    ]
+}
+
+fn valid_body() -> impl Strategy<Value = Vec<u8>> {
+    (
+        any::<u8>(),
+        any::<u16>(),
+        proptest::collection::vec(item_strategy(), 0..2),
+    )
+        .prop_map(|(sender, seq, items)| {
+            let mut b = postcard::to_allocvec(&FrameHeader {
+                version: WIRE_VERSION,
+                sender,
+                seq,
+            })
+            .expect("encode");
+            for it in &items {
+                b.extend(postcard::to_allocvec(it).expect("encode"));
+            }
+            b
+        })
+}
+
+fn mutated_body() -> impl Strategy<Value = Vec<u8>> {
+    (
+        valid_body(),
+        proptest::collection::vec((any::<usize>(), any::<u8>()), 1..4),
+        any::<usize>(),
+        any::<bool>(),
+    )
+        .prop_map(|(mut b, changes, cut, do_cut)| {
+            let n = b.len();
+            for (at, v) in changes {
+                b[at % n] = v;
+            }
+            if do_cut {
+                b.truncate(cut % (n + 1));
+            }
+            b
+        })
+}
+
+/// Header and items as `postcard` decodes them (`None`: it fails somewhere).
+fn postcard_decode(body: &[u8]) -> Option<(FrameHeader, Vec<WireItem>)> {
+    let (h, mut rest) = postcard::take_from_bytes::<FrameHeader>(body).ok()?;
+    let mut items = Vec::new();
+    while !rest.is_empty() {
+        let (it, r) = postcard::take_from_bytes::<WireItem>(rest).ok()?;
+        items.push(it);
+        rest = r;
+    }
+    Some((h, items))
+}
+
+/// Items with every `f32` as its bits (so that NaNs compare).
+fn bits(items: &[WireItem]) -> Vec<Vec<u32>> {
+    items
+        .iter()
+        .map(|it| match *it {
+            WireItem::Velocity(v) => v.iter().map(|x| x.to_bits()).collect(),
+            WireItem::Angle { far, s, rate, r } => [far[0] as u32, far[1] as u32, 1]
+                .into_iter()
+                .chain(
+                    s.iter()
+                        .chain(&rate)
+                        .flatten()
+                        .chain(&r)
+                        .map(|x| x.to_bits()),
+                )
+                .collect(),
+            WireItem::AngleBearings { far, s, rate } => [far[0] as u32, far[1] as u32, 2]
+                .into_iter()
+                .chain(s.iter().chain(&rate).flatten().map(|x| x.to_bits()))
+                .collect(),
+        })
+        .collect()
 }
 
 proptest! {

@@ -3,39 +3,34 @@
 
 use super::{pick, Agent, Role};
 use crate::config::{AgentId, EstimatorMode};
-use crate::wire::{check_frame, FrameError, FrameWriter, WireItem};
+use crate::wire::{
+    check_frame, item_valid, FrameError, FrameWriter, WireItem, MAX_ITEMS_PER_FRAME,
+};
 use crate::{Real, Vec2};
 
 impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
-    /// Calls `f` for everything this agent broadcasts: velocity, the bearings its
-    /// neighbours need, and (shared mode) the estimates it owns.
+    /// Calls `f` for everything this agent broadcasts: its velocity, and for every
+    /// controlled angle it is the apex of (and has fresh bearings for), the bearings and
+    /// rates its far vertices need, with the estimates it owns in shared mode.
     fn for_each_item(&self, mut f: impl FnMut(Item<T>)) {
         f(Item::Velocity(self.velocity));
-        for n in &self.neighbours {
-            if let (true, true, Some(s)) = (n.bearing_needed, n.fresh, n.bearing) {
-                f(Item::Bearing {
-                    to: n.id,
-                    s,
-                    rate: n.rate,
-                });
-            }
-        }
-        if self.config.estimator == EstimatorMode::Shared {
-            for a in self
-                .angles
-                .iter()
-                .flatten()
-                .filter(|a| a.role == Role::Apex)
-            {
-                f(Item::Estimate {
-                    far: a.far[0],
-                    other: a.far[1],
-                    r: a.estimate[0],
-                });
-                f(Item::Estimate {
-                    far: a.far[1],
-                    other: a.far[0],
-                    r: a.estimate[1],
+        let shared = self.config.estimator == EstimatorMode::Shared;
+        for a in self
+            .angles
+            .iter()
+            .flatten()
+            .filter(|a| a.role == Role::Apex)
+        {
+            let bearing = |slot: usize| match self.neighbours.get(slot) {
+                Some(n) if n.fresh => n.bearing.map(|s| (s, n.rate)),
+                _ => None,
+            };
+            if let (Some((s0, d0)), Some((s1, d1))) = (bearing(a.slots[1]), bearing(a.slots[2])) {
+                f(Item::Angle {
+                    far: a.far,
+                    s: [s0, s1],
+                    rate: [d0, d1],
+                    r: shared.then_some(a.estimate),
                 });
             }
         }
@@ -97,15 +92,33 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 return Err(FrameError::StaleSequence { sender, seq });
             }
         }
-        // Whole frame valid before anything is applied.
-        frame.validate(self.config.limits.bearing_tolerance.as_f32())?;
+        // One pass over the items: decode, check, and keep what concerns this agent. The
+        // whole frame is valid before anything is applied.
+        let me = self.config.id;
+        let tol = self.config.limits.bearing_tolerance.as_f32();
+        let mut kept: heapless::Vec<Item<T>, MAX_ITEMS_PER_FRAME> = heapless::Vec::new();
+        let mut rest = frame.item_bytes();
+        while !rest.is_empty() {
+            let item = WireItem::decode(&mut rest).ok_or(FrameError::Malformed)?;
+            if !item_valid(&item, tol) {
+                return Err(FrameError::InvalidValue);
+            }
+            if let WireItem::Angle { far, .. } | WireItem::AngleBearings { far, .. } = item {
+                if far[0] != me && far[1] != me {
+                    continue;
+                }
+            }
+            // At most MAX_ITEMS_PER_FRAME items fit in a frame.
+            kept.push(Item::from_wire(&item))
+                .map_err(|_| FrameError::Malformed)?;
+        }
         if let Some(n) = self.neighbours.get_mut(slot) {
             n.last_seq = Some(seq);
             n.heard = true;
             n.age = T::zero();
         }
-        for item in frame.items().flatten() {
-            self.apply(sender, slot, Item::from_wire(&item));
+        for item in &kept {
+            self.apply(sender, slot, *item);
         }
         Ok(())
     }
@@ -128,15 +141,23 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         let Some(n) = self.neighbours.get_mut(slot) else {
             return;
         };
-        let (other, update): (AgentId, Item<T>) = match item {
+        let (far, s, rate, r) = match item {
             Item::Velocity(v) => {
                 n.velocity = Some(v);
                 return;
             }
-            Item::Bearing { to, .. } => (to, item),
-            Item::Estimate { far, other, .. } if far == me => (other, item),
-            Item::Estimate { .. } => return,
+            Item::Angle { far, s, rate, r } => (far, s, rate, r),
         };
+        // `mine`: this agent's index among the far vertices; the other one's bearing is
+        // what it needs (S4–S6), and the estimate of its own edge (S8).
+        let mine = if far[0] == me {
+            0
+        } else if far[1] == me {
+            1
+        } else {
+            return;
+        };
+        let other = pick(&far, 1 - mine);
         // Only the angles whose apex is the sender and of which this agent is a far vertex.
         for &flat in &n.apex_of {
             let flat = usize::from(flat);
@@ -151,10 +172,9 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             if a.apex != sender || pick(&a.far, 1 - k.min(1)) != other {
                 continue;
             }
-            match update {
-                Item::Bearing { s, rate, .. } => a.remote_bearing = Some((s, rate)),
-                Item::Estimate { r, .. } => a.remote_estimate = Some(r),
-                Item::Velocity(_) => {}
+            a.remote_bearing = Some((pick(&s, 1 - mine), pick(&rate, 1 - mine)));
+            if let Some(r) = r {
+                a.remote_estimate = Some(pick(&r, mine));
             }
         }
     }
@@ -164,15 +184,12 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
 #[derive(Clone, Copy, Debug)]
 enum Item<T: Real> {
     Velocity(Vec2<T>),
-    Bearing {
-        to: AgentId,
-        s: Vec2<T>,
-        rate: Vec2<T>,
-    },
-    Estimate {
-        far: AgentId,
-        other: AgentId,
-        r: T,
+    /// A controlled angle of which the sender is the apex; `r` in shared mode only.
+    Angle {
+        far: [AgentId; 2],
+        s: [Vec2<T>; 2],
+        rate: [Vec2<T>; 2],
+        r: Option<[T; 2]>,
     },
 }
 
@@ -181,16 +198,18 @@ impl<T: Real> Item<T> {
         let w = |v: Vec2<T>| [v.x.as_f32(), v.y.as_f32()];
         match self {
             Item::Velocity(v) => WireItem::Velocity(w(v)),
-            Item::Bearing { to, s, rate } => WireItem::Bearing {
-                to,
-                s: w(s),
-                rate: w(rate),
-            },
-            Item::Estimate { far, other, r } => WireItem::Estimate {
-                far,
-                other,
-                r: r.as_f32(),
-            },
+            Item::Angle { far, s, rate, r } => {
+                let (s, rate) = ([w(s[0]), w(s[1])], [w(rate[0]), w(rate[1])]);
+                match r {
+                    Some(r) => WireItem::Angle {
+                        far,
+                        s,
+                        rate,
+                        r: [r[0].as_f32(), r[1].as_f32()],
+                    },
+                    None => WireItem::AngleBearings { far, s, rate },
+                }
+            }
         }
     }
 
@@ -198,15 +217,17 @@ impl<T: Real> Item<T> {
         let v = |a: [f32; 2]| Vec2::new(T::of_f32(a[0]), T::of_f32(a[1]));
         match *w {
             WireItem::Velocity(x) => Item::Velocity(v(x)),
-            WireItem::Bearing { to, s, rate } => Item::Bearing {
-                to,
-                s: v(s),
-                rate: v(rate),
-            },
-            WireItem::Estimate { far, other, r } => Item::Estimate {
+            WireItem::Angle { far, s, rate, r } => Item::Angle {
                 far,
-                other,
-                r: T::of_f32(r),
+                s: [v(s[0]), v(s[1])],
+                rate: [v(rate[0]), v(rate[1])],
+                r: Some([T::of_f32(r[0]), T::of_f32(r[1])]),
+            },
+            WireItem::AngleBearings { far, s, rate } => Item::Angle {
+                far,
+                s: [v(s[0]), v(s[1])],
+                rate: [v(rate[0]), v(rate[1])],
+                r: None,
             },
         }
     }

@@ -461,7 +461,10 @@ impl HilController {
             return;
         };
         for item in &frame.items {
-            if let WireItem::Estimate { far, other, r } = *item {
+            let WireItem::Angle { far: [v, w], r, .. } = *item else {
+                continue;
+            };
+            for (far, other, r) in [(v, w, r[0]), (w, v, r[1])] {
                 if let Some(k) = self
                     .slots
                     .iter()
