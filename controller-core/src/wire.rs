@@ -461,29 +461,125 @@ impl WireItem {
 
     /// Decodes one item from the front of `rest` (`None`: malformed or truncated).
     pub(crate) fn decode(rest: &mut &[u8]) -> Option<Self> {
-        let tag = take_varint::<5, 0x0F>(rest)?;
-        let len = match tag {
-            0 => LEN_VELOCITY,
-            1 => LEN_ANGLE,
-            2 => LEN_ANGLE_BEARINGS,
-            _ => return None,
-        } - 1;
-        let (b, tail) = rest.split_at_checked(len)?;
-        *rest = tail;
-        Some(match tag {
-            0 => WireItem::Velocity(get_pair(b, 0)),
-            1 => WireItem::Angle {
+        RawItem::next(rest).map(|raw| raw.item())
+    }
+}
+
+/// One item of a frame, split off but not decoded: its field bytes, by variant.
+/// Receiving agents check and read items through it without copying them.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum RawItem<'a> {
+    Velocity(&'a [u8; LEN_VELOCITY - 1]),
+    Angle(&'a [u8; LEN_ANGLE - 1]),
+    AngleBearings(&'a [u8; LEN_ANGLE_BEARINGS - 1]),
+}
+
+/// Splits `N` bytes off the front of `rest`.
+#[inline(always)]
+fn split<'a, const N: usize>(rest: &mut &'a [u8]) -> Option<&'a [u8; N]> {
+    let (head, tail) = rest.split_first_chunk::<N>()?;
+    *rest = tail;
+    Some(head)
+}
+
+impl<'a> RawItem<'a> {
+    /// Splits the next item off the front of `rest` (`None`: malformed or truncated).
+    #[inline(always)]
+    pub(crate) fn next(rest: &mut &'a [u8]) -> Option<Self> {
+        match take_varint::<5, 0x0F>(rest)? {
+            0 => split(rest).map(RawItem::Velocity),
+            1 => split(rest).map(RawItem::Angle),
+            2 => split(rest).map(RawItem::AngleBearings),
+            _ => None,
+        }
+    }
+
+    /// The bytes an angle item shares with its estimate-less form: far vertices, bearings
+    /// and rates.
+    #[inline(always)]
+    fn angle_part(&self) -> Option<&'a [u8; LEN_ANGLE_BEARINGS - 1]> {
+        match *self {
+            RawItem::Velocity(_) => None,
+            RawItem::Angle(b) => b.first_chunk(),
+            RawItem::AngleBearings(b) => Some(b),
+        }
+    }
+
+    /// The decoded item.
+    pub(crate) fn item(&self) -> WireItem {
+        match *self {
+            RawItem::Velocity(b) => WireItem::Velocity(get_pair(b, 0)),
+            RawItem::Angle(b) => WireItem::Angle {
                 far: angle_far(b),
                 s: [get_pair(b, 2), get_pair(b, 10)],
                 rate: [get_pair(b, 18), get_pair(b, 26)],
                 r: get_pair(b, 34),
             },
-            _ => WireItem::AngleBearings {
+            RawItem::AngleBearings(b) => WireItem::AngleBearings {
                 far: angle_far(b),
                 s: [get_pair(b, 2), get_pair(b, 10)],
                 rate: [get_pair(b, 18), get_pair(b, 26)],
             },
-        })
+        }
+    }
+
+    /// [`item_valid`] on the undecoded item.
+    #[inline(always)]
+    pub(crate) fn valid(&self, tol: f32) -> bool {
+        let bearings = |b: &[u8; LEN_ANGLE_BEARINGS - 1]| {
+            bearings_valid(
+                &[get_pair(b, 2), get_pair(b, 10)],
+                &[get_pair(b, 18), get_pair(b, 26)],
+                tol,
+            )
+        };
+        match *self {
+            RawItem::Velocity(b) => finite2(&get_pair(b, 0)),
+            RawItem::AngleBearings(b) => bearings(b),
+            RawItem::Angle(b) => {
+                let r = get_pair(b, 34);
+                b.first_chunk().is_some_and(bearings)
+                    && r[0].is_finite()
+                    && r[1].is_finite()
+                    && r[0] > 0.0
+                    && r[1] > 0.0
+            }
+        }
+    }
+
+    /// A velocity item's value.
+    #[inline(always)]
+    pub(crate) fn velocity(&self) -> Option<[f32; 2]> {
+        match *self {
+            RawItem::Velocity(b) => Some(get_pair(b, 0)),
+            _ => None,
+        }
+    }
+
+    /// An angle item's far vertices.
+    #[inline(always)]
+    pub(crate) fn far(&self) -> Option<[AgentId; 2]> {
+        self.angle_part().map(|b| angle_far(b))
+    }
+
+    /// An angle item's bearing and rate to far vertex `k` (0, else 1).
+    #[inline(always)]
+    pub(crate) fn bearing(&self, k: usize) -> ([f32; 2], [f32; 2]) {
+        match (self.angle_part(), k) {
+            (Some(b), 0) => (get_pair(b, 2), get_pair(b, 18)),
+            (Some(b), _) => (get_pair(b, 10), get_pair(b, 26)),
+            (None, _) => ([0.0; 2], [0.0; 2]),
+        }
+    }
+
+    /// An angle item's estimate of the edge to far vertex `k` (0, else 1), if it carries
+    /// estimates.
+    #[inline(always)]
+    pub(crate) fn estimate(&self, k: usize) -> Option<f32> {
+        match *self {
+            RawItem::Angle(b) => Some(get_f32(b, if k == 0 { 34 } else { 38 })),
+            _ => None,
+        }
     }
 }
 

@@ -1,11 +1,9 @@
 //! Communication of one agent: what it broadcasts ([`Agent::frames`]) and how it takes
 //! in its neighbours' frames ([`Agent::receive`]).
 
-use super::{pick, Agent, Role};
+use super::{pick, Agent, AngleState, Role};
 use crate::config::{AgentId, EstimatorMode};
-use crate::wire::{
-    check_frame, item_valid, FrameError, FrameWriter, WireItem, MAX_ITEMS_PER_FRAME,
-};
+use crate::wire::{check_frame, FrameError, FrameWriter, RawItem, WireItem, MAX_ITEMS_PER_FRAME};
 use crate::{Real, Vec2};
 
 impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
@@ -92,33 +90,42 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 return Err(FrameError::StaleSequence { sender, seq });
             }
         }
-        // One pass over the items: decode, check, and keep what concerns this agent. The
-        // whole frame is valid before anything is applied.
+        // One pass over the items: split, check, and keep (without copying) what concerns
+        // this agent. The whole frame is valid before anything is applied.
         let me = self.config.id;
         let tol = self.config.limits.bearing_tolerance.as_f32();
-        let mut kept: heapless::Vec<Item<T>, MAX_ITEMS_PER_FRAME> = heapless::Vec::new();
+        let mut kept: heapless::Vec<RawItem<'_>, MAX_ITEMS_PER_FRAME> = heapless::Vec::new();
         let mut rest = frame.item_bytes();
         while !rest.is_empty() {
-            let item = WireItem::decode(&mut rest).ok_or(FrameError::Malformed)?;
-            if !item_valid(&item, tol) {
+            let item = RawItem::next(&mut rest).ok_or(FrameError::Malformed)?;
+            if !item.valid(tol) {
                 return Err(FrameError::InvalidValue);
             }
-            if let WireItem::Angle { far, .. } | WireItem::AngleBearings { far, .. } = item {
-                if far[0] != me && far[1] != me {
-                    continue;
-                }
+            if item.far().is_none_or(|far| far.contains(&me)) {
+                // At most MAX_ITEMS_PER_FRAME items fit in a frame.
+                kept.push(item).map_err(|_| FrameError::Malformed)?;
             }
-            // At most MAX_ITEMS_PER_FRAME items fit in a frame.
-            kept.push(Item::from_wire(&item))
-                .map_err(|_| FrameError::Malformed)?;
         }
         if let Some(n) = self.neighbours.get_mut(slot) {
             n.last_seq = Some(seq);
             n.heard = true;
             n.age = T::zero();
         }
+        let v = |a: [f32; 2]| Vec2::new(T::of_f32(a[0]), T::of_f32(a[1]));
         for item in &kept {
-            self.apply(sender, slot, *item);
+            if let Some(vel) = item.velocity() {
+                if let Some(n) = self.neighbours.get_mut(slot) {
+                    n.velocity = Some(v(vel));
+                }
+            } else if let Some(far) = item.far() {
+                self.for_far_angles(sender, slot, far, |a, mine| {
+                    let (s, rate) = item.bearing(1 - mine);
+                    a.remote_bearing = Some((v(s), v(rate)));
+                    if let Some(r) = item.estimate(mine) {
+                        a.remote_estimate = Some(T::of_f32(r));
+                    }
+                });
+            }
         }
         Ok(())
     }
@@ -137,19 +144,34 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     }
 
     fn apply(&mut self, sender: AgentId, slot: usize, item: Item<T>) {
-        let me = self.config.id;
-        let Some(n) = self.neighbours.get_mut(slot) else {
-            return;
-        };
-        let (far, s, rate, r) = match item {
+        match item {
             Item::Velocity(v) => {
-                n.velocity = Some(v);
-                return;
+                if let Some(n) = self.neighbours.get_mut(slot) {
+                    n.velocity = Some(v);
+                }
             }
-            Item::Angle { far, s, rate, r } => (far, s, rate, r),
-        };
-        // `mine`: this agent's index among the far vertices; the other one's bearing is
-        // what it needs (S4–S6), and the estimate of its own edge (S8).
+            Item::Angle { far, s, rate, r } => {
+                self.for_far_angles(sender, slot, far, |a, mine| {
+                    a.remote_bearing = Some((pick(&s, 1 - mine), pick(&rate, 1 - mine)));
+                    if let Some(r) = r {
+                        a.remote_estimate = Some(pick(&r, mine));
+                    }
+                });
+            }
+        }
+    }
+
+    /// Calls `f(angle, mine)` for the angle(s) `(sender; far[0], far[1])` of which this
+    /// agent is the far vertex `far[mine]`: the other far vertex's bearing is what it
+    /// needs (S4–S6), with the estimate of its own edge (S8).
+    fn for_far_angles(
+        &mut self,
+        sender: AgentId,
+        slot: usize,
+        far: [AgentId; 2],
+        mut f: impl FnMut(&mut AngleState<T>, usize),
+    ) {
+        let me = self.config.id;
         let mine = if far[0] == me {
             0
         } else if far[1] == me {
@@ -158,6 +180,9 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             return;
         };
         let other = pick(&far, 1 - mine);
+        let Some(n) = self.neighbours.get(slot) else {
+            return;
+        };
         // Only the angles whose apex is the sender and of which this agent is a far vertex.
         for &flat in &n.apex_of {
             let flat = usize::from(flat);
@@ -169,12 +194,8 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 continue;
             };
             let Role::Far(k) = a.role else { continue };
-            if a.apex != sender || pick(&a.far, 1 - k.min(1)) != other {
-                continue;
-            }
-            a.remote_bearing = Some((pick(&s, 1 - mine), pick(&rate, 1 - mine)));
-            if let Some(r) = r {
-                a.remote_estimate = Some(pick(&r, mine));
+            if a.apex == sender && pick(&a.far, 1 - k.min(1)) == other {
+                f(a, mine);
             }
         }
     }
@@ -210,25 +231,6 @@ impl<T: Real> Item<T> {
                     None => WireItem::AngleBearings { far, s, rate },
                 }
             }
-        }
-    }
-
-    fn from_wire(w: &WireItem) -> Self {
-        let v = |a: [f32; 2]| Vec2::new(T::of_f32(a[0]), T::of_f32(a[1]));
-        match *w {
-            WireItem::Velocity(x) => Item::Velocity(v(x)),
-            WireItem::Angle { far, s, rate, r } => Item::Angle {
-                far,
-                s: [v(s[0]), v(s[1])],
-                rate: [v(rate[0]), v(rate[1])],
-                r: Some([T::of_f32(r[0]), T::of_f32(r[1])]),
-            },
-            WireItem::AngleBearings { far, s, rate } => Item::Angle {
-                far,
-                s: [v(s[0]), v(s[1])],
-                rate: [v(rate[0]), v(rate[1])],
-                r: None,
-            },
         }
     }
 }
