@@ -3,7 +3,7 @@
 //! byte streams (UART).
 //!
 //! Layout of one frame: `postcard(FrameHeader) ‖ postcard(WireItem)* ‖ CRC-16 (LE)`.
-//! The CRC is CRC-16/IBM-3740 (CCITT-FALSE) over everything before it. Items are packed
+//! The CRC is CRC-16/IBM-SDLC (X-25, see [`crate::crc16`]) over everything before it. Items are packed
 //! greedily; an agent whose data does not fit sends several frames, each with its own
 //! sequence number.
 //!

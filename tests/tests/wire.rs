@@ -159,7 +159,7 @@ fn angle(s1: [f32; 2], rate: [f32; 2], r: [f32; 2]) -> WireItem {
 
 /// A frame with a valid CRC around arbitrary header and item bytes.
 fn with_crc(body: &[u8]) -> Vec<u8> {
-    let crc = crc::Crc::<u16>::new(&crc::CRC_16_IBM_3740).checksum(body);
+    let crc = crc::Crc::<u16>::new(&crc::CRC_16_IBM_SDLC).checksum(body);
     let mut v = body.to_vec();
     v.extend_from_slice(&crc.to_le_bytes());
     v
@@ -234,6 +234,13 @@ proptest! {
         prop_assert!(decode_frame(&bytes, 1e-3).is_err() || bytes.len() <= MAX_FRAME_LEN);
     }
 
+    /// The slice-by-4 CRC equals the `crc` crate's CRC-16/IBM-SDLC on every length.
+    #[test]
+    fn crc_matches_the_crc_crate(bytes in proptest::collection::vec(any::<u8>(), 0..80)) {
+        let reference = crc::Crc::<u16>::new(&crc::CRC_16_IBM_SDLC);
+        prop_assert_eq!(controller_core::crc16::checksum(&bytes), reference.checksum(&bytes));
+    }
+
     /// Arbitrary well-formed item sequences round-trip through a frame exactly.
     #[test]
     fn writer_and_decoder_round_trip(
@@ -254,7 +261,7 @@ proptest! {
     }
 
     /// The hand-written encoder writes exactly what `postcard` writes, and the CRC is
-    /// CRC-16/IBM-3740 as the `crc` crate computes it.
+    /// CRC-16/IBM-SDLC as the `crc` crate computes it.
     #[test]
     fn frames_are_postcard_bytes(
         sender in any::<u8>(), seq in any::<u16>(),

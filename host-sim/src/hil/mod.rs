@@ -235,7 +235,7 @@ pub struct LinkStats {
 
 impl LinkStats {
     /// Where the agent's estimates in the outputs come from: `"estimates_message"`
-    /// (`TargetMsg::Estimates`), `"radio_frames"` (the estimate items of its own broadcast
+    /// (`TargetMsg::Estimates`), `"radio_frames"` (the angle items of its own broadcast
     /// frames) or `"none"` (it owns no estimate).
     pub fn estimates_source(&self) -> &'static str {
         match (self.estimates, self.estimates_from_target) {
