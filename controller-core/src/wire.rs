@@ -302,16 +302,39 @@ pub fn decode_frame(bytes: &[u8], bearing_tolerance: f32) -> Result<Frame, Frame
     })
 }
 
+/// Every value is finite: `x·0` is `±0` for finite `x` and NaN for `±∞` and NaN, so one
+/// comparison checks them all (no branch per value).
+#[inline(always)]
+fn all_finite<const N: usize>(xs: [f32; N]) -> bool {
+    let mut acc = 0.0f32;
+    for x in xs {
+        acc += x * 0.0;
+    }
+    acc == 0.0
+}
+
+#[inline(always)]
 fn finite2(v: &[f32; 2]) -> bool {
-    v[0].is_finite() && v[1].is_finite()
+    all_finite(*v)
 }
 
+/// `| |s|² − 1 | ≤ tol` (for finite `s`).
+#[inline(always)]
 fn unit(s: &[f32; 2], tol: f32) -> bool {
-    finite2(s) && ((s[0] * s[0] + s[1] * s[1]) - 1.0).abs() <= tol
+    ((s[0] * s[0] + s[1] * s[1]) - 1.0).abs() <= tol
 }
 
+#[inline(always)]
 fn bearings_valid(s: &[[f32; 2]; 2], rate: &[[f32; 2]; 2], tol: f32) -> bool {
-    unit(&s[0], tol) && unit(&s[1], tol) && finite2(&rate[0]) && finite2(&rate[1])
+    let [[a, b], [c, d]] = *s;
+    let [[e, f], [g, h]] = *rate;
+    all_finite([a, b, c, d, e, f, g, h]) & unit(&s[0], tol) & unit(&s[1], tol)
+}
+
+/// Estimates are finite and positive.
+#[inline(always)]
+fn estimates_valid(r: &[f32; 2]) -> bool {
+    all_finite(*r) & (r[0] > 0.0) & (r[1] > 0.0)
 }
 
 /// Values of an item are acceptable: finite, unit bearings within `tol` on `|s|²`, and
@@ -319,13 +342,7 @@ fn bearings_valid(s: &[[f32; 2]; 2], rate: &[[f32; 2]; 2], tol: f32) -> bool {
 pub(crate) fn item_valid(item: &WireItem, tol: f32) -> bool {
     match item {
         WireItem::Velocity(v) => finite2(v),
-        WireItem::Angle { s, rate, r, .. } => {
-            bearings_valid(s, rate, tol)
-                && r[0].is_finite()
-                && r[1].is_finite()
-                && r[0] > 0.0
-                && r[1] > 0.0
-        }
+        WireItem::Angle { s, rate, r, .. } => bearings_valid(s, rate, tol) & estimates_valid(r),
         WireItem::AngleBearings { s, rate, .. } => bearings_valid(s, rate, tol),
     }
 }
@@ -537,12 +554,7 @@ impl<'a> RawItem<'a> {
             RawItem::Velocity(b) => finite2(&get_pair(b, 0)),
             RawItem::AngleBearings(b) => bearings(b),
             RawItem::Angle(b) => {
-                let r = get_pair(b, 34);
-                b.first_chunk().is_some_and(bearings)
-                    && r[0].is_finite()
-                    && r[1].is_finite()
-                    && r[0] > 0.0
-                    && r[1] > 0.0
+                b.first_chunk().is_some_and(bearings) & estimates_valid(&get_pair(b, 34))
             }
         }
     }
