@@ -205,6 +205,8 @@ struct AngleState<T: Real> {
     remote_bearing: Option<(Vec2<T>, Vec2<T>)>,
     /// Far vertex, shared mode only: the apex's estimate for this agent's edge.
     remote_estimate: Option<T>,
+    /// `estimate` before the fast step changed it (restored if that step fails).
+    estimate_before: [T; 2],
 }
 
 #[derive(Clone, Debug)]
@@ -217,12 +219,18 @@ struct Neighbour<T: Real, const MT: usize> {
     in_triangle: bool,
     /// Some triangle neighbour needs this agent's bearing to it (far vertex of own apex angle).
     bearing_needed: bool,
+    /// The shared-mode step needs its velocity: far vertex of an own apex angle (S9) or
+    /// the leader partner (S11).
+    velocity_needed: bool,
     heard: bool,
     age: T,
     last_seq: Option<u16>,
     velocity: Option<Vec2<T>>,
     bearing: Option<Vec2<T>>,
-    /// Seconds since `bearing` was measured (finite-difference interval).
+    /// The last bearing (`bearing` without the `Option`; zero before the first one).
+    s: Vec2<T>,
+    /// Seconds since `bearing` was measured (finite-difference interval); −∞ while there
+    /// is none.
     bearing_age: T,
     rate: Vec2<T>,
     range: Option<T>,
@@ -240,6 +248,9 @@ pub struct Agent<T: Real, const MT: usize, const NB: usize> {
     angles: heapless::Vec<[AngleState<T>; 2], MT>,
     neighbours: heapless::Vec<Neighbour<T, MT>, NB>,
     partner_slot: usize,
+    /// Neighbour slots `0..bearings_needed` hold every triangle neighbour (they come
+    /// first): the bearings each tick must cover.
+    bearings_needed: usize,
     time: T,
     velocity: Vec2<T>,
     partner_offset: Option<Vec2<T>>,
@@ -316,6 +327,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     for &s in &slots[1..] {
                         if let Some(n) = neighbours.get_mut(s) {
                             n.bearing_needed = true;
+                            n.velocity_needed = true;
                         }
                     }
                 } else if let Some(n) = neighbours.get_mut(slots[0]) {
@@ -339,6 +351,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                         estimate: [config.initial_estimate; 2],
                         remote_bearing: None,
                         remote_estimate: None,
+                        estimate_before: [config.initial_estimate; 2],
                     });
                 }
             }
@@ -352,11 +365,19 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             Some(l) => Self::add_neighbour(&mut neighbours, l.partner, false)?,
             None => SELF_SLOT,
         };
+        if let Some(n) = neighbours.get_mut(partner_slot) {
+            n.velocity_needed = true;
+        }
+        let bearings_needed = neighbours
+            .iter()
+            .rposition(|n| n.in_triangle)
+            .map_or(0, |i| i + 1);
         Ok(Self {
             config,
             angles,
             neighbours,
             partner_slot,
+            bearings_needed,
             time: T::zero(),
             velocity: Vec2::zeros(),
             partner_offset: None,
@@ -460,12 +481,15 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             apex_of: heapless::Vec::new(),
             in_triangle,
             bearing_needed: false,
+            velocity_needed: false,
             heard: false,
-            age: T::zero(),
+            // Never heard: infinitely old (so `age <= timeout` alone means heard recently).
+            age: T::lit(f64::INFINITY),
             last_seq: None,
             velocity: None,
             bearing: None,
-            bearing_age: T::zero(),
+            s: Vec2::zeros(),
+            bearing_age: T::lit(f64::NEG_INFINITY),
             rate: Vec2::zeros(),
             range: None,
             fresh: false,
@@ -504,68 +528,138 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// refused), then checks and stores the own measurements (bearings, rates, velocity,
     /// time). Nothing else changes if they are refused.
     pub fn sense(&mut self, m: &Measurements<'_, T>) -> Result<(), Fault> {
-        let bad = |e| Err(Fault::Measurement(e));
-        if !(m.dt.finite() && m.dt >= T::zero()) {
-            return bad(MeasurementError::NonFinite);
+        self.sense_ready(m).map(|_| ())
+    }
+
+    /// [`Agent::sense`], also telling whether the neighbour table holds everything the
+    /// shared-mode step needs from it: every neighbour heard within the timeout (see
+    /// [`Agent::check_fresh`]), with its velocity where needed, and a bearing to every
+    /// triangle neighbour this tick.
+    fn sense_ready(&mut self, m: &Measurements<'_, T>) -> Result<bool, Fault> {
+        let dt = m.dt;
+        if !(dt.finite() && dt >= T::zero()) {
+            return Err(Fault::Measurement(MeasurementError::NonFinite));
         }
-        for n in self.neighbours.iter_mut() {
-            n.age += m.dt;
-            n.bearing_age += m.dt;
-        }
-        if !(m.time.finite() && finite_vec(&m.velocity)) {
-            return bad(MeasurementError::NonFinite);
-        }
-        if let Some(p) = &m.partner_offset {
-            if !finite_vec(p) {
-                return bad(MeasurementError::NonFinite);
-            }
-        }
-        let tol = self.config.limits.bearing_tolerance;
-        for (i, b) in m.bearings.iter().enumerate() {
-            let id = b.neighbour;
-            if self.slot(id).is_none() {
-                return bad(MeasurementError::UnknownNeighbour(id));
-            }
-            if m.bearings.iter().take(i).any(|o| o.neighbour == id) {
-                return bad(MeasurementError::DuplicateBearing(id));
-            }
-            let s = &b.bearing;
-            let unit = finite_vec(s) && (s.dot(s) - T::one()).abs() <= tol;
-            if !unit || !b.rate.as_ref().is_none_or(finite_vec) {
-                return bad(MeasurementError::BadBearing(id));
-            }
-            if let Some(r) = b.range {
-                if !(r.finite() && r > T::zero()) {
-                    return bad(MeasurementError::BadRange(id));
+        // The checks read nothing that aging changes: age after them.
+        let in_order = match self.check_measurements(m) {
+            Ok(in_order) => in_order,
+            Err(e) => {
+                for n in self.neighbours.iter_mut() {
+                    n.age += dt;
+                    n.bearing_age += dt;
                 }
+                return Err(Fault::Measurement(e));
             }
-        }
+        };
         self.time = m.time;
         self.velocity = m.velocity;
         self.partner_offset = m.partner_offset;
-        for n in self.neighbours.iter_mut() {
-            n.fresh = false;
-            n.range = None;
-        }
-        for b in m.bearings {
-            let Some(n) = self.neighbours.iter_mut().find(|n| n.id == b.neighbour) else {
-                continue;
-            };
-            n.rate = match (b.rate, n.bearing) {
-                (Some(rate), _) => rate,
-                // Finite difference of successive bearings (SPEC §2), over the time
-                // since the previous bearing (a missed tick widens the interval).
-                (None, Some(prev)) if n.bearing_age > T::zero() => {
-                    (b.bearing - prev) / n.bearing_age
+        let timeout = self.config.limits.neighbour_timeout;
+        let mut ready = true;
+        if in_order {
+            // Bearing i is to slot i: one pass. Triangle neighbours are the first slots.
+            ready &= m.bearings.len() >= self.bearings_needed;
+            let mut bearings = m.bearings.iter();
+            for n in self.neighbours.iter_mut() {
+                n.age += dt;
+                ready &= Self::heard_with_velocity(n, timeout);
+                match bearings.next() {
+                    Some(b) => Self::take_bearing(n, b, dt),
+                    None => {
+                        n.bearing_age += dt;
+                        n.fresh = false;
+                        n.range = None;
+                    }
                 }
-                _ => Vec2::zeros(),
-            };
-            n.bearing = Some(b.bearing);
-            n.bearing_age = T::zero();
-            n.range = b.range;
-            n.fresh = true;
+            }
+        } else {
+            for n in self.neighbours.iter_mut() {
+                n.age += dt;
+                n.bearing_age += dt;
+                n.fresh = false;
+                n.range = None;
+            }
+            for b in m.bearings {
+                if let Some(n) = self.neighbours.iter_mut().find(|n| n.id == b.neighbour) {
+                    Self::take_bearing(n, b, T::zero());
+                }
+            }
+            for n in &self.neighbours {
+                ready &= Self::heard_with_velocity(n, timeout) & (n.fresh | !n.in_triangle);
+            }
         }
-        Ok(())
+        Ok(ready)
+    }
+
+    /// Heard within `timeout` (not stale, see [`Agent::check_fresh`]) and, if the
+    /// shared-mode step needs it, with a velocity.
+    #[inline(always)]
+    fn heard_with_velocity(n: &Neighbour<T, MT>, timeout: T) -> bool {
+        // `age` is ∞ until first heard: no need to read `heard`.
+        (n.age <= timeout) & (n.velocity.is_some() | !n.velocity_needed)
+    }
+
+    /// Checks the own measurements (the faults of [`Agent::sense`] after `dt`, in the same
+    /// order). Returns whether bearing `i` is to neighbour slot `i` for every `i`.
+    fn check_measurements(&self, m: &Measurements<'_, T>) -> Result<bool, MeasurementError> {
+        if !(m.time.finite() && finite_vec(&m.velocity)) {
+            return Err(MeasurementError::NonFinite);
+        }
+        if let Some(p) = &m.partner_offset {
+            if !finite_vec(p) {
+                return Err(MeasurementError::NonFinite);
+            }
+        }
+        let tol = self.config.limits.bearing_tolerance;
+        // While bearing i is to slot i, the bearings are known and distinct without
+        // searching (neighbour ids are unique). What the firmware sends.
+        let mut in_order = true;
+        let mut slots = self.neighbours.iter();
+        for (i, b) in m.bearings.iter().enumerate() {
+            let id = b.neighbour;
+            in_order = in_order && slots.next().is_some_and(|n| n.id == id);
+            if !in_order {
+                if self.slot(id).is_none() {
+                    return Err(MeasurementError::UnknownNeighbour(id));
+                }
+                if m.bearings.iter().take(i).any(|o| o.neighbour == id) {
+                    return Err(MeasurementError::DuplicateBearing(id));
+                }
+            }
+            // A unit vector within a finite tolerance is finite (NaN and ∞ fail the
+            // comparison): no separate finiteness check.
+            let s = &b.bearing;
+            let unit = (s.dot(s) - T::one()).abs() <= tol;
+            if !unit || !b.rate.as_ref().is_none_or(finite_vec) {
+                return Err(MeasurementError::BadBearing(id));
+            }
+            if let Some(r) = b.range {
+                if !(r.finite() && r > T::zero()) {
+                    return Err(MeasurementError::BadRange(id));
+                }
+            }
+        }
+        Ok(in_order)
+    }
+
+    /// Stores a checked bearing of this tick and its rate; `dt` is the time since the last
+    /// aging of `bearing_age` (zero if already aged).
+    #[inline(always)]
+    fn take_bearing(n: &mut Neighbour<T, MT>, b: &BearingMeasurement<T>, dt: T) {
+        let interval = n.bearing_age + dt;
+        n.rate = match b.rate {
+            Some(rate) => rate,
+            // Finite difference of successive bearings (SPEC §2), over the time since the
+            // previous bearing (a missed tick widens the interval). Without a previous
+            // bearing the interval is −∞.
+            None if interval > T::zero() => (b.bearing - n.s) / interval,
+            None => Vec2::zeros(),
+        };
+        n.bearing = Some(b.bearing);
+        n.s = b.bearing;
+        n.bearing_age = T::zero();
+        n.range = b.range;
+        n.fresh = true;
     }
 
     // ---------------------------------------------------------------- control law
@@ -747,25 +841,27 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// One control tick: [`Agent::sense`], [`Agent::evaluate`], integrate the owned
     /// estimates (sampled S10), saturate. On any fault the output is the documented safe
     /// command `U = −safe_damping · v` (no formation force) and the estimates hold still.
+    ///
+    /// In shared mode with everything present (the usual tick) this runs a fused version
+    /// of evaluate-and-integrate (`control_shared`, same arithmetic); anything else, and
+    /// every fault, goes through [`Agent::evaluate`], which names the fault.
     pub fn step(&mut self, m: &Measurements<'_, T>) -> StepOutput<T> {
         let limit = self.config.limits.max_force;
-        let result = self.sense(m).and_then(|()| self.evaluate());
+        let result = match self.sense_ready(m) {
+            Err(fault) => Err(fault),
+            Ok(ready) => match ready.then(|| self.control_shared(m.dt)).flatten() {
+                Some(out) => Ok(out),
+                None => self.control_reference(m.dt),
+            },
+        };
         match result {
-            Ok(ev) => {
-                let r_min = self.config.min_estimate;
-                for (tri, rates) in self.angles.iter_mut().zip(ev.estimate_rates.iter()) {
-                    for (a, ar) in tri.iter_mut().zip(rates.iter()) {
-                        for (est, rate) in a.estimate.iter_mut().zip(ar.iter()) {
-                            *est = law::estimator_step(*est, *rate, m.dt, r_min);
-                        }
-                    }
-                }
-                let (force, saturated) = law::saturate(&ev.force, limit);
+            Ok((force, degenerate)) => {
+                let (force, saturated) = law::saturate(&force, limit);
                 StepOutput {
                     force,
                     status: Status::Nominal,
                     saturated,
-                    degenerate: ev.degenerate,
+                    degenerate,
                 }
             }
             Err(fault) => {
@@ -784,6 +880,118 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 }
             }
         }
+    }
+
+    /// [`Agent::evaluate`], then the owned estimates integrated over `dt` (sampled S10).
+    /// Returns the unsaturated force and `degenerate`.
+    fn control_reference(&mut self, dt: T) -> Result<(Vec2<T>, bool), Fault> {
+        let ev = self.evaluate()?;
+        let r_min = self.config.min_estimate;
+        for (tri, rates) in self.angles.iter_mut().zip(ev.estimate_rates.iter()) {
+            for (a, ar) in tri.iter_mut().zip(rates.iter()) {
+                for (est, rate) in a.estimate.iter_mut().zip(ar.iter()) {
+                    *est = law::estimator_step(*est, *rate, dt, r_min);
+                }
+            }
+        }
+        Ok((ev.force, ev.degenerate))
+    }
+
+    /// Shared mode: the control law S4–S12 and the sampled estimators S9/S10 in one pass,
+    /// with the same arithmetic as [`Agent::evaluate`] followed by the integration of
+    /// `control_reference`. Call only when `sense_ready` said ready (fresh neighbours with
+    /// velocities and bearings). Returns the unsaturated force and `degenerate`; `None`,
+    /// with the estimates unchanged, when something else is missing (remote data, partner
+    /// offset) or the force is not finite: the caller then takes the reference path,
+    /// which reports the fault.
+    fn control_shared(&mut self, dt: T) -> Option<(Vec2<T>, bool)> {
+        let c = &self.config;
+        if c.estimator != EstimatorMode::Shared {
+            return None;
+        }
+        let v = self.velocity;
+        let v_star = vec2(c.velocity_reference.at(self.time));
+        // S12.
+        let mut force = law::velocity_force(&c.friction, &c.velocity_damping, &v, &v_star);
+        let (margin, r_min) = (c.limits.margin_cos, c.min_estimate);
+        let nbs = &self.neighbours;
+        let mut ok = true;
+        let mut degenerate = false;
+        for tri in self.angles.iter_mut() {
+            for a in tri.iter_mut() {
+                if a.role == Role::Apex {
+                    a.estimate_before = a.estimate;
+                    let (Some(nv), Some(nw)) = (nbs.get(a.slots[1]), nbs.get(a.slots[2])) else {
+                        ok = false;
+                        continue;
+                    };
+                    let s = [nv.s, nw.s];
+                    // S4–S6 from the own bearings and rates.
+                    let geo = AngleGeometry::new(&s, &[nv.rate, nw.rate]);
+                    degenerate |= geo.y.abs() > margin;
+                    // S7.
+                    let gamma =
+                        law::port_effort(a.stiffness, a.damping, geo.y - a.cos_desired, geo.y_dot);
+                    let r = a.estimate;
+                    // S8 on the apex.
+                    force += law::apex_force(gamma, &geo.g, r);
+                    // S9 (S3 for ṙ, share t_{α,e}), projected (S10), sampled S10.
+                    let gain = a.estimator_gain;
+                    let next = |s_e: &Vec2<T>, v_far: Option<Vec2<T>>, t_e: T, r_e: T| {
+                        let rr = crate::geometry::range_rate(s_e, &(v_far.unwrap_or(v) - v));
+                        let flow = law::estimator_rate(rr, gamma, t_e, gain, r_e);
+                        law::estimator_step(r_e, law::projected_rate(r_e, flow, r_min), dt, r_min)
+                    };
+                    a.estimate = [
+                        next(&s[0], nv.velocity, geo.t[0], r[0]),
+                        next(&s[1], nw.velocity, geo.t[1], r[1]),
+                    ];
+                } else {
+                    let (Some(nu), Some((s_j, d_j)), Some(r_k)) =
+                        (nbs.get(a.slots[0]), a.remote_bearing, a.remote_estimate)
+                    else {
+                        ok = false;
+                        continue;
+                    };
+                    // s_uk = −s_ku, ṡ_uk = −ṡ_ku (SPEC §2); S4–S6 with this agent's edge
+                    // first (the order of the two edges does not change y, ẏ or g_k).
+                    let geo = AngleGeometry::new(&[-nu.s, s_j], &[-nu.rate, d_j]);
+                    degenerate |= geo.y.abs() > margin;
+                    // S7.
+                    let gamma =
+                        law::port_effort(a.stiffness, a.damping, geo.y - a.cos_desired, geo.y_dot);
+                    // S8 on this far vertex, with the apex's estimate of its edge.
+                    force += law::far_vertex_force(gamma, &geo.g[0], r_k);
+                }
+            }
+        }
+        if let Some(l) = &c.leader {
+            // S11 with z = q_a − q_b.
+            match (
+                self.partner_offset,
+                self.neighbour_velocity(self.partner_slot),
+            ) {
+                (Some(p), Ok(v_p)) => {
+                    let z_star = vec2(l.displacement.at(self.time));
+                    let (z, z_dot, sign) = match l.role {
+                        LeaderRole::A => (-p, v - v_p, T::one()),
+                        LeaderRole::B => (p, v_p - v, -T::one()),
+                    };
+                    force +=
+                        law::leader_force(l.stiffness, &l.damping, &(z - z_star), &z_dot) * sign;
+                }
+                _ => ok = false,
+            }
+        }
+        if ok && finite_vec(&force) {
+            return Some((force, degenerate));
+        }
+        for a in self.angles.iter_mut().flatten() {
+            if a.role == Role::Apex {
+                a.estimate = a.estimate_before;
+            }
+        }
+        None
     }
 
     // ---------------------------------------------------------------- estimates
