@@ -84,16 +84,14 @@ impl<T: Real> Schedule<T> {
 
     /// The value at time `t`.
     pub fn at(&self, t: T) -> [T; 2] {
-        let mut value = match self.steps.first() {
+        // The last step (in order) that has started, else the first.
+        match self.steps.iter().rev().find(|s| s.from <= t) {
             Some(s) => s.value,
-            None => [T::zero(); 2],
-        };
-        for s in &self.steps {
-            if s.from <= t {
-                value = s.value;
-            }
+            None => match self.steps.first() {
+                Some(s) => s.value,
+                None => [T::zero(); 2],
+            },
         }
-        value
     }
 }
 

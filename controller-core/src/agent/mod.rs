@@ -219,9 +219,6 @@ struct Neighbour<T: Real, const MT: usize> {
     in_triangle: bool,
     /// Some triangle neighbour needs this agent's bearing to it (far vertex of own apex angle).
     bearing_needed: bool,
-    /// The shared-mode step needs its velocity: far vertex of an own apex angle (S9) or
-    /// the leader partner (S11).
-    velocity_needed: bool,
     heard: bool,
     age: T,
     last_seq: Option<u16>,
@@ -258,8 +255,19 @@ pub struct Agent<T: Real, const MT: usize, const NB: usize> {
     stats: FrameStats,
 }
 
+/// Neither NaN nor infinite, in two float operations: `x − x` is 0 exactly for finite `x`
+/// and NaN otherwise (cheaper on the FPU than the bit tests of `is_finite`).
+#[inline(always)]
+#[allow(clippy::eq_op)] // `x − x` on purpose: NaN for NaN and ±∞.
+fn finite<T: Real>(x: T) -> bool {
+    x - x == T::zero()
+}
+
+/// Both components finite (see [`finite`]): `(x − x) + (y − y)` is 0 or NaN.
+#[inline(always)]
+#[allow(clippy::eq_op)] // See `finite`.
 fn finite_vec<T: Real>(v: &Vec2<T>) -> bool {
-    v.x.finite() && v.y.finite()
+    (v.x - v.x) + (v.y - v.y) == T::zero()
 }
 
 fn finite_pair<T: Real>(v: &[T; 2], min: T) -> bool {
@@ -327,7 +335,6 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     for &s in &slots[1..] {
                         if let Some(n) = neighbours.get_mut(s) {
                             n.bearing_needed = true;
-                            n.velocity_needed = true;
                         }
                     }
                 } else if let Some(n) = neighbours.get_mut(slots[0]) {
@@ -365,9 +372,6 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             Some(l) => Self::add_neighbour(&mut neighbours, l.partner, false)?,
             None => SELF_SLOT,
         };
-        if let Some(n) = neighbours.get_mut(partner_slot) {
-            n.velocity_needed = true;
-        }
         let bearings_needed = neighbours
             .iter()
             .rposition(|n| n.in_triangle)
@@ -481,7 +485,6 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             apex_of: heapless::Vec::new(),
             in_triangle,
             bearing_needed: false,
-            velocity_needed: false,
             heard: false,
             // Never heard: infinitely old (so `age <= timeout` alone means heard recently).
             age: T::lit(f64::INFINITY),
@@ -531,13 +534,12 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         self.sense_ready(m).map(|_| ())
     }
 
-    /// [`Agent::sense`], also telling whether the neighbour table holds everything the
-    /// shared-mode step needs from it: every neighbour heard within the timeout (see
-    /// [`Agent::check_fresh`]), with its velocity where needed, and a bearing to every
-    /// triangle neighbour this tick.
+    /// [`Agent::sense`], also telling whether every neighbour was heard within the timeout
+    /// (see [`Agent::check_fresh`]) and there is a bearing to every triangle neighbour this
+    /// tick (what the shared-mode step needs from sensing).
     fn sense_ready(&mut self, m: &Measurements<'_, T>) -> Result<bool, Fault> {
         let dt = m.dt;
-        if !(dt.finite() && dt >= T::zero()) {
+        if !(finite(dt) && dt >= T::zero()) {
             return Err(Fault::Measurement(MeasurementError::NonFinite));
         }
         // The checks read nothing that aging changes: age after them.
@@ -554,15 +556,18 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         self.time = m.time;
         self.velocity = m.velocity;
         self.partner_offset = m.partner_offset;
-        let timeout = self.config.limits.neighbour_timeout;
-        let mut ready = true;
+        // The oldest neighbour (NaN ignored, as in `check_fresh`).
+        let mut age_max = T::zero();
+        let ready;
         if in_order {
             // Bearing i is to slot i: one pass. Triangle neighbours are the first slots.
-            ready &= m.bearings.len() >= self.bearings_needed;
+            ready = m.bearings.len() >= self.bearings_needed;
             let mut bearings = m.bearings.iter();
             for n in self.neighbours.iter_mut() {
                 n.age += dt;
-                ready &= Self::heard_with_velocity(n, timeout);
+                if n.age > age_max {
+                    age_max = n.age;
+                }
                 match bearings.next() {
                     Some(b) => Self::take_bearing(n, b, dt),
                     None => {
@@ -584,25 +589,23 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     Self::take_bearing(n, b, T::zero());
                 }
             }
+            let mut all = true;
             for n in &self.neighbours {
-                ready &= Self::heard_with_velocity(n, timeout) & (n.fresh | !n.in_triangle);
+                if n.age > age_max {
+                    age_max = n.age;
+                }
+                all &= n.fresh | !n.in_triangle;
             }
+            ready = all;
         }
-        Ok(ready)
-    }
-
-    /// Heard within `timeout` (not stale, see [`Agent::check_fresh`]) and, if the
-    /// shared-mode step needs it, with a velocity.
-    #[inline(always)]
-    fn heard_with_velocity(n: &Neighbour<T, MT>, timeout: T) -> bool {
-        // `age` is ∞ until first heard: no need to read `heard`.
-        (n.age <= timeout) & (n.velocity.is_some() | !n.velocity_needed)
+        // `age` is ∞ until first heard: no need to read `heard`. (`age_max` is not NaN.)
+        Ok(ready && age_max <= self.config.limits.neighbour_timeout)
     }
 
     /// Checks the own measurements (the faults of [`Agent::sense`] after `dt`, in the same
     /// order). Returns whether bearing `i` is to neighbour slot `i` for every `i`.
     fn check_measurements(&self, m: &Measurements<'_, T>) -> Result<bool, MeasurementError> {
-        if !(m.time.finite() && finite_vec(&m.velocity)) {
+        if !(finite(m.time) && finite_vec(&m.velocity)) {
             return Err(MeasurementError::NonFinite);
         }
         if let Some(p) = &m.partner_offset {
@@ -611,8 +614,17 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             }
         }
         let tol = self.config.limits.bearing_tolerance;
-        // While bearing i is to slot i, the bearings are known and distinct without
-        // searching (neighbour ids are unique). What the firmware sends.
+        // Usual case (what the firmware sends): bearing i is to slot i, so the bearings are
+        // known and distinct without searching (neighbour ids are unique), and all valid.
+        if m.bearings.len() <= self.neighbours.len()
+            && m.bearings
+                .iter()
+                .zip(&self.neighbours)
+                .all(|(b, n)| b.neighbour == n.id && Self::bearing_error(b, tol).is_none())
+        {
+            return Ok(true);
+        }
+        // Otherwise the first error in order, as the search finds it.
         let mut in_order = true;
         let mut slots = self.neighbours.iter();
         for (i, b) in m.bearings.iter().enumerate() {
@@ -626,20 +638,29 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     return Err(MeasurementError::DuplicateBearing(id));
                 }
             }
-            // A unit vector within a finite tolerance is finite (NaN and ∞ fail the
-            // comparison): no separate finiteness check.
-            let s = &b.bearing;
-            let unit = (s.dot(s) - T::one()).abs() <= tol;
-            if !unit || !b.rate.as_ref().is_none_or(finite_vec) {
-                return Err(MeasurementError::BadBearing(id));
-            }
-            if let Some(r) = b.range {
-                if !(r.finite() && r > T::zero()) {
-                    return Err(MeasurementError::BadRange(id));
-                }
+            if let Some(e) = Self::bearing_error(b, tol) {
+                return Err(e);
             }
         }
         Ok(in_order)
+    }
+
+    /// What is wrong with one bearing measurement itself, if anything (neighbour aside).
+    #[inline(always)]
+    fn bearing_error(b: &BearingMeasurement<T>, tol: T) -> Option<MeasurementError> {
+        // A unit vector within a finite tolerance is finite (NaN and ∞ fail the
+        // comparison): no separate finiteness check.
+        let s = &b.bearing;
+        let unit = (s.dot(s) - T::one()).abs() <= tol;
+        if !unit || !b.rate.as_ref().is_none_or(finite_vec) {
+            return Some(MeasurementError::BadBearing(b.neighbour));
+        }
+        match b.range {
+            Some(r) if !(finite(r) && r > T::zero()) => {
+                Some(MeasurementError::BadRange(b.neighbour))
+            }
+            _ => None,
+        }
     }
 
     /// Stores a checked bearing of this tick and its rate; `dt` is the time since the last
@@ -913,10 +934,11 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         let v_star = vec2(c.velocity_reference.at(self.time));
         // S12.
         let mut force = law::velocity_force(&c.friction, &c.velocity_damping, &v, &v_star);
-        let (margin, r_min) = (c.limits.margin_cos, c.min_estimate);
+        let r_min = c.min_estimate;
         let nbs = &self.neighbours;
         let mut ok = true;
-        let mut degenerate = false;
+        // Largest |y| (NaN ignored, as in `|y| > margin`): degenerate iff above the margin.
+        let mut y_max = T::zero();
         for tri in self.angles.iter_mut() {
             for a in tri.iter_mut() {
                 if a.role == Role::Apex {
@@ -928,23 +950,36 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     let s = [nv.s, nw.s];
                     // S4–S6 from the own bearings and rates.
                     let geo = AngleGeometry::new(&s, &[nv.rate, nw.rate]);
-                    degenerate |= geo.y.abs() > margin;
+                    let y_abs = geo.y.abs();
+                    if y_abs > y_max {
+                        y_max = y_abs;
+                    }
                     // S7.
                     let gamma =
                         law::port_effort(a.stiffness, a.damping, geo.y - a.cos_desired, geo.y_dot);
                     let r = a.estimate;
                     // S8 on the apex.
                     force += law::apex_force(gamma, &geo.g, r);
-                    // S9 (S3 for ṙ, share t_{α,e}), projected (S10), sampled S10.
+                    // S9 (S3 for ṙ, share t_{α,e}), then the sampled S10
+                    // `max(r_min, r̂ + Δt·S9)`. The continuous S10 projection that
+                    // `evaluate` applies first changes nothing here: it only acts when
+                    // r̂ ≤ r_min and S9 < 0, and then (Δt ≥ 0) both give r_min.
                     let gain = a.estimator_gain;
-                    let next = |s_e: &Vec2<T>, v_far: Option<Vec2<T>>, t_e: T, r_e: T| {
-                        let rr = crate::geometry::range_rate(s_e, &(v_far.unwrap_or(v) - v));
+                    let mut next = |s_e: &Vec2<T>, v_far: &Option<Vec2<T>>, t_e: T, r_e: T| {
+                        let v_far = match v_far {
+                            Some(x) => *x,
+                            None => {
+                                ok = false;
+                                v
+                            }
+                        };
+                        let rr = crate::geometry::range_rate(s_e, &(v_far - v));
                         let flow = law::estimator_rate(rr, gamma, t_e, gain, r_e);
-                        law::estimator_step(r_e, law::projected_rate(r_e, flow, r_min), dt, r_min)
+                        law::estimator_step(r_e, flow, dt, r_min)
                     };
                     a.estimate = [
-                        next(&s[0], nv.velocity, geo.t[0], r[0]),
-                        next(&s[1], nw.velocity, geo.t[1], r[1]),
+                        next(&s[0], &nv.velocity, geo.t[0], r[0]),
+                        next(&s[1], &nw.velocity, geo.t[1], r[1]),
                     ];
                 } else {
                     let (Some(nu), Some((s_j, d_j)), Some(r_k)) =
@@ -956,7 +991,10 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     // s_uk = −s_ku, ṡ_uk = −ṡ_ku (SPEC §2); S4–S6 with this agent's edge
                     // first (the order of the two edges does not change y, ẏ or g_k).
                     let geo = AngleGeometry::new(&[-nu.s, s_j], &[-nu.rate, d_j]);
-                    degenerate |= geo.y.abs() > margin;
+                    let y_abs = geo.y.abs();
+                    if y_abs > y_max {
+                        y_max = y_abs;
+                    }
                     // S7.
                     let gamma =
                         law::port_effort(a.stiffness, a.damping, geo.y - a.cos_desired, geo.y_dot);
@@ -984,7 +1022,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             }
         }
         if ok && finite_vec(&force) {
-            return Some((force, degenerate));
+            return Some((force, y_max > c.limits.margin_cos));
         }
         for a in self.angles.iter_mut().flatten() {
             if a.role == Role::Apex {
