@@ -85,13 +85,16 @@ impl<T: Real> Schedule<T> {
     /// The value at time `t`.
     pub fn at(&self, t: T) -> [T; 2] {
         // The last step (in order) that has started, else the first.
-        match self.steps.iter().rev().find(|s| s.from <= t) {
-            Some(s) => s.value,
-            None => match self.steps.first() {
-                Some(s) => s.value,
-                None => [T::zero(); 2],
-            },
+        let Some((first, rest)) = self.steps.split_first() else {
+            return [T::zero(); 2];
+        };
+        let mut value = first.value;
+        for s in rest {
+            if s.from <= t {
+                value = s.value;
+            }
         }
+        value
     }
 }
 

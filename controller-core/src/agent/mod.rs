@@ -905,6 +905,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
 
     /// [`Agent::evaluate`], then the owned estimates integrated over `dt` (sampled S10).
     /// Returns the unsaturated force and `degenerate`.
+    #[inline(never)]
     fn control_reference(&mut self, dt: T) -> Result<(Vec2<T>, bool), Fault> {
         let ev = self.evaluate()?;
         let r_min = self.config.min_estimate;
@@ -935,72 +936,67 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         // S12.
         let mut force = law::velocity_force(&c.friction, &c.velocity_damping, &v, &v_star);
         let r_min = c.min_estimate;
-        let nbs = &self.neighbours;
+        let nbs = self.neighbours.as_slice();
         let mut ok = true;
         // Largest |y| (NaN ignored, as in `|y| > margin`): degenerate iff above the margin.
         let mut y_max = T::zero();
-        for tri in self.angles.iter_mut() {
-            for a in tri.iter_mut() {
-                if a.role == Role::Apex {
-                    a.estimate_before = a.estimate;
-                    let (Some(nv), Some(nw)) = (nbs.get(a.slots[1]), nbs.get(a.slots[2])) else {
-                        ok = false;
-                        continue;
-                    };
-                    let s = [nv.s, nw.s];
-                    // S4–S6 from the own bearings and rates.
-                    let geo = AngleGeometry::new(&s, &[nv.rate, nw.rate]);
-                    let y_abs = geo.y.abs();
-                    if y_abs > y_max {
-                        y_max = y_abs;
-                    }
-                    // S7.
-                    let gamma =
-                        law::port_effort(a.stiffness, a.damping, geo.y - a.cos_desired, geo.y_dot);
-                    let r = a.estimate;
-                    // S8 on the apex.
-                    force += law::apex_force(gamma, &geo.g, r);
-                    // S9 (S3 for ṙ, share t_{α,e}), then the sampled S10
-                    // `max(r_min, r̂ + Δt·S9)`. The continuous S10 projection that
-                    // `evaluate` applies first changes nothing here: it only acts when
-                    // r̂ ≤ r_min and S9 < 0, and then (Δt ≥ 0) both give r_min.
-                    let gain = a.estimator_gain;
-                    let mut next = |s_e: &Vec2<T>, v_far: &Option<Vec2<T>>, t_e: T, r_e: T| {
-                        let v_far = match v_far {
-                            Some(x) => *x,
-                            None => {
-                                ok = false;
-                                v
-                            }
-                        };
-                        let rr = crate::geometry::range_rate(s_e, &(v_far - v));
-                        let flow = law::estimator_rate(rr, gamma, t_e, gain, r_e);
-                        law::estimator_step(r_e, flow, dt, r_min)
-                    };
-                    a.estimate = [
-                        next(&s[0], &nv.velocity, geo.t[0], r[0]),
-                        next(&s[1], &nw.velocity, geo.t[1], r[1]),
-                    ];
-                } else {
-                    let (Some(nu), Some((s_j, d_j)), Some(r_k)) =
-                        (nbs.get(a.slots[0]), a.remote_bearing, a.remote_estimate)
-                    else {
-                        ok = false;
-                        continue;
-                    };
-                    // s_uk = −s_ku, ṡ_uk = −ṡ_ku (SPEC §2); S4–S6 with this agent's edge
-                    // first (the order of the two edges does not change y, ẏ or g_k).
-                    let geo = AngleGeometry::new(&[-nu.s, s_j], &[-nu.rate, d_j]);
-                    let y_abs = geo.y.abs();
-                    if y_abs > y_max {
-                        y_max = y_abs;
-                    }
-                    // S7.
-                    let gamma =
-                        law::port_effort(a.stiffness, a.damping, geo.y - a.cos_desired, geo.y_dot);
-                    // S8 on this far vertex, with the apex's estimate of its edge.
-                    force += law::far_vertex_force(gamma, &geo.g[0], r_k);
+        for a in self.angles.as_mut_slice().as_flattened_mut() {
+            if a.role == Role::Apex {
+                a.estimate_before = a.estimate;
+                let (Some(nv), Some(nw)) = (nbs.get(a.slots[1]), nbs.get(a.slots[2])) else {
+                    ok = false;
+                    continue;
+                };
+                let s = [nv.s, nw.s];
+                // S4–S6 from the own bearings and rates.
+                let geo = AngleGeometry::new(&s, &[nv.rate, nw.rate]);
+                let y_abs = geo.y.abs();
+                if y_abs > y_max {
+                    y_max = y_abs;
                 }
+                // S7.
+                let gamma =
+                    law::port_effort(a.stiffness, a.damping, geo.y - a.cos_desired, geo.y_dot);
+                let r = a.estimate;
+                // S8 on the apex.
+                force += law::apex_force(gamma, &geo.g, r);
+                // S9 (S3 for ṙ, share t_{α,e}), then the sampled S10
+                // `max(r_min, r̂ + Δt·S9)`. The continuous S10 projection that
+                // `evaluate` applies first changes nothing here: it only acts when
+                // r̂ ≤ r_min and S9 < 0, and then (Δt ≥ 0) both give r_min.
+                let gain = a.estimator_gain;
+                let mut next = |s_e: &Vec2<T>, v_far: &Option<Vec2<T>>, t_e: T, r_e: T| {
+                    let Some(v_far) = v_far else {
+                        ok = false;
+                        return r_e;
+                    };
+                    let rr = crate::geometry::range_rate(s_e, &(v_far - v));
+                    let flow = law::estimator_rate(rr, gamma, t_e, gain, r_e);
+                    law::estimator_step(r_e, flow, dt, r_min)
+                };
+                a.estimate = [
+                    next(&s[0], &nv.velocity, geo.t[0], r[0]),
+                    next(&s[1], &nw.velocity, geo.t[1], r[1]),
+                ];
+            } else {
+                let (Some(nu), Some((s_j, d_j)), Some(r_k)) =
+                    (nbs.get(a.slots[0]), a.remote_bearing, a.remote_estimate)
+                else {
+                    ok = false;
+                    continue;
+                };
+                // s_uk = −s_ku, ṡ_uk = −ṡ_ku (SPEC §2); S4–S6 with this agent's edge
+                // first (the order of the two edges does not change y, ẏ or g_k).
+                let geo = AngleGeometry::new(&[-nu.s, s_j], &[-nu.rate, d_j]);
+                let y_abs = geo.y.abs();
+                if y_abs > y_max {
+                    y_max = y_abs;
+                }
+                // S7.
+                let gamma =
+                    law::port_effort(a.stiffness, a.damping, geo.y - a.cos_desired, geo.y_dot);
+                // S8 on this far vertex, with the apex's estimate of its edge.
+                force += law::far_vertex_force(gamma, &geo.g[0], r_k);
             }
         }
         if let Some(l) = &c.leader {
@@ -1011,12 +1007,25 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             ) {
                 (Some(p), Ok(v_p)) => {
                     let z_star = vec2(l.displacement.at(self.time));
-                    let (z, z_dot, sign) = match l.role {
-                        LeaderRole::A => (-p, v - v_p, T::one()),
-                        LeaderRole::B => (p, v_p - v, -T::one()),
-                    };
-                    force +=
-                        law::leader_force(l.stiffness, &l.damping, &(z - z_star), &z_dot) * sign;
+                    // Agent b gets the negation (exactly what `evaluate`'s `* −1` gives).
+                    match l.role {
+                        LeaderRole::A => {
+                            force += law::leader_force(
+                                l.stiffness,
+                                &l.damping,
+                                &(-p - z_star),
+                                &(v - v_p),
+                            );
+                        }
+                        LeaderRole::B => {
+                            force -= law::leader_force(
+                                l.stiffness,
+                                &l.damping,
+                                &(p - z_star),
+                                &(v_p - v),
+                            );
+                        }
+                    }
                 }
                 _ => ok = false,
             }
@@ -1024,7 +1033,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         if ok && finite_vec(&force) {
             return Some((force, y_max > c.limits.margin_cos));
         }
-        for a in self.angles.iter_mut().flatten() {
+        for a in self.angles.as_mut_slice().as_flattened_mut() {
             if a.role == Role::Apex {
                 a.estimate = a.estimate_before;
             }
