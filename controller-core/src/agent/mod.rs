@@ -578,25 +578,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 }
             }
         } else {
-            for n in self.neighbours.iter_mut() {
-                n.age += dt;
-                n.bearing_age += dt;
-                n.fresh = false;
-                n.range = None;
-            }
-            for b in m.bearings {
-                if let Some(n) = self.neighbours.iter_mut().find(|n| n.id == b.neighbour) {
-                    Self::take_bearing(n, b, T::zero());
-                }
-            }
-            let mut all = true;
-            for n in &self.neighbours {
-                if n.age > age_max {
-                    age_max = n.age;
-                }
-                all &= n.fresh | !n.in_triangle;
-            }
-            ready = all;
+            (ready, age_max) = self.take_bearings_searched(m.bearings, dt);
         }
         // `age` is ∞ until first heard: no need to read `heard`. (`age_max` is not NaN.)
         Ok(ready && age_max <= self.config.limits.neighbour_timeout)
@@ -624,17 +606,28 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         {
             return Ok(true);
         }
-        // Otherwise the first error in order, as the search finds it.
+        self.check_bearings_in_order(m.bearings, tol)
+    }
+
+    /// The bearing checks in general (any order): the first error in order, as the search
+    /// finds it, or whether bearing `i` is to slot `i` for every `i`.
+    #[cold]
+    #[inline(never)]
+    fn check_bearings_in_order(
+        &self,
+        bearings: &[BearingMeasurement<T>],
+        tol: T,
+    ) -> Result<bool, MeasurementError> {
         let mut in_order = true;
         let mut slots = self.neighbours.iter();
-        for (i, b) in m.bearings.iter().enumerate() {
+        for (i, b) in bearings.iter().enumerate() {
             let id = b.neighbour;
             in_order = in_order && slots.next().is_some_and(|n| n.id == id);
             if !in_order {
                 if self.slot(id).is_none() {
                     return Err(MeasurementError::UnknownNeighbour(id));
                 }
-                if m.bearings.iter().take(i).any(|o| o.neighbour == id) {
+                if bearings.iter().take(i).any(|o| o.neighbour == id) {
                     return Err(MeasurementError::DuplicateBearing(id));
                 }
             }
@@ -661,6 +654,33 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             }
             _ => None,
         }
+    }
+
+    /// Ages the neighbour table and stores checked bearings in any order (searching their
+    /// slots). Returns whether every triangle neighbour got a bearing, and the largest age.
+    #[cold]
+    #[inline(never)]
+    fn take_bearings_searched(&mut self, bearings: &[BearingMeasurement<T>], dt: T) -> (bool, T) {
+        for n in self.neighbours.iter_mut() {
+            n.age += dt;
+            n.bearing_age += dt;
+            n.fresh = false;
+            n.range = None;
+        }
+        for b in bearings {
+            if let Some(n) = self.neighbours.iter_mut().find(|n| n.id == b.neighbour) {
+                Self::take_bearing(n, b, T::zero());
+            }
+        }
+        let mut all = true;
+        let mut age_max = T::zero();
+        for n in &self.neighbours {
+            if n.age > age_max {
+                age_max = n.age;
+            }
+            all &= n.fresh | !n.in_triangle;
+        }
+        (all, age_max)
     }
 
     /// Stores a checked bearing of this tick and its rate; `dt` is the time since the last
