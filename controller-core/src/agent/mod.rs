@@ -656,31 +656,39 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         }
     }
 
-    /// Ages the neighbour table and stores checked bearings in any order (searching their
-    /// slots). Returns whether every triangle neighbour got a bearing, and the largest age.
+    /// Ages the neighbour table and stores checked bearings in any order (at most one per
+    /// neighbour, so taking each slot's bearing is taking each bearing in turn). Returns
+    /// whether every triangle neighbour got a bearing, and the largest age.
     #[cold]
     #[inline(never)]
     fn take_bearings_searched(&mut self, bearings: &[BearingMeasurement<T>], dt: T) -> (bool, T) {
+        let mut covered = true;
+        let mut age_max = T::zero();
         for n in self.neighbours.iter_mut() {
             n.age += dt;
-            n.bearing_age += dt;
-            n.fresh = false;
-            n.range = None;
-        }
-        for b in bearings {
-            if let Some(n) = self.neighbours.iter_mut().find(|n| n.id == b.neighbour) {
-                Self::take_bearing(n, b, T::zero());
-            }
-        }
-        let mut all = true;
-        let mut age_max = T::zero();
-        for n in &self.neighbours {
             if n.age > age_max {
                 age_max = n.age;
             }
-            all &= n.fresh | !n.in_triangle;
+            match Self::bearing_to(bearings, n.id) {
+                Some(b) => Self::take_bearing(n, b, dt),
+                None => {
+                    n.bearing_age += dt;
+                    n.fresh = false;
+                    n.range = None;
+                    covered &= !n.in_triangle;
+                }
+            }
         }
-        (all, age_max)
+        (covered, age_max)
+    }
+
+    /// The bearing to neighbour `id`, if any.
+    #[inline(never)]
+    fn bearing_to(
+        bearings: &[BearingMeasurement<T>],
+        id: AgentId,
+    ) -> Option<&BearingMeasurement<T>> {
+        bearings.iter().find(|b| b.neighbour == id)
     }
 
     /// Stores a checked bearing of this tick and its rate; `dt` is the time since the last
