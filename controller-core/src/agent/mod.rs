@@ -933,7 +933,6 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
 
     /// [`Agent::evaluate`], then the owned estimates integrated over `dt` (sampled S10).
     /// Returns the unsaturated force and `degenerate`.
-    #[inline(never)]
     fn control_reference(&mut self, dt: T) -> Result<(Vec2<T>, bool), Fault> {
         let ev = self.evaluate()?;
         let r_min = self.config.min_estimate;
