@@ -948,11 +948,12 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
 
     /// Shared mode: the control law S4–S12 and the sampled estimators S9/S10 in one pass,
     /// with the same arithmetic as [`Agent::evaluate`] followed by the integration of
-    /// `control_reference`. Call only when `sense_ready` said ready (fresh neighbours with
-    /// velocities and bearings). Returns the unsaturated force and `degenerate`; `None`,
-    /// with the estimates unchanged, when something else is missing (remote data, partner
-    /// offset) or the force is not finite: the caller then takes the reference path,
-    /// which reports the fault.
+    /// `control_reference`. Call only when `sense_ready` said ready (every neighbour heard
+    /// within the timeout, a bearing to every triangle neighbour). Returns the unsaturated
+    /// force and `degenerate`; `None`, with the estimates unchanged, when something else is
+    /// missing (a velocity, the apex's bearing or estimate, the partner offset) or the
+    /// force is not finite: the caller then takes the reference path, which reports the
+    /// fault.
     fn control_shared(&mut self, dt: T) -> Option<(Vec2<T>, bool)> {
         let c = &self.config;
         if c.estimator != EstimatorMode::Shared {
