@@ -84,11 +84,12 @@ impl<T: Real> Schedule<T> {
 
     /// The value at time `t`.
     pub fn at(&self, t: T) -> [T; 2] {
-        let mut value = match self.steps.first() {
-            Some(s) => s.value,
-            None => [T::zero(); 2],
+        // The last step (in order) that has started, else the first.
+        let Some((first, rest)) = self.steps.split_first() else {
+            return [T::zero(); 2];
         };
-        for s in &self.steps {
+        let mut value = first.value;
+        for s in rest {
             if s.from <= t {
                 value = s.value;
             }

@@ -205,6 +205,8 @@ struct AngleState<T: Real> {
     remote_bearing: Option<(Vec2<T>, Vec2<T>)>,
     /// Far vertex, shared mode only: the apex's estimate for this agent's edge.
     remote_estimate: Option<T>,
+    /// `estimate` before the fast step changed it (restored if that step fails).
+    estimate_before: [T; 2],
 }
 
 #[derive(Clone, Debug)]
@@ -222,7 +224,10 @@ struct Neighbour<T: Real, const MT: usize> {
     last_seq: Option<u16>,
     velocity: Option<Vec2<T>>,
     bearing: Option<Vec2<T>>,
-    /// Seconds since `bearing` was measured (finite-difference interval).
+    /// The last bearing (`bearing` without the `Option`; zero before the first one).
+    s: Vec2<T>,
+    /// Seconds since `bearing` was measured (finite-difference interval); −∞ while there
+    /// is none.
     bearing_age: T,
     rate: Vec2<T>,
     range: Option<T>,
@@ -240,6 +245,9 @@ pub struct Agent<T: Real, const MT: usize, const NB: usize> {
     angles: heapless::Vec<[AngleState<T>; 2], MT>,
     neighbours: heapless::Vec<Neighbour<T, MT>, NB>,
     partner_slot: usize,
+    /// Neighbour slots `0..bearings_needed` hold every triangle neighbour (they come
+    /// first): the bearings each tick must cover.
+    bearings_needed: usize,
     time: T,
     velocity: Vec2<T>,
     partner_offset: Option<Vec2<T>>,
@@ -247,8 +255,19 @@ pub struct Agent<T: Real, const MT: usize, const NB: usize> {
     stats: FrameStats,
 }
 
+/// Neither NaN nor infinite, in two float operations: `x − x` is 0 exactly for finite `x`
+/// and NaN otherwise (cheaper on the FPU than the bit tests of `is_finite`).
+#[inline(always)]
+#[allow(clippy::eq_op)] // `x − x` on purpose: NaN for NaN and ±∞.
+fn finite<T: Real>(x: T) -> bool {
+    x - x == T::zero()
+}
+
+/// Both components finite (see [`finite`]): `(x − x) + (y − y)` is 0 or NaN.
+#[inline(always)]
+#[allow(clippy::eq_op)] // See `finite`.
 fn finite_vec<T: Real>(v: &Vec2<T>) -> bool {
-    v.x.finite() && v.y.finite()
+    (v.x - v.x) + (v.y - v.y) == T::zero()
 }
 
 fn finite_pair<T: Real>(v: &[T; 2], min: T) -> bool {
@@ -339,6 +358,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                         estimate: [config.initial_estimate; 2],
                         remote_bearing: None,
                         remote_estimate: None,
+                        estimate_before: [config.initial_estimate; 2],
                     });
                 }
             }
@@ -352,11 +372,16 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             Some(l) => Self::add_neighbour(&mut neighbours, l.partner, false)?,
             None => SELF_SLOT,
         };
+        let bearings_needed = neighbours
+            .iter()
+            .rposition(|n| n.in_triangle)
+            .map_or(0, |i| i + 1);
         Ok(Self {
             config,
             angles,
             neighbours,
             partner_slot,
+            bearings_needed,
             time: T::zero(),
             velocity: Vec2::zeros(),
             partner_offset: None,
@@ -461,11 +486,13 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             in_triangle,
             bearing_needed: false,
             heard: false,
-            age: T::zero(),
+            // Never heard: infinitely old (so `age <= timeout` alone means heard recently).
+            age: T::lit(f64::INFINITY),
             last_seq: None,
             velocity: None,
             bearing: None,
-            bearing_age: T::zero(),
+            s: Vec2::zeros(),
+            bearing_age: T::lit(f64::NEG_INFINITY),
             rate: Vec2::zeros(),
             range: None,
             fresh: false,
@@ -504,68 +531,184 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// refused), then checks and stores the own measurements (bearings, rates, velocity,
     /// time). Nothing else changes if they are refused.
     pub fn sense(&mut self, m: &Measurements<'_, T>) -> Result<(), Fault> {
-        let bad = |e| Err(Fault::Measurement(e));
-        if !(m.dt.finite() && m.dt >= T::zero()) {
-            return bad(MeasurementError::NonFinite);
+        self.sense_ready(m).map(|_| ())
+    }
+
+    /// [`Agent::sense`], also telling whether every neighbour was heard within the timeout
+    /// (see [`Agent::check_fresh`]) and there is a bearing to every triangle neighbour this
+    /// tick (what the shared-mode step needs from sensing).
+    fn sense_ready(&mut self, m: &Measurements<'_, T>) -> Result<bool, Fault> {
+        let dt = m.dt;
+        if !(finite(dt) && dt >= T::zero()) {
+            return Err(Fault::Measurement(MeasurementError::NonFinite));
         }
-        for n in self.neighbours.iter_mut() {
-            n.age += m.dt;
-            n.bearing_age += m.dt;
-        }
-        if !(m.time.finite() && finite_vec(&m.velocity)) {
-            return bad(MeasurementError::NonFinite);
-        }
-        if let Some(p) = &m.partner_offset {
-            if !finite_vec(p) {
-                return bad(MeasurementError::NonFinite);
-            }
-        }
-        let tol = self.config.limits.bearing_tolerance;
-        for (i, b) in m.bearings.iter().enumerate() {
-            let id = b.neighbour;
-            if self.slot(id).is_none() {
-                return bad(MeasurementError::UnknownNeighbour(id));
-            }
-            if m.bearings.iter().take(i).any(|o| o.neighbour == id) {
-                return bad(MeasurementError::DuplicateBearing(id));
-            }
-            let s = &b.bearing;
-            let unit = finite_vec(s) && (s.dot(s) - T::one()).abs() <= tol;
-            if !unit || !b.rate.as_ref().is_none_or(finite_vec) {
-                return bad(MeasurementError::BadBearing(id));
-            }
-            if let Some(r) = b.range {
-                if !(r.finite() && r > T::zero()) {
-                    return bad(MeasurementError::BadRange(id));
+        // The checks read nothing that aging changes: age after them.
+        let in_order = match self.check_measurements(m) {
+            Ok(in_order) => in_order,
+            Err(e) => {
+                for n in self.neighbours.iter_mut() {
+                    n.age += dt;
+                    n.bearing_age += dt;
                 }
+                return Err(Fault::Measurement(e));
             }
-        }
+        };
         self.time = m.time;
         self.velocity = m.velocity;
         self.partner_offset = m.partner_offset;
-        for n in self.neighbours.iter_mut() {
-            n.fresh = false;
-            n.range = None;
-        }
-        for b in m.bearings {
-            let Some(n) = self.neighbours.iter_mut().find(|n| n.id == b.neighbour) else {
-                continue;
-            };
-            n.rate = match (b.rate, n.bearing) {
-                (Some(rate), _) => rate,
-                // Finite difference of successive bearings (SPEC §2), over the time
-                // since the previous bearing (a missed tick widens the interval).
-                (None, Some(prev)) if n.bearing_age > T::zero() => {
-                    (b.bearing - prev) / n.bearing_age
+        // The oldest neighbour (NaN ignored, as in `check_fresh`).
+        let mut age_max = T::zero();
+        let ready;
+        if in_order {
+            // Bearing i is to slot i: one pass. Triangle neighbours are the first slots.
+            ready = m.bearings.len() >= self.bearings_needed;
+            let mut bearings = m.bearings.iter();
+            for n in self.neighbours.iter_mut() {
+                n.age += dt;
+                if n.age > age_max {
+                    age_max = n.age;
                 }
-                _ => Vec2::zeros(),
-            };
-            n.bearing = Some(b.bearing);
-            n.bearing_age = T::zero();
-            n.range = b.range;
-            n.fresh = true;
+                match bearings.next() {
+                    Some(b) => Self::take_bearing(n, b, dt),
+                    None => {
+                        n.bearing_age += dt;
+                        n.fresh = false;
+                        n.range = None;
+                    }
+                }
+            }
+        } else {
+            (ready, age_max) = self.take_bearings_searched(m.bearings, dt);
         }
-        Ok(())
+        // `age` is ∞ until first heard: no need to read `heard`. (`age_max` is not NaN.)
+        Ok(ready && age_max <= self.config.limits.neighbour_timeout)
+    }
+
+    /// Checks the own measurements (the faults of [`Agent::sense`] after `dt`, in the same
+    /// order). Returns whether bearing `i` is to neighbour slot `i` for every `i`.
+    fn check_measurements(&self, m: &Measurements<'_, T>) -> Result<bool, MeasurementError> {
+        if !(finite(m.time) && finite_vec(&m.velocity)) {
+            return Err(MeasurementError::NonFinite);
+        }
+        if let Some(p) = &m.partner_offset {
+            if !finite_vec(p) {
+                return Err(MeasurementError::NonFinite);
+            }
+        }
+        let tol = self.config.limits.bearing_tolerance;
+        // Usual case (what the firmware sends): bearing i is to slot i, so the bearings are
+        // known and distinct without searching (neighbour ids are unique), and all valid.
+        if m.bearings.len() <= self.neighbours.len()
+            && m.bearings
+                .iter()
+                .zip(&self.neighbours)
+                .all(|(b, n)| b.neighbour == n.id && Self::bearing_error(b, tol).is_none())
+        {
+            return Ok(true);
+        }
+        self.check_bearings_in_order(m.bearings, tol)
+    }
+
+    /// The bearing checks in general (any order): the first error in order, as the search
+    /// finds it, or whether bearing `i` is to slot `i` for every `i`.
+    #[cold]
+    #[inline(never)]
+    fn check_bearings_in_order(
+        &self,
+        bearings: &[BearingMeasurement<T>],
+        tol: T,
+    ) -> Result<bool, MeasurementError> {
+        let mut in_order = true;
+        let mut slots = self.neighbours.iter();
+        for (i, b) in bearings.iter().enumerate() {
+            let id = b.neighbour;
+            in_order = in_order && slots.next().is_some_and(|n| n.id == id);
+            if !in_order {
+                if self.slot(id).is_none() {
+                    return Err(MeasurementError::UnknownNeighbour(id));
+                }
+                if bearings.iter().take(i).any(|o| o.neighbour == id) {
+                    return Err(MeasurementError::DuplicateBearing(id));
+                }
+            }
+            if let Some(e) = Self::bearing_error(b, tol) {
+                return Err(e);
+            }
+        }
+        Ok(in_order)
+    }
+
+    /// What is wrong with one bearing measurement itself, if anything (neighbour aside).
+    #[inline(always)]
+    fn bearing_error(b: &BearingMeasurement<T>, tol: T) -> Option<MeasurementError> {
+        // A unit vector within a finite tolerance is finite (NaN and ∞ fail the
+        // comparison): no separate finiteness check.
+        let s = &b.bearing;
+        let unit = (s.dot(s) - T::one()).abs() <= tol;
+        if !unit || !b.rate.as_ref().is_none_or(finite_vec) {
+            return Some(MeasurementError::BadBearing(b.neighbour));
+        }
+        match b.range {
+            Some(r) if !(finite(r) && r > T::zero()) => {
+                Some(MeasurementError::BadRange(b.neighbour))
+            }
+            _ => None,
+        }
+    }
+
+    /// Ages the neighbour table and stores checked bearings in any order (at most one per
+    /// neighbour, so taking each slot's bearing is taking each bearing in turn). Returns
+    /// whether every triangle neighbour got a bearing, and the largest age.
+    #[cold]
+    #[inline(never)]
+    fn take_bearings_searched(&mut self, bearings: &[BearingMeasurement<T>], dt: T) -> (bool, T) {
+        let mut covered = true;
+        let mut age_max = T::zero();
+        for n in self.neighbours.iter_mut() {
+            n.age += dt;
+            if n.age > age_max {
+                age_max = n.age;
+            }
+            match Self::bearing_to(bearings, n.id) {
+                Some(b) => Self::take_bearing(n, b, dt),
+                None => {
+                    n.bearing_age += dt;
+                    n.fresh = false;
+                    n.range = None;
+                    covered &= !n.in_triangle;
+                }
+            }
+        }
+        (covered, age_max)
+    }
+
+    /// The bearing to neighbour `id`, if any.
+    #[inline(never)]
+    fn bearing_to(
+        bearings: &[BearingMeasurement<T>],
+        id: AgentId,
+    ) -> Option<&BearingMeasurement<T>> {
+        bearings.iter().find(|b| b.neighbour == id)
+    }
+
+    /// Stores a checked bearing of this tick and its rate; `dt` is the time since the last
+    /// aging of `bearing_age` (zero if already aged).
+    #[inline(always)]
+    fn take_bearing(n: &mut Neighbour<T, MT>, b: &BearingMeasurement<T>, dt: T) {
+        let interval = n.bearing_age + dt;
+        n.rate = match b.rate {
+            Some(rate) => rate,
+            // Finite difference of successive bearings (SPEC §2), over the time since the
+            // previous bearing (a missed tick widens the interval). Without a previous
+            // bearing the interval is −∞.
+            None if interval > T::zero() => (b.bearing - n.s) / interval,
+            None => Vec2::zeros(),
+        };
+        n.bearing = Some(b.bearing);
+        n.s = b.bearing;
+        n.bearing_age = T::zero();
+        n.range = b.range;
+        n.fresh = true;
     }
 
     // ---------------------------------------------------------------- control law
@@ -747,25 +890,27 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// One control tick: [`Agent::sense`], [`Agent::evaluate`], integrate the owned
     /// estimates (sampled S10), saturate. On any fault the output is the documented safe
     /// command `U = −safe_damping · v` (no formation force) and the estimates hold still.
+    ///
+    /// In shared mode with everything present (the usual tick) this runs a fused version
+    /// of evaluate-and-integrate (`control_shared`, same arithmetic); anything else, and
+    /// every fault, goes through [`Agent::evaluate`], which names the fault.
     pub fn step(&mut self, m: &Measurements<'_, T>) -> StepOutput<T> {
         let limit = self.config.limits.max_force;
-        let result = self.sense(m).and_then(|()| self.evaluate());
+        let result = match self.sense_ready(m) {
+            Err(fault) => Err(fault),
+            Ok(ready) => match ready.then(|| self.control_shared(m.dt)).flatten() {
+                Some(out) => Ok(out),
+                None => self.control_reference(m.dt),
+            },
+        };
         match result {
-            Ok(ev) => {
-                let r_min = self.config.min_estimate;
-                for (tri, rates) in self.angles.iter_mut().zip(ev.estimate_rates.iter()) {
-                    for (a, ar) in tri.iter_mut().zip(rates.iter()) {
-                        for (est, rate) in a.estimate.iter_mut().zip(ar.iter()) {
-                            *est = law::estimator_step(*est, *rate, m.dt, r_min);
-                        }
-                    }
-                }
-                let (force, saturated) = law::saturate(&ev.force, limit);
+            Ok((force, degenerate)) => {
+                let (force, saturated) = law::saturate(&force, limit);
                 StepOutput {
                     force,
                     status: Status::Nominal,
                     saturated,
-                    degenerate: ev.degenerate,
+                    degenerate,
                 }
             }
             Err(fault) => {
@@ -784,6 +929,144 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 }
             }
         }
+    }
+
+    /// [`Agent::evaluate`], then the owned estimates integrated over `dt` (sampled S10).
+    /// Returns the unsaturated force and `degenerate`.
+    fn control_reference(&mut self, dt: T) -> Result<(Vec2<T>, bool), Fault> {
+        let ev = self.evaluate()?;
+        let r_min = self.config.min_estimate;
+        for (tri, rates) in self.angles.iter_mut().zip(ev.estimate_rates.iter()) {
+            for (a, ar) in tri.iter_mut().zip(rates.iter()) {
+                for (est, rate) in a.estimate.iter_mut().zip(ar.iter()) {
+                    *est = law::estimator_step(*est, *rate, dt, r_min);
+                }
+            }
+        }
+        Ok((ev.force, ev.degenerate))
+    }
+
+    /// Shared mode: the control law S4–S12 and the sampled estimators S9/S10 in one pass,
+    /// with the same arithmetic as [`Agent::evaluate`] followed by the integration of
+    /// `control_reference`. Call only when `sense_ready` said ready (every neighbour heard
+    /// within the timeout, a bearing to every triangle neighbour). Returns the unsaturated
+    /// force and `degenerate`; `None`, with the estimates unchanged, when something else is
+    /// missing (a velocity, the apex's bearing or estimate, the partner offset) or the
+    /// force is not finite: the caller then takes the reference path, which reports the
+    /// fault.
+    fn control_shared(&mut self, dt: T) -> Option<(Vec2<T>, bool)> {
+        let c = &self.config;
+        if c.estimator != EstimatorMode::Shared {
+            return None;
+        }
+        let v = self.velocity;
+        let v_star = vec2(c.velocity_reference.at(self.time));
+        // S12.
+        let mut force = law::velocity_force(&c.friction, &c.velocity_damping, &v, &v_star);
+        let r_min = c.min_estimate;
+        let nbs = self.neighbours.as_slice();
+        let mut ok = true;
+        // Largest |y| (NaN ignored, as in `|y| > margin`): degenerate iff above the margin.
+        let mut y_max = T::zero();
+        for a in self.angles.as_mut_slice().as_flattened_mut() {
+            if a.role == Role::Apex {
+                a.estimate_before = a.estimate;
+                let (Some(nv), Some(nw)) = (nbs.get(a.slots[1]), nbs.get(a.slots[2])) else {
+                    ok = false;
+                    continue;
+                };
+                let s = [nv.s, nw.s];
+                // S4–S6 from the own bearings and rates.
+                let geo = AngleGeometry::new(&s, &[nv.rate, nw.rate]);
+                let y_abs = geo.y.abs();
+                if y_abs > y_max {
+                    y_max = y_abs;
+                }
+                // S7.
+                let gamma =
+                    law::port_effort(a.stiffness, a.damping, geo.y - a.cos_desired, geo.y_dot);
+                let r = a.estimate;
+                // S8 on the apex.
+                force += law::apex_force(gamma, &geo.g, r);
+                // S9 (S3 for ṙ, share t_{α,e}), then the sampled S10
+                // `max(r_min, r̂ + Δt·S9)`. The continuous S10 projection that
+                // `evaluate` applies first changes nothing here: it only acts when
+                // r̂ ≤ r_min and S9 < 0, and then (Δt ≥ 0) both give r_min.
+                let gain = a.estimator_gain;
+                let mut next = |s_e: &Vec2<T>, v_far: &Option<Vec2<T>>, t_e: T, r_e: T| {
+                    let Some(v_far) = v_far else {
+                        ok = false;
+                        return r_e;
+                    };
+                    let rr = crate::geometry::range_rate(s_e, &(v_far - v));
+                    let flow = law::estimator_rate(rr, gamma, t_e, gain, r_e);
+                    law::estimator_step(r_e, flow, dt, r_min)
+                };
+                a.estimate = [
+                    next(&s[0], &nv.velocity, geo.t[0], r[0]),
+                    next(&s[1], &nw.velocity, geo.t[1], r[1]),
+                ];
+            } else {
+                let (Some(nu), Some((s_j, d_j)), Some(r_k)) =
+                    (nbs.get(a.slots[0]), a.remote_bearing, a.remote_estimate)
+                else {
+                    ok = false;
+                    continue;
+                };
+                // s_uk = −s_ku, ṡ_uk = −ṡ_ku (SPEC §2); S4–S6 with this agent's edge
+                // first (the order of the two edges does not change y, ẏ or g_k).
+                let geo = AngleGeometry::new(&[-nu.s, s_j], &[-nu.rate, d_j]);
+                let y_abs = geo.y.abs();
+                if y_abs > y_max {
+                    y_max = y_abs;
+                }
+                // S7.
+                let gamma =
+                    law::port_effort(a.stiffness, a.damping, geo.y - a.cos_desired, geo.y_dot);
+                // S8 on this far vertex, with the apex's estimate of its edge.
+                force += law::far_vertex_force(gamma, &geo.g[0], r_k);
+            }
+        }
+        if let Some(l) = &c.leader {
+            // S11 with z = q_a − q_b.
+            match (
+                self.partner_offset,
+                self.neighbour_velocity(self.partner_slot),
+            ) {
+                (Some(p), Ok(v_p)) => {
+                    let z_star = vec2(l.displacement.at(self.time));
+                    // Agent b gets the negation (exactly what `evaluate`'s `* −1` gives).
+                    match l.role {
+                        LeaderRole::A => {
+                            force += law::leader_force(
+                                l.stiffness,
+                                &l.damping,
+                                &(-p - z_star),
+                                &(v - v_p),
+                            );
+                        }
+                        LeaderRole::B => {
+                            force -= law::leader_force(
+                                l.stiffness,
+                                &l.damping,
+                                &(p - z_star),
+                                &(v_p - v),
+                            );
+                        }
+                    }
+                }
+                _ => ok = false,
+            }
+        }
+        if ok && finite_vec(&force) {
+            return Some((force, y_max > c.limits.margin_cos));
+        }
+        for a in self.angles.as_mut_slice().as_flattened_mut() {
+            if a.role == Role::Apex {
+                a.estimate = a.estimate_before;
+            }
+        }
+        None
     }
 
     // ---------------------------------------------------------------- estimates
