@@ -240,12 +240,12 @@ else
     if ((${#measured[@]} == 0)); then
         fail "measure announced no regions (no 'FWCHECK region' lines in $out/measure.log)"
     fi
-    printf '%-9s %4s %4s %12s %12s %7s %7s %7s %8s %15s %15s\n' \
-        config tri nbrs "rx frm/B" "tx frm/B" rx step tx total "total budget" "step budget"
+    printf '%-9s %4s %4s %12s %12s %7s %7s %7s %8s %15s %15s %7s\n' \
+        config tri nbrs "rx frm/B" "tx frm/B" rx step tx total "total budget" "step budget" "crc"
     for cname in "${names[@]}"; do
         [[ $cname == *-* ]] && continue
         if [[ $cname == overhead ]]; then
-            printf '%-9s %4s %4s %12s %12s %7s %7s %7s %8d %15s\n' overhead - - - - - - - "${cmax[overhead]}" "(markers)"
+            printf '%-9s %4s %4s %12s %12s %7s %7s %7s %8d %15s %15s %7s\n' overhead - - - - - - - "${cmax[overhead]}" "(markers)" - -
             continue
         fi
         if ((cmin[$cname] != cmax[$cname])); then
@@ -261,9 +261,10 @@ else
             cell="-"
             [[ -z ${budget[insn_control_law_$cname]:-} ]] || fail "config $cname: no '$cname-step' region for insn_control_law_$cname"
         fi
-        printf '%-9s %4s %4s %12s %12s %7s %7s %7s %8d %15s %15s\n' "$cname" "${ctri[$cname]}" "$(field neighbours)" \
+        printf '%-9s %4s %4s %12s %12s %7s %7s %7s %8d %15s %15s %7s\n' "$cname" "${ctri[$cname]}" "$(field neighbours)" \
             "$(field rx_frames)/$(field rx_bytes)" "$(field tx_frames)/$(field tx_bytes)" \
-            "${cmax[$cname-rx]:--}" "${cmax[$cname-step]:--}" "${cmax[$cname-tx]:--}" "${cmax[$cname]}" "$total_cell" "$cell"
+            "${cmax[$cname-rx]:--}" "${cmax[$cname-step]:--}" "${cmax[$cname-tx]:--}" "${cmax[$cname]}" "$total_cell" "$cell" \
+            "${cmax[$cname-crc]:--}"
     done
     for key in "${!budget[@]}"; do
         if [[ $key == insn_step_* && -z ${measured[${key#insn_step_}]:-} ]]; then
@@ -273,7 +274,8 @@ else
             fail "budget $key has no measured configuration '${key#insn_control_law_}'"
         fi
     done
-    echo "    (rx, step and tx are measured separately on a fresh copy of the same state; rx+step+tx = step + ~2 x overhead)"
+    echo "    (rx, step and tx are measured separately on a fresh copy of the same state; rx+step+tx = step + ~2 x overhead;"
+    echo "    crc: the CRC-16 of all rx and tx frames alone, a part of rx + tx)"
     echo "    total budget: regression guard, 20 % above measured; the issue's starting budget for the whole"
     echo "    step (tri2 <= 2000, tri8 <= 8000) is NOT met (see docs/firmware.md). step budget: Agent::step alone."
 fi

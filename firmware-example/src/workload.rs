@@ -538,6 +538,16 @@ impl StepCtx<'_> {
         self.agent.frames(|bytes| tx.push(bytes)) as u8
     }
 
+    /// The frame CRCs alone: [`controller_core::crc16::checksum`] of every frame the
+    /// step decodes and encodes (the part of the wire cost no codec can avoid).
+    #[inline(always)]
+    pub fn crc_all(&self) -> u16 {
+        self.rx
+            .iter()
+            .chain(self.tx.iter())
+            .fold(0, |acc, f| acc ^ controller_core::crc16::checksum(f))
+    }
+
     /// The whole measured step: [`StepCtx::receive_all`],
     /// [`StepCtx::step_only`], [`StepCtx::encode`].
     #[inline(always)]

@@ -10,7 +10,8 @@
 //!   [`REPEATS`] times, each on a freshly built bench (same state);
 //! * `<name>-rx`, `<name>-step`, `<name>-tx`: the three parts separately, on
 //!   one more fresh bench (their sum is the whole step plus twice the marker
-//!   overhead).
+//!   overhead);
+//! * `<name>-crc`: the CRC-16 of all those frames alone (part of rx and tx).
 //!
 //! Every measured step must be nominal (`Status::Nominal`) with every
 //! neighbour frame accepted; otherwise it prints `FWCHECK error …` and exits
@@ -46,8 +47,8 @@ mod firmware {
 
     /// Region id of the empty calibration region (marker overhead only).
     const OVERHEAD_ID: u8 = 0;
-    /// Regions per configuration: whole step, rx, step, tx.
-    const REGIONS_PER_CONFIG: usize = 4;
+    /// Regions per configuration: whole step, rx, step, tx, crc.
+    const REGIONS_PER_CONFIG: usize = 5;
 
     const _: () = assert!(
         REGIONS_PER_CONFIG * STEP_CONFIGS.len() < MAX_REGIONS,
@@ -73,6 +74,11 @@ mod firmware {
     #[inline(never)]
     fn measured_tx(id: u8, ctx: &mut StepCtx<'_>) -> u8 {
         measure::measured(id, ctx, |b| b.encode())
+    }
+
+    #[inline(never)]
+    fn measured_crc(id: u8, ctx: &mut StepCtx<'_>) -> u16 {
+        measure::measured(id, ctx, |b| b.crc_all())
     }
 
     /// An empty measured region: the marker overhead alone.
@@ -136,7 +142,8 @@ mod firmware {
         let mut bench = Bench::empty();
         for (i, cfg) in STEP_CONFIGS.iter().enumerate() {
             let base = (1 + REGIONS_PER_CONFIG * i) as u8;
-            let (id_all, id_rx, id_step, id_tx) = (base, base + 1, base + 2, base + 3);
+            let (id_all, id_rx, id_step, id_tx, id_crc) =
+                (base, base + 1, base + 2, base + 3, base + 4);
 
             announce(id_all, cfg.name, "", cfg.triangles, REPEATS);
             let mut last = None;
@@ -168,10 +175,16 @@ mod firmware {
             announce(id_rx, cfg.name, "-rx", cfg.triangles, 1);
             announce(id_step, cfg.name, "-step", cfg.triangles, 1);
             announce(id_tx, cfg.name, "-tx", cfg.triangles, 1);
+            announce(id_crc, cfg.name, "-crc", cfg.triangles, 1);
             let mut ctx = reset(&mut bench, cfg);
             let (accepted, rejected) = measured_rx(id_rx, &mut ctx);
             let output = measured_step_only(id_step, &mut ctx);
             let sent = measured_tx(id_tx, &mut ctx);
+            defmt::println!(
+                "FWCHECK crc name={=str} xor={=u16}",
+                cfg.name,
+                measured_crc(id_crc, &mut ctx)
+            );
             let r = StepResult {
                 output,
                 accepted,
