@@ -1,64 +1,82 @@
 //! Communication of one agent: what it broadcasts ([`Agent::frames`]) and how it takes
 //! in its neighbours' frames ([`Agent::receive`]).
 
-use super::{pick, Agent, AngleState, Role};
+use super::{pick, Agent, AngleState, ApexBearings, Role};
 use crate::config::{AgentId, EstimatorMode};
 use crate::wire::{check_frame, FrameError, FrameWriter, RawItem, WireItem, MAX_ITEMS_PER_FRAME};
 use crate::{Real, Vec2};
 
 impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
-    /// Calls `f` for everything this agent broadcasts: its velocity, and for every
-    /// controlled angle it is the apex of (and has fresh bearings for), the bearings and
-    /// rates its far vertices need, with the estimates it owns in shared mode.
+    /// The fresh bearings `[s_uv, s_uw]` and rates of an angle this agent is the apex of
+    /// (`None` without a fresh bearing to both far vertices).
+    fn apex_bearings(&self, a: &AngleState<T>) -> Option<ApexBearings<T>> {
+        let bearing = |slot: usize| match self.neighbours.get(slot) {
+            Some(n) if n.fresh => n.bearing.map(|s| (s, n.rate)),
+            _ => None,
+        };
+        let ((s0, d0), (s1, d1)) = (bearing(a.slots[1])?, bearing(a.slots[2])?);
+        Some(([s0, s1], [d0, d1]))
+    }
+
+    /// Calls `f` for everything this agent broadcasts, at full precision: its velocity, and
+    /// for every controlled angle it is the apex of (and has fresh bearings for), the
+    /// bearings and rates its far vertices need, with the estimates it owns in shared mode.
+    /// [`Agent::frames`] sends the same, rounded to `f32`.
     fn for_each_item(&self, mut f: impl FnMut(Item<T>)) {
         f(Item::Velocity(self.velocity));
         let shared = self.config.estimator == EstimatorMode::Shared;
-        for a in self
-            .angles
-            .iter()
-            .flatten()
-            .filter(|a| a.role == Role::Apex)
-        {
-            let bearing = |slot: usize| match self.neighbours.get(slot) {
-                Some(n) if n.fresh => n.bearing.map(|s| (s, n.rate)),
-                _ => None,
-            };
-            if let (Some((s0, d0)), Some((s1, d1))) = (bearing(a.slots[1]), bearing(a.slots[2])) {
+        for a in self.angles.iter().flatten() {
+            if a.role != Role::Apex {
+                continue;
+            }
+            if let Some((s, rate)) = self.apex_bearings(a) {
                 f(Item::Angle {
                     far: a.far,
-                    s: [s0, s1],
-                    rate: [d0, d1],
+                    s,
+                    rate,
                     r: shared.then_some(a.estimate),
                 });
             }
         }
     }
 
-    /// Encodes this tick's broadcast into frames of at most 60 bytes and passes each to
-    /// `send`. Returns the number of frames.
+    /// Encodes this tick's broadcast (what `for_each_item` lists, as [`WireItem`]s) into
+    /// frames of at most 60 bytes and passes each to `send`. Returns the number of frames.
     pub fn frames(&mut self, mut send: impl FnMut(&[u8])) -> usize {
         let id = self.config.id;
+        let shared = self.config.estimator == EstimatorMode::Shared;
+        let w = |v: Vec2<T>| [v.x.as_f32(), v.y.as_f32()];
         let mut seq = self.seq;
         let mut count = 0;
         let mut writer = FrameWriter::new(id, seq);
-        self.for_each_item(|item| {
-            let wire = item.to_wire();
-            if !writer.push(&wire) {
+        // The velocity always fits in an empty frame.
+        let _ = writer.push(&WireItem::Velocity(w(self.velocity)));
+        for a in self.angles.iter().flatten() {
+            if a.role != Role::Apex {
+                continue;
+            }
+            let Some((s, rate)) = self.apex_bearings(a) else {
+                continue;
+            };
+            let (far, s, rate) = (a.far, [w(s[0]), w(s[1])], [w(rate[0]), w(rate[1])]);
+            let item = if shared {
+                let r = [a.estimate[0].as_f32(), a.estimate[1].as_f32()];
+                WireItem::Angle { far, s, rate, r }
+            } else {
+                WireItem::AngleBearings { far, s, rate }
+            };
+            if !writer.push(&item) {
                 send(writer.finish());
                 count += 1;
                 seq = seq.wrapping_add(1);
                 writer.reset(id, seq);
                 // A single item always fits in an empty frame.
-                let _ = writer.push(&wire);
+                let _ = writer.push(&item);
             }
-        });
-        if writer.items() > 0 {
-            send(writer.finish());
-            count += 1;
-            seq = seq.wrapping_add(1);
         }
-        self.seq = seq;
-        count
+        send(writer.finish());
+        self.seq = seq.wrapping_add(1);
+        count + 1
     }
 
     /// Decodes and applies one received frame. Rejected frames change nothing but the
@@ -212,25 +230,4 @@ enum Item<T: Real> {
         rate: [Vec2<T>; 2],
         r: Option<[T; 2]>,
     },
-}
-
-impl<T: Real> Item<T> {
-    fn to_wire(self) -> WireItem {
-        let w = |v: Vec2<T>| [v.x.as_f32(), v.y.as_f32()];
-        match self {
-            Item::Velocity(v) => WireItem::Velocity(w(v)),
-            Item::Angle { far, s, rate, r } => {
-                let (s, rate) = ([w(s[0]), w(s[1])], [w(rate[0]), w(rate[1])]);
-                match r {
-                    Some(r) => WireItem::Angle {
-                        far,
-                        s,
-                        rate,
-                        r: [r[0].as_f32(), r[1].as_f32()],
-                    },
-                    None => WireItem::AngleBearings { far, s, rate },
-                }
-            }
-        }
-    }
 }
