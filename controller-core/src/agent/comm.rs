@@ -1,16 +1,19 @@
 //! Communication of one agent: what it broadcasts ([`Agent::frames`]) and how it takes
 //! in its neighbours' frames ([`Agent::receive`]).
 
-use super::{pick, Agent, AngleState, ApexBearings, Role};
+use super::{pick, Agent, AngleState, ApexBearings, Neighbour, Role};
 use crate::config::{AgentId, EstimatorMode};
-use crate::wire::{check_frame, FrameError, FrameWriter, RawItem, WireItem, MAX_ITEMS_PER_FRAME};
+use crate::wire::{check_frame, FrameError, RawItem, WireItem, MAX_ITEMS_PER_FRAME};
 use crate::{Real, Vec2};
 
 impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// The fresh bearings `[s_uv, s_uw]` and rates of an angle this agent is the apex of
     /// (`None` without a fresh bearing to both far vertices).
-    fn apex_bearings(&self, a: &AngleState<T>) -> Option<ApexBearings<T>> {
-        let bearing = |slot: usize| match self.neighbours.get(slot) {
+    fn apex_bearings(
+        neighbours: &[Neighbour<T, MT>],
+        a: &AngleState<T>,
+    ) -> Option<ApexBearings<T>> {
+        let bearing = |slot: usize| match neighbours.get(slot) {
             Some(n) if n.fresh => n.bearing.map(|s| (s, n.rate)),
             _ => None,
         };
@@ -29,7 +32,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             if a.role != Role::Apex {
                 continue;
             }
-            if let Some((s, rate)) = self.apex_bearings(a) {
+            if let Some((s, rate)) = Self::apex_bearings(&self.neighbours, a) {
                 f(Item::Angle {
                     far: a.far,
                     s,
@@ -48,14 +51,15 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         let w = |v: Vec2<T>| [v.x.as_f32(), v.y.as_f32()];
         let mut seq = self.seq;
         let mut count = 0;
-        let mut writer = FrameWriter::new(id, seq);
+        let (writer, angles, neighbours) = (&mut self.writer, &self.angles, &self.neighbours);
+        writer.reset(id, seq);
         // The velocity always fits in an empty frame.
         let _ = writer.push(&WireItem::Velocity(w(self.velocity)));
-        for a in self.angles.iter().flatten() {
+        for a in angles.iter().flatten() {
             if a.role != Role::Apex {
                 continue;
             }
-            let Some((s, rate)) = self.apex_bearings(a) else {
+            let Some((s, rate)) = Self::apex_bearings(neighbours, a) else {
                 continue;
             };
             let (far, s, rate) = (a.far, [w(s[0]), w(s[1])], [w(rate[0]), w(rate[1])]);

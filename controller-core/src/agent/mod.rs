@@ -4,6 +4,7 @@
 use crate::config::{AgentConfig, AgentId, ConfigError, EstimatorMode, LeaderRole, Schedule};
 use crate::geometry::AngleGeometry;
 use crate::law;
+use crate::wire::FrameWriter;
 use crate::{FrameStats, Real, Vec2};
 
 mod comm;
@@ -252,6 +253,8 @@ pub struct Agent<T: Real, const MT: usize, const NB: usize> {
     velocity: Vec2<T>,
     partner_offset: Option<Vec2<T>>,
     seq: u16,
+    /// Frame buffer reused by [`Agent::frames`] (no zeroing per tick).
+    writer: FrameWriter,
     stats: FrameStats,
 }
 
@@ -386,6 +389,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             velocity: Vec2::zeros(),
             partner_offset: None,
             seq: 0,
+            writer: FrameWriter::new(me, 0),
             stats: FrameStats::default(),
         })
     }
