@@ -812,6 +812,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// Evaluates the control law S7–S12 and the estimator flows S9/S10 on the stored
     /// measurements and neighbour data, without changing anything. Used by [`Agent::step`]
     /// and by simulators that integrate the estimators themselves (continuous time).
+    /// (`step`'s shared-mode fast path repeats this arithmetic: change both together.)
     pub fn evaluate(&self) -> Result<Evaluation<T, MT>, Fault> {
         self.check_fresh()?;
         let c = &self.config;
@@ -958,6 +959,9 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// missing (a velocity, the apex's bearing or estimate, the partner offset) or the
     /// force is not finite: the caller then takes the reference path, which reports the
     /// fault.
+    ///
+    /// A second implementation of the law: change it together with [`Agent::evaluate`].
+    /// `tests/tests/step_fast.rs` checks that both agree bit for bit.
     fn control_shared(&mut self, dt: T) -> Option<(Vec2<T>, bool)> {
         let c = &self.config;
         if c.estimator != EstimatorMode::Shared {
