@@ -1159,6 +1159,18 @@ const CHART_MARGIN: u32 = 14;
 const X_LABEL_AREA: u32 = 56;
 const Y_LABEL_AREA: u32 = 96;
 
+/// A chart builder on `area` with the house margins and label areas.
+fn chart_on<'a, 'b, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+) -> ChartBuilder<'a, 'b, DB> {
+    let mut builder = ChartBuilder::on(area);
+    builder
+        .margin(CHART_MARGIN)
+        .x_label_area_size(X_LABEL_AREA)
+        .y_label_area_size(Y_LABEL_AREA);
+    builder
+}
+
 /// The house style of every time-series panel's mesh: axis descriptions, fonts, grid.
 fn styled_mesh<'m, 'a, 'b, X, Y, XT, YT, DB>(
     mesh: &'m mut plotters::chart::MeshStyle<'a, 'b, X, Y, DB>,
@@ -1270,11 +1282,7 @@ where
     let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
     let (hx, hy) = (scale * pw / 2.0, scale * ph / 2.0);
 
-    let mut chart = ChartBuilder::on(&plot)
-        .margin(CHART_MARGIN)
-        .x_label_area_size(X_LABEL_AREA)
-        .y_label_area_size(Y_LABEL_AREA)
-        .build_cartesian_2d(cx - hx..cx + hx, cy - hy..cy + hy)?;
+    let mut chart = chart_on(&plot).build_cartesian_2d(cx - hx..cx + hx, cy - hy..cy + hy)?;
     chart
         .configure_mesh()
         .x_desc("x (m)")
@@ -1397,11 +1405,7 @@ where
             .map(|p| p.1)
             .chain([ANGLE_THRESHOLD, ANGLE_THRESHOLD * 10.0]),
     );
-    let mut chart = ChartBuilder::on(&plot)
-        .margin(CHART_MARGIN)
-        .x_label_area_size(X_LABEL_AREA)
-        .y_label_area_size(Y_LABEL_AREA)
-        .build_cartesian_2d(t0..t1, (y0..y1).log_scale())?;
+    let mut chart = chart_on(&plot).build_cartesian_2d(t0..t1, (y0..y1).log_scale())?;
     styled_mesh(&mut chart.configure_mesh(), "|angle error| (rad)")
         .y_label_formatter(&log_label)
         .draw()?;
@@ -1465,11 +1469,7 @@ where
 
     let (t0, t1) = time_range(&run.t);
     let (y0, y1) = log_range(drawn.iter().flat_map(|d| d.0.iter().map(|p| p.1)));
-    let mut chart = ChartBuilder::on(&plot)
-        .margin(CHART_MARGIN)
-        .x_label_area_size(X_LABEL_AREA)
-        .y_label_area_size(Y_LABEL_AREA)
-        .build_cartesian_2d(t0..t1, (y0..y1).log_scale())?;
+    let mut chart = chart_on(&plot).build_cartesian_2d(t0..t1, (y0..y1).log_scale())?;
     styled_mesh(&mut chart.configure_mesh(), "energy")
         .y_label_formatter(&log_label)
         .draw()?;
@@ -1522,11 +1522,7 @@ where
             .iter()
             .flat_map(|(a, b)| a.iter().chain(b).map(|p| p.1)),
     );
-    let mut chart = ChartBuilder::on(&plot)
-        .margin(CHART_MARGIN)
-        .x_label_area_size(X_LABEL_AREA)
-        .y_label_area_size(Y_LABEL_AREA)
-        .build_cartesian_2d(t0..t1, y0..y1)?;
+    let mut chart = chart_on(&plot).build_cartesian_2d(t0..t1, y0..y1)?;
     styled_mesh(&mut chart.configure_mesh(), "distance (m)").draw()?;
     for (i, (rhat, r)) in series.into_iter().enumerate() {
         stroke(chart.plotting_area(), &r, colour(i), 2, true, bitmap)?;
@@ -1574,21 +1570,13 @@ where
     let (t0, t1) = time_range(&run.t);
 
     let (y0, y1) = lin_range(disp.iter().chain(&vel).map(|p| p.1).chain([0.0]));
-    let mut chart = ChartBuilder::on(&upper)
-        .margin(CHART_MARGIN)
-        .x_label_area_size(X_LABEL_AREA)
-        .y_label_area_size(Y_LABEL_AREA)
-        .build_cartesian_2d(t0..t1, y0..y1)?;
+    let mut chart = chart_on(&upper).build_cartesian_2d(t0..t1, y0..y1)?;
     styled_mesh(&mut chart.configure_mesh(), "leader error (m, m/s)").draw()?;
     stroke(chart.plotting_area(), &disp, colour(0), 2, false, bitmap)?;
     stroke(chart.plotting_area(), &vel, colour(1), 2, false, bitmap)?;
 
     let (y0, y1) = lin_range(dist.iter().map(|p| p.1).chain([0.0]));
-    let mut chart = ChartBuilder::on(&lower)
-        .margin(CHART_MARGIN)
-        .x_label_area_size(X_LABEL_AREA)
-        .y_label_area_size(Y_LABEL_AREA)
-        .build_cartesian_2d(t0..t1, y0..y1)?;
+    let mut chart = chart_on(&lower).build_cartesian_2d(t0..t1, y0..y1)?;
     styled_mesh(&mut chart.configure_mesh(), "min distance (m)").draw()?;
     stroke(chart.plotting_area(), &dist, colour(2), 2, false, bitmap)?;
     Ok(())
