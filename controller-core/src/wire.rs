@@ -361,9 +361,7 @@ pub(crate) fn item_valid(item: &WireItem, tol: f32) -> bool {
 /// Takes the next `N` bytes.
 #[inline(always)]
 fn take<const N: usize>(rest: &mut &[u8]) -> Option<[u8; N]> {
-    let (head, tail) = rest.split_first_chunk::<N>()?;
-    *rest = tail;
-    Some(*head)
+    split(rest).copied()
 }
 
 /// Postcard `u16`/`u32` varint of at most `MAX` bytes whose last byte is at most `LAST`.
@@ -408,9 +406,6 @@ fn set_pair(b: &mut [u8], at: usize, x: &[f32; 2]) {
 }
 
 impl FrameHeader {
-    /// Largest encoded header (`seq` takes up to 3 varint bytes).
-    pub const MAX_LEN: usize = HEADER_FIXED + 3;
-
     /// Writes the postcard encoding into `out`; returns its length.
     fn encode(&self, out: &mut [u8; MAX_FRAME_LEN]) -> usize {
         let s = self.seq;

@@ -136,9 +136,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         let v = |a: [f32; 2]| Vec2::new(T::of_f32(a[0]), T::of_f32(a[1]));
         for item in &kept {
             if let Some(vel) = item.velocity() {
-                if let Some(n) = self.neighbours.get_mut(slot) {
-                    n.velocity = Some(v(vel));
-                }
+                self.apply(sender, slot, Item::Velocity(v(vel)));
             } else if let Some(far) = item.far() {
                 self.for_far_angles(sender, slot, far, |a, mine| {
                     let (s, rate) = item.bearing(1 - mine);

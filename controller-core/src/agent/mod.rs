@@ -218,8 +218,6 @@ struct Neighbour<T: Real, const MT: usize> {
     apex_of: heapless::Vec<u8, MT>,
     /// Is in a triangle with this agent (needs a bearing every tick).
     in_triangle: bool,
-    /// Some triangle neighbour needs this agent's bearing to it (far vertex of own apex angle).
-    bearing_needed: bool,
     heard: bool,
     age: T,
     last_seq: Option<u16>,
@@ -334,13 +332,8 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                         *slot = Self::add_neighbour(&mut neighbours, id, true)?;
                     }
                 }
-                if role == Role::Apex {
-                    for &s in &slots[1..] {
-                        if let Some(n) = neighbours.get_mut(s) {
-                            n.bearing_needed = true;
-                        }
-                    }
-                } else if let Some(n) = neighbours.get_mut(slots[0]) {
+                // A far vertex takes this angle's items from its apex (`comm::receive`).
+                if let (Role::Far(_), Some(n)) = (role, neighbours.get_mut(slots[0])) {
                     // At most one controlled angle per triangle has this apex: ≤ MT entries.
                     let flat =
                         u8::try_from(2 * ti + ai).map_err(|_| ConfigError::TooManyNeighbours)?;
@@ -488,7 +481,6 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             id,
             apex_of: heapless::Vec::new(),
             in_triangle,
-            bearing_needed: false,
             heard: false,
             // Never heard: infinitely old (so `age <= timeout` alone means heard recently).
             age: T::lit(f64::INFINITY),
