@@ -20,20 +20,9 @@
 // `summary.json` is one large `serde_json::json!` literal.
 #![recursion_limit = "256"]
 
+pub mod analysis;
 pub mod cli;
-pub mod continuous;
-pub mod controller;
-pub mod diagnostics;
-pub mod error;
-pub mod graph;
-pub mod hil;
+pub mod engine;
 pub mod model;
-pub mod output;
-pub mod plant;
-pub mod plot;
-pub mod radio;
+pub mod report;
 pub mod scenario;
-pub mod sensors;
-pub mod sim;
-pub mod strip;
-pub mod validate;

@@ -1,7 +1,7 @@
 //! Host-in-the-loop (`host-sim run … --hil ID`, `docs/hil.md`).
 //!
 //! Always run (no QEMU needed): the protocol, lock-step, error paths and exit codes
-//! against the host-side stand-in of the firmware (`host_sim::hil::fake`: an
+//! against the host-side stand-in of the firmware (`host_sim::engine::hil::fake`: an
 //! `Agent<f32, 4, 8>` behind a TCP link speaking `controller_core::link`), and the
 //! start-up errors (missing ELF, missing QEMU, bad `--hil` arguments) through the binary.
 //!
@@ -17,13 +17,13 @@
 //! cores to itself.
 
 use host_sim::cli::run_to_dir;
-use host_sim::error::{exit_code, RunError};
-use host_sim::hil::fake::FakeBehaviour;
-use host_sim::hil::{self, HilError, HilOptions, Launcher, When};
+use host_sim::engine::hil::fake::FakeBehaviour;
+use host_sim::engine::hil::{self, HilError, HilOptions, Launcher, When};
+use host_sim::engine::sampled::{self as sim, RunResult};
 use host_sim::model::Model;
-use host_sim::output::NullRecorder;
-use host_sim::sim::{self, RunResult};
-use host_sim::validate::load;
+use host_sim::report::csv::NullRecorder;
+use host_sim::scenario::error::{exit_code, RunError};
+use host_sim::scenario::validate::load;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::sync::Mutex;

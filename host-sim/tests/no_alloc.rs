@@ -2,13 +2,13 @@
 //! the radio), RK4 steps (sampled and continuous), diagnostics, failure monitor and CSV
 //! rows, once warmed up. A counting global allocator counts this thread's allocations.
 
-use host_sim::continuous::ContinuousSim;
-use host_sim::diagnostics::{Diagnostics, Monitor};
+use host_sim::analysis::diagnostics::{Diagnostics, Monitor};
+use host_sim::engine::continuous::ContinuousSim;
+use host_sim::engine::sampled::{Engine, SampledSim};
 use host_sim::model::Model;
-use host_sim::output::{CsvRecorder, Recorder, Row};
-use host_sim::sim::{Engine, SampledSim};
-use host_sim::strip::strip_model;
-use host_sim::validate::load;
+use host_sim::report::csv::{CsvRecorder, Recorder, Row};
+use host_sim::scenario::strip::strip_model;
+use host_sim::scenario::validate::load;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 

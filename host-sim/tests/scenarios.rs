@@ -1,14 +1,14 @@
 //! The built-in scenarios end as SPEC §9 says, continuous mode keeps V from increasing,
 //! the paper scenario survives a lossy, delayed radio, and runs are reproducible.
 
+use host_sim::analysis::diagnostics::Outcome;
 use host_sim::cli::run_to_dir;
-use host_sim::diagnostics::Outcome;
+use host_sim::engine::sampled::{self as sim, RunResult};
 use host_sim::model::Model;
-use host_sim::output::NullRecorder;
+use host_sim::report::csv::NullRecorder;
+use host_sim::scenario::strip::strip_model;
+use host_sim::scenario::validate::load;
 use host_sim::scenario::Mode;
-use host_sim::sim::{self, RunResult};
-use host_sim::strip::strip_model;
-use host_sim::validate::load;
 
 fn model(name: &str, overrides: &[&str]) -> Model {
     let o: Vec<String> = overrides.iter().map(|s| (*s).to_owned()).collect();

@@ -1,13 +1,13 @@
 //! The command line: `host-sim [run|validate|list|plot]` (exit codes in
-//! [`crate::error::exit_code`] and `docs/outputs.md`).
+//! [`crate::scenario::error::exit_code`] and `docs/outputs.md`).
 
-use crate::error::{exit_code, RunError, ScenarioErrors};
-use crate::hil::{self, HilOptions};
+use crate::engine::hil::{self, HilOptions};
+use crate::engine::sampled::{self as sim, RunResult};
 use crate::model::Model;
-use crate::output::{summary_json, write_summary, CsvRecorder};
+use crate::report::csv::{summary_json, write_summary, CsvRecorder};
+use crate::scenario::error::{exit_code, RunError, ScenarioErrors};
+use crate::scenario::validate;
 use crate::scenario::BUILTINS;
-use crate::sim::{self, RunResult};
-use crate::validate;
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -133,7 +133,7 @@ pub fn execute(cli: Cli) -> u8 {
             }
             exit_code::CONVERGED
         }
-        Some(Command::Plot { dir }) => match crate::plot::plot_run(&dir) {
+        Some(Command::Plot { dir }) => match crate::report::plot::plot_run(&dir) {
             Ok(files) => {
                 if !quiet {
                     for f in files {
@@ -240,7 +240,9 @@ pub fn run_to_dir_with(
     for i in 0..model.n() {
         let a = model.core_agent(i)?;
         let owned: Vec<_> = a.owned_estimates().collect();
-        layout.extend(crate::diagnostics::resolve_estimates(model, i, &owned)?);
+        layout.extend(crate::analysis::diagnostics::resolve_estimates(
+            model, i, &owned,
+        )?);
     }
     let csv_path = out.join("timeseries.csv");
     let mut recorder = CsvRecorder::create(&csv_path, model, &layout)
@@ -263,7 +265,7 @@ pub fn run_to_dir_with(
         .map_err(|e| format!("cannot write {}: {e}", summary_path.display()))?;
     let mut files = vec![csv_path, summary_path];
     if plots {
-        match crate::plot::plot_run(out) {
+        match crate::report::plot::plot_run(out) {
             Ok(p) => files.extend(p),
             Err(e) => eprintln!("warning: plots not drawn: {e}"),
         }

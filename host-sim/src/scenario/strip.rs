@@ -6,7 +6,7 @@
 //! away along the strip, whose ids are distinct. Such a model is built here directly; the
 //! file validation would refuse the repeated ids.
 
-use crate::graph::{strip_triangles, Graph};
+use crate::model::graph::{strip_triangles, Graph};
 use crate::model::{AgentModel, AngleModel, Model, RadioModel, SensorModel, TriangleModel};
 use crate::scenario::{BearingRate, CriteriaSpec, Estimator, Mode};
 use controller_core::{Limits, Schedule};

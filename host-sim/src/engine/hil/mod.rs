@@ -18,13 +18,13 @@ pub mod fake;
 pub mod link;
 pub mod qemu;
 
-use crate::controller::{AgentController, LocalCore};
-use crate::diagnostics::resolve_estimates;
-use crate::error::{exit_code, RunError};
+use crate::analysis::diagnostics::resolve_estimates;
+use crate::engine::controller::{AgentController, LocalCore};
+use crate::engine::sampled::{drive, RunResult, SampledSim};
 use crate::model::Model;
-use crate::output::Recorder;
+use crate::report::csv::Recorder;
+use crate::scenario::error::{exit_code, RunError};
 use crate::scenario::Mode;
-use crate::sim::{drive, RunResult, SampledSim};
 use controller::{EstimateSlot, HilController, TargetHandle};
 use controller_core::{
     Agent, AgentConfig, AngleConfig, LeaderConfig, Limits, Schedule, ScheduleStep, TriangleConfig,

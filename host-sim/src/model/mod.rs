@@ -3,7 +3,9 @@
 //! Agents are referred to by index (their position in the scenario's `[[agents]]` list);
 //! `AgentModel::id` is the controller-core id used on the wire.
 
-use crate::graph::Graph;
+pub mod graph;
+
+use crate::model::graph::Graph;
 use crate::scenario::{BearingRate, CriteriaSpec, Estimator, Mode};
 use controller_core::{
     AgentConfig, AngleConfig, EstimatorMode, LeaderConfig, LeaderRole, Limits, Schedule,

@@ -3,13 +3,13 @@
 //! The simulator gives a controller what the agent's own sensors measured and the frames
 //! its radio received since the last tick; the controller returns a force and the frames
 //! to broadcast. [`LocalCore`] runs a `controller-core` [`Agent`](controller_core::Agent)
-//! in process; [`crate::hil::controller::HilController`] runs it on an emulated target
+//! in process; [`crate::engine::hil::controller::HilController`] runs it on an emulated target
 //! behind a UART. Remote controllers answer in two phases ([`AgentController::start_tick`],
 //! [`AgentController::finish_tick`]) so that several compute at once.
 
-use crate::hil::{HilError, LinkStats};
+use crate::engine::hil::{HilError, LinkStats};
+use crate::engine::radio::RadioFrame;
 use crate::model::CoreAgent;
-use crate::radio::RadioFrame;
 use controller_core::{FrameStats, Measurements, OwnedEstimate, StepOutput};
 
 /// One agent's controller, as seen by the sampled simulator.

@@ -7,8 +7,8 @@
 use super::link::{Link, LinkCounters, RecvError, TARGET_MT};
 use super::qemu::QemuProcess;
 use super::{HilError, LinkStats, When};
-use crate::controller::AgentController;
-use crate::radio::RadioFrame;
+use crate::engine::controller::AgentController;
+use crate::engine::radio::RadioFrame;
 use controller_core::link::{
     HostMsg, LinkBearing, LinkError, LinkOutput, LinkStep, TargetMsg, LINK_VERSION,
 };

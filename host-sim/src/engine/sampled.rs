@@ -1,18 +1,20 @@
 //! The sampled simulator (controllers at their rate with zero-order hold, frames over the
-//! radio model) and the run driver shared with [`crate::continuous`]: time loop,
+//! radio model) and the run driver shared with [`crate::engine::continuous`]: time loop,
 //! diagnostics cadence, logging, failure detection and the run's result.
 
-use crate::continuous::ContinuousSim;
-use crate::controller::{AgentController, LocalCore};
-use crate::diagnostics::{resolve_estimates, Diagnostics, EstimateInfo, Event, Monitor, Outcome};
-use crate::error::RunError;
-use crate::hil::{HilError, LinkStats};
+use crate::analysis::diagnostics::{
+    resolve_estimates, Diagnostics, EstimateInfo, Event, Monitor, Outcome,
+};
+use crate::engine::continuous::ContinuousSim;
+use crate::engine::controller::{AgentController, LocalCore};
+use crate::engine::hil::{HilError, LinkStats};
+use crate::engine::plant::Plant;
+use crate::engine::radio::{Radio, RadioFrame};
+use crate::engine::sensors::Sensors;
 use crate::model::Model;
-use crate::output::{Recorder, Row};
-use crate::plant::Plant;
-use crate::radio::{Radio, RadioFrame};
+use crate::report::csv::{Recorder, Row};
+use crate::scenario::error::RunError;
 use crate::scenario::{BearingRate, Estimator, Mode};
-use crate::sensors::Sensors;
 use controller_core::{BearingMeasurement, Fault, Measurements, Status, StepOutput, Vec2};
 use std::time::Instant;
 
@@ -367,7 +369,7 @@ impl Engine for SampledSim<'_> {
     }
 }
 
-/// Everything a run found (written to `summary.json` by [`crate::output`]).
+/// Everything a run found (written to `summary.json` by [`crate::report::csv`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct RunResult {
     /// How it ended.

@@ -1,11 +1,11 @@
 //! Outputs of a run (documented in `docs/outputs.md`): `timeseries.csv` (one row per
 //! log instant, written without allocating after the first row) and `summary.json`.
 
-use crate::diagnostics::{EstimateInfo, Snapshot};
-use crate::error::exit_code;
-use crate::hil::LinkStats;
+use crate::analysis::diagnostics::{EstimateInfo, Snapshot};
+use crate::engine::hil::LinkStats;
+use crate::engine::sampled::{FrameCounts, RunResult};
 use crate::model::Model;
-use crate::sim::{FrameCounts, RunResult};
+use crate::scenario::error::exit_code;
 use controller_core::Vec2;
 use serde_json::{json, Value};
 use std::fmt::Write as _;

@@ -1,11 +1,11 @@
 //! Scenario validation: every check names the file, the field and the reason, and
 //! resolves a [`ScenarioFile`] into a [`Model`].
 
-use crate::error::{ErrorKind, ScenarioError, ScenarioErrors};
-use crate::graph::{laman_order, Graph, LamanError};
+use crate::model::graph::{laman_order, Graph, LamanError};
 use crate::model::{
     AgentModel, AngleModel, LeaderModel, Model, RadioModel, SensorModel, TriangleModel, MT, NB,
 };
+use crate::scenario::error::{ErrorKind, ScenarioError, ScenarioErrors};
 use crate::scenario::{ScenarioFile, ScheduleSpec, Source};
 use controller_core::{Limits, Schedule, ScheduleStep, MAX_SCHEDULE_STEPS};
 use std::collections::HashMap;

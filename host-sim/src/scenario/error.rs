@@ -39,7 +39,7 @@ pub enum RunError {
     /// Setup or output failure (exit code [`exit_code::IO`]).
     Failed(String),
     /// A host-in-the-loop failure (its own exit code).
-    Hil(crate::hil::HilError),
+    Hil(crate::engine::hil::HilError),
 }
 
 impl RunError {
@@ -69,8 +69,8 @@ impl From<String> for RunError {
     }
 }
 
-impl From<crate::hil::HilError> for RunError {
-    fn from(e: crate::hil::HilError) -> Self {
+impl From<crate::engine::hil::HilError> for RunError {
+    fn from(e: crate::engine::hil::HilError) -> Self {
         Self::Hil(e)
     }
 }

@@ -68,14 +68,14 @@ const ABSURD: f64 = 1e100;
 /// Number of formation snapshots in `trajectories`.
 const SNAPSHOTS: usize = 5;
 /// The embedded font and its path, for the error message.
-const FONT_BYTES: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+const FONT_BYTES: &[u8] = include_bytes!("../../../assets/DejaVuSans.ttf");
 const FONT_ASSET: &str = "host-sim/assets/DejaVuSans.ttf";
 const FONT: &str = "sans-serif";
 
 /// Columns of `timeseries.csv` that every run must have (besides the
 /// per-agent, per-angle and per-estimate ones).
 const REQUIRED: [&str; 10] = {
-    let b = crate::output::BASE_COLUMNS;
+    let b = crate::report::csv::BASE_COLUMNS;
     [b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7], b[8], b[9]]
 };
 

@@ -276,7 +276,7 @@ impl Outcome {
 
     /// The process exit code.
     pub fn exit_code(self) -> u8 {
-        use crate::error::exit_code as x;
+        use crate::scenario::error::exit_code as x;
         match self {
             Outcome::Converged => x::CONVERGED,
             Outcome::Collision => x::COLLISION,

@@ -1,10 +1,14 @@
 //! The scenario file: its TOML schema (documented in `docs/scenarios.md`), the built-in
 //! scenarios embedded in the binary, loading and `--set key=value` overrides.
 //!
-//! This module only parses; [`crate::validate`] checks the meaning and resolves a
+//! This module only parses; [`crate::scenario::validate`] checks the meaning and resolves a
 //! [`ScenarioFile`] into a [`crate::model::Model`].
 
-use crate::error::{ErrorKind, ScenarioError};
+pub mod error;
+pub mod strip;
+pub mod validate;
+
+use crate::scenario::error::{ErrorKind, ScenarioError};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -24,17 +28,17 @@ pub const BUILTINS: &[Builtin] = &[
     Builtin {
         name: "paper",
         description: "SPEC §9 reference: c = 1000, d = 10, c_e = 1000, leader edge and v*, 100 s (converges)",
-        text: include_str!("../scenarios/paper.toml"),
+        text: include_str!("../../scenarios/paper.toml"),
     },
     Builtin {
         name: "paper-printed",
         description: "SPEC §9 with the printed gains c = 10, d = 1, c_e = 10 (fails: estimates collapse, agents collide)",
-        text: include_str!("../scenarios/paper-printed.toml"),
+        text: include_str!("../../scenarios/paper-printed.toml"),
     },
     Builtin {
         name: "formation-only",
         description: "SPEC §9 printed gains without maneuvers (no leader edge, v* = 0, D^v = 0; converges)",
-        text: include_str!("../scenarios/formation-only.toml"),
+        text: include_str!("../../scenarios/formation-only.toml"),
     },
 ];
 

@@ -1,0 +1,3 @@
+//! Analysis of the true state (placeholder, split later).
+
+pub mod diagnostics;

@@ -1,0 +1,4 @@
+//! Reports (placeholder).
+
+pub mod csv;
+pub mod plot;
