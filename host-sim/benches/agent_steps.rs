@@ -14,9 +14,9 @@
 #![allow(missing_docs)]
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use host_sim::engine::sampled::SampledSim;
-use host_sim::scenario::strip::strip_model;
-use host_sim::scenario::validate::load;
+use host_sim::engine::SampledSim;
+use host_sim::load;
+use host_sim::scenario::strip_model;
 use std::hint::black_box;
 use std::time::Duration;
 

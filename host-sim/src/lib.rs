@@ -20,9 +20,18 @@
 // `summary.json` is one large `serde_json::json!` literal.
 #![recursion_limit = "256"]
 
+pub use analysis::Outcome;
+pub use api::{load, load_toml, Error, Progress, Run, Simulation};
+pub use engine::{RunError, RunResult};
+pub use model::Model;
+pub use report::TimeSeries;
+pub use scenario::{ScenarioErrors, BUILTINS};
+
 pub mod analysis;
+mod api;
 pub mod cli;
 pub mod engine;
+pub mod exit_code;
 pub mod model;
 pub mod report;
 pub mod scenario;

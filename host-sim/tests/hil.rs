@@ -16,14 +16,11 @@
 //! The QEMU tests also serialize themselves (a lock), so that each one has the machine's
 //! cores to itself.
 
-use host_sim::cli::run_to_dir;
 use host_sim::engine::hil::fake::FakeBehaviour;
 use host_sim::engine::hil::{self, HilError, HilOptions, Launcher, When};
-use host_sim::engine::sampled::{self as sim, RunResult};
+use host_sim::engine::{self as sim, NullRecorder, RunResult};
 use host_sim::model::Model;
-use host_sim::report::csv::NullRecorder;
-use host_sim::scenario::error::{exit_code, RunError};
-use host_sim::scenario::validate::load;
+use host_sim::{exit_code, load, RunError, Simulation};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::sync::Mutex;
@@ -150,14 +147,14 @@ fn stand_in_run_is_deterministic_and_lock_step() {
     let mut csv = Vec::new();
     for k in 0..2 {
         let out = dir.path().join(format!("run{k}"));
-        let (r, _) = host_sim::cli::run_to_dir_with(
-            &m,
-            &out,
-            false,
-            true,
-            Some(&fake(&[2, 3], FakeBehaviour::default(), 10.0)),
-        )
-        .expect("run");
+        let options = fake(&[2, 3], FakeBehaviour::default(), 10.0);
+        let run = Simulation::new(&m)
+            .keep_series(false)
+            .write_to(&out, false)
+            .hil(&options)
+            .run()
+            .expect("run");
+        let r = &run.result;
         assert_eq!(r.hil.len(), 2);
         csv.push(std::fs::read(out.join("timeseries.csv")).expect("csv"));
         let s: serde_json::Value =
@@ -183,7 +180,10 @@ fn stand_in_run_is_deterministic_and_lock_step() {
     assert!(csv[0] == csv[1], "same seed, different CSV");
     // A pure-host summary has no wall-clock figures (same seed, same summary).
     let out = dir.path().join("host");
-    run_to_dir(&m, &out, false, true).expect("host run");
+    Simulation::new(&m)
+        .write_to(&out, false)
+        .run()
+        .expect("host run");
     let s: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).expect("json"))
             .expect("json");

@@ -2,13 +2,12 @@
 //! the radio), RK4 steps (sampled and continuous), diagnostics, failure monitor and CSV
 //! rows, once warmed up. A counting global allocator counts this thread's allocations.
 
-use host_sim::analysis::diagnostics::{Diagnostics, Monitor};
-use host_sim::engine::continuous::ContinuousSim;
-use host_sim::engine::sampled::{Engine, SampledSim};
+use host_sim::analysis::{Diagnostics, Monitor};
+use host_sim::engine::{ContinuousSim, Engine, Recorder, Row, SampledSim};
+use host_sim::load;
 use host_sim::model::Model;
-use host_sim::report::csv::{CsvRecorder, Recorder, Row};
-use host_sim::scenario::strip::strip_model;
-use host_sim::scenario::validate::load;
+use host_sim::report::CsvRecorder;
+use host_sim::scenario::strip_model;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 

@@ -1,6 +1,6 @@
 //! The plot module on a real (short) run and on broken inputs.
 
-use host_sim::report::plot::{plot_run, PlotError};
+use host_sim::report::{plot_run, PlotError};
 use std::path::Path;
 
 fn run_formation_only(dir: &Path) {

@@ -1,8 +1,8 @@
 //! Cost grows linearly in N: the time per agent-step of a 1,000-agent strip is within a
 //! small factor of a 100-agent strip's (quadratic cost would make it ~10× larger).
 
-use host_sim::engine::sampled::SampledSim;
-use host_sim::scenario::strip::strip_model;
+use host_sim::engine::SampledSim;
+use host_sim::scenario::strip_model;
 use std::time::Instant;
 
 /// Best-of-3 seconds per agent-step over `ticks` control periods.

@@ -1,14 +1,10 @@
 //! The built-in scenarios end as SPEC §9 says, continuous mode keeps V from increasing,
 //! the paper scenario survives a lossy, delayed radio, and runs are reproducible.
 
-use host_sim::analysis::diagnostics::Outcome;
-use host_sim::cli::run_to_dir;
-use host_sim::engine::sampled::{self as sim, RunResult};
-use host_sim::model::Model;
-use host_sim::report::csv::NullRecorder;
-use host_sim::scenario::strip::strip_model;
-use host_sim::scenario::validate::load;
-use host_sim::scenario::Mode;
+use host_sim::engine::{self as sim, NullRecorder, RunResult};
+use host_sim::model::{Mode, Model};
+use host_sim::scenario::strip_model;
+use host_sim::{load, Outcome, Simulation};
 
 fn model(name: &str, overrides: &[&str]) -> Model {
     let o: Vec<String> = overrides.iter().map(|s| (*s).to_owned()).collect();
@@ -193,7 +189,12 @@ fn same_seed_same_csv_other_seed_other_csv() {
         o.push(&s);
         let m = model("paper", &o);
         let out = dir.path().join(format!("run{k}"));
-        let (r, _) = run_to_dir(&m, &out, false, true).expect("run");
+        let run = Simulation::new(&m)
+            .keep_series(false)
+            .write_to(&out, false)
+            .run()
+            .expect("run");
+        let r = &run.result;
         assert!(r.frames.rejected > 0 && r.frames.dropped > 0);
         csv.push(std::fs::read(out.join("timeseries.csv")).expect("csv"));
         summaries.push(std::fs::read(out.join("summary.json")).expect("json"));

@@ -6,12 +6,13 @@
 //! agent (time = stage time, `dt = 0`, exact rates), pass every neighbour's data with
 //! `receive_direct`, then `evaluate` every agent for its force and estimate rates.
 
-use crate::analysis::diagnostics::{resolve_estimates, EstimateInfo};
-use crate::engine::plant::acceleration;
-use crate::engine::sampled::{ControlStats, Engine, FrameCounts};
-use crate::engine::sensors::Sensors;
-use crate::model::{CoreAgent, Model, SensorModel};
-use crate::scenario::{BearingRate, Estimator};
+use super::driver::Engine;
+use super::plant::acceleration;
+use super::sensors::Sensors;
+use super::stats::{ControlStats, FrameCounts};
+use crate::model::{
+    resolve_estimates, BearingRate, CoreAgent, EstimateInfo, Estimator, Model, SensorModel,
+};
 use controller_core::{law, BearingMeasurement, Fault, Measurements, Status, Vec2};
 
 /// `(&mut v[i], &v[j])` for `i ≠ j`.

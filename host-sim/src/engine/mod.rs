@@ -1,9 +1,30 @@
-//! The engine (placeholder).
+//! The engine: everything that moves during a run. The plant (S1, RK4), each agent's
+//! sensors, the radio between agents, the agents' controllers (in process, or as
+//! firmware in QEMU: [`hil`]), the sampled and continuous simulators, and the driver's
+//! time loop that advances them, consults [`crate::analysis`] and hands each logged
+//! instant to a [`Recorder`].
+//!
+//! It reads the [`crate::model::Model`] only: nothing here knows the scenario file, the
+//! reports or the command line (`docs/architecture.md`).
 
 pub mod continuous;
 pub mod controller;
+mod driver;
+mod error;
 pub mod hil;
 pub mod plant;
 pub mod radio;
+mod record;
+mod result;
 pub mod sampled;
 pub mod sensors;
+mod stats;
+
+pub use continuous::ContinuousSim;
+pub use controller::{AgentController, LocalCore};
+pub use driver::{drive, run, Engine};
+pub use error::RunError;
+pub use record::{NullRecorder, Recorder, Row};
+pub use result::RunResult;
+pub use sampled::SampledSim;
+pub use stats::{ControlStats, FrameCounts};

@@ -104,7 +104,7 @@ impl Sensors {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scenario::BearingRate;
+    use crate::model::BearingRate;
 
     #[test]
     fn ideal_bearing_is_exact() {

@@ -1,177 +1,27 @@
 //! A validated scenario, resolved to agent indices and SI units: what the simulator runs.
+//! The lowest layer: everything else speaks its vocabulary, and it imports no other
+//! layer (`docs/architecture.md`).
 //!
 //! Agents are referred to by index (their position in the scenario's `[[agents]]` list);
 //! `AgentModel::id` is the controller-core id used on the wire.
 
+mod core_config;
+mod criteria;
+mod devices;
+pub mod estimates;
+mod formation;
 pub mod graph;
+mod options;
 
-use crate::model::graph::Graph;
-use crate::scenario::{BearingRate, CriteriaSpec, Estimator, Mode};
-use controller_core::{
-    AgentConfig, AngleConfig, EstimatorMode, LeaderConfig, LeaderRole, Limits, Schedule,
-    TriangleConfig,
-};
+pub use core_config::{CoreAgent, MT, NB};
+pub use criteria::Criteria;
+pub use devices::{RadioModel, SensorModel};
+pub use estimates::{estimate_layout, resolve_estimates, EstimateInfo};
+pub use formation::{AgentModel, AngleModel, LeaderModel, TriangleModel};
+pub use graph::Graph;
+pub use options::{BearingRate, Estimator, Mode};
 
-/// Triangle capacity of one host agent (`MT` of `controller_core::Agent`).
-pub const MT: usize = 8;
-/// Neighbour capacity of one host agent (`NB` of `controller_core::Agent`).
-pub const NB: usize = 12;
-/// The controller-core agent the host simulates.
-pub type CoreAgent = controller_core::Agent<f64, MT, NB>;
-
-/// One agent's plant and initial state.
-#[derive(Clone, Debug, PartialEq)]
-pub struct AgentModel {
-    /// Wire id.
-    pub id: u8,
-    /// `q(0)`.
-    pub position: [f64; 2],
-    /// `v(0)`.
-    pub velocity: [f64; 2],
-    /// Mass.
-    pub mass: f64,
-    /// `D^r` (diagonal).
-    pub friction: [f64; 2],
-    /// `D^v` (diagonal).
-    pub velocity_damping: [f64; 2],
-}
-
-/// One controlled angle, by agent index.
-#[derive(Clone, Debug, PartialEq)]
-pub struct AngleModel {
-    /// Apex `u`.
-    pub apex: usize,
-    /// Far vertices `[v, w]`, in the triangle's vertex order (as controller-core orders
-    /// them: edge 0 is `u–v`, edge 1 is `u–w`).
-    pub far: [usize; 2],
-    /// `α*` (rad).
-    pub desired: f64,
-    /// `c_α`.
-    pub stiffness: f64,
-    /// `d_α`.
-    pub damping: f64,
-    /// `c_e`.
-    pub estimator_gain: f64,
-}
-
-/// One triangle, by agent index.
-#[derive(Clone, Debug, PartialEq)]
-pub struct TriangleModel {
-    /// The three vertices.
-    pub vertices: [usize; 3],
-    /// The two controlled angles.
-    pub angles: [AngleModel; 2],
-}
-
-/// The leader edge (S11), `z = q_a − q_b`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct LeaderModel {
-    /// Agent `a`.
-    pub a: usize,
-    /// Agent `b`.
-    pub b: usize,
-    /// `k_z`.
-    pub stiffness: f64,
-    /// `D_z` (diagonal).
-    pub damping: [f64; 2],
-    /// `z*(t)`.
-    pub displacement: Schedule<f64>,
-}
-
-/// Sensor imperfections, in SI units.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SensorModel {
-    /// Bearing angle noise standard deviation (rad).
-    pub bearing_noise: f64,
-    /// Bearing rotation bias (rad).
-    pub bearing_bias: f64,
-    /// Source of bearing rates.
-    pub bearing_rate: BearingRate,
-    /// Velocity noise standard deviation per component (m/s).
-    pub velocity_noise: f64,
-    /// Velocity bias (m/s).
-    pub velocity_bias: [f64; 2],
-    /// Leader relative-position noise per component (m).
-    pub offset_noise: f64,
-    /// Range noise (m).
-    pub range_noise: f64,
-}
-
-impl SensorModel {
-    /// No noise, no bias, the given rate source.
-    pub fn ideal(bearing_rate: BearingRate) -> Self {
-        Self {
-            bearing_noise: 0.0,
-            bearing_bias: 0.0,
-            bearing_rate,
-            velocity_noise: 0.0,
-            velocity_bias: [0.0; 2],
-            offset_noise: 0.0,
-            range_noise: 0.0,
-        }
-    }
-
-    /// Whether any noise or bias is configured.
-    pub fn is_noisy(&self) -> bool {
-        self.bearing_noise != 0.0
-            || self.bearing_bias != 0.0
-            || self.velocity_noise != 0.0
-            || self.velocity_bias != [0.0; 2]
-            || self.offset_noise != 0.0
-            || self.range_noise != 0.0
-    }
-}
-
-/// The radio link model, in SI units.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RadioModel {
-    /// Fixed latency (s).
-    pub latency: f64,
-    /// Uniform extra delay bound (s).
-    pub jitter: f64,
-    /// Loss probability per link copy.
-    pub loss: f64,
-    /// Duplication probability per link copy.
-    pub duplication: f64,
-    /// Reordering probability per link copy.
-    pub reordering: f64,
-    /// Largest extra delay of a reordered copy (s).
-    pub reorder_delay: f64,
-    /// Corruption (one bit flip) probability per link copy.
-    pub corruption: f64,
-    /// Sender air time in bytes/s (0 = unlimited).
-    pub bandwidth: f64,
-    /// Longest transmit-queue wait before a drop (s).
-    pub queue_limit: f64,
-}
-
-impl RadioModel {
-    /// A perfect radio (every frame delivered at the next tick).
-    pub fn ideal() -> Self {
-        Self {
-            latency: 0.0,
-            jitter: 0.0,
-            loss: 0.0,
-            duplication: 0.0,
-            reordering: 0.0,
-            reorder_delay: 0.0,
-            corruption: 0.0,
-            bandwidth: 0.0,
-            queue_limit: 0.05,
-        }
-    }
-
-    /// Whether any fault or delay is configured.
-    pub fn is_faulty(&self) -> bool {
-        self.latency != 0.0
-            || self.jitter != 0.0
-            || self.loss != 0.0
-            || self.duplication != 0.0
-            || self.reordering != 0.0
-            || self.corruption != 0.0
-            || self.bandwidth != 0.0
-    }
-}
+use controller_core::{Limits, Schedule};
 
 /// A validated, resolved scenario.
 #[derive(Clone, Debug, PartialEq)]
@@ -208,6 +58,7 @@ pub struct Model {
     pub triangles: Vec<TriangleModel>,
     /// The leader edge.
     pub leader: Option<LeaderModel>,
+
     /// `v*(t)`.
     pub velocity_reference: Schedule<f64>,
     /// Sensors.
@@ -215,7 +66,7 @@ pub struct Model {
     /// Radio.
     pub radio: RadioModel,
     /// Failure detection and convergence tolerances.
-    pub criteria: CriteriaSpec,
+    pub criteria: Criteria,
     /// Edges and neighbour lists.
     pub graph: Graph,
 }
@@ -262,15 +113,6 @@ impl Model {
         (self.duration / self.dt).round().max(0.0) as usize
     }
 
-    /// Core estimator mode.
-    pub fn estimator_mode(&self) -> EstimatorMode {
-        match self.estimator {
-            Estimator::Shared => EstimatorMode::Shared,
-            Estimator::PerAgent => EstimatorMode::PerAgent,
-            Estimator::Measured => EstimatorMode::Measured,
-        }
-    }
-
     /// Whether agent `i` is in triangle `t`.
     fn in_triangle(t: &TriangleModel, i: usize) -> bool {
         t.vertices.contains(&i)
@@ -284,65 +126,6 @@ impl Model {
             .enumerate()
             .filter(move |(_, t)| Self::in_triangle(t, i))
             .map(|(k, _)| k)
-    }
-
-    /// Agent `i`'s controller-core configuration. Fails only beyond the capacity `MT`.
-    pub fn agent_config(&self, i: usize) -> Result<AgentConfig<f64, MT>, String> {
-        let a = self
-            .agents
-            .get(i)
-            .ok_or_else(|| format!("no agent index {i}"))?;
-        let mut c = AgentConfig::new(a.id);
-        for k in self.triangles_of(i) {
-            let t = &self.triangles[k];
-            let ang = |m: &AngleModel| AngleConfig {
-                apex: self.agents[m.apex].id,
-                cos_desired: m.desired.cos(),
-                stiffness: m.stiffness,
-                damping: m.damping,
-                estimator_gain: m.estimator_gain,
-            };
-            let tc = TriangleConfig {
-                vertices: t.vertices.map(|v| self.agents[v].id),
-                angles: [ang(&t.angles[0]), ang(&t.angles[1])],
-            };
-            c.triangles.push(tc).map_err(|_| {
-                format!(
-                    "agent {} belongs to more than {MT} triangles (controller capacity)",
-                    a.id
-                )
-            })?;
-        }
-        c.estimator = self.estimator_mode();
-        c.initial_estimate = self.initial_estimate;
-        c.min_estimate = self.min_estimate;
-        c.friction = a.friction;
-        c.velocity_damping = a.velocity_damping;
-        c.velocity_reference = self.velocity_reference.clone();
-        c.limits = self.limits;
-        if let Some(l) = &self.leader {
-            let role = if l.a == i {
-                Some((LeaderRole::A, l.b))
-            } else if l.b == i {
-                Some((LeaderRole::B, l.a))
-            } else {
-                None
-            };
-            c.leader = role.map(|(role, p)| LeaderConfig {
-                role,
-                partner: self.agents[p].id,
-                stiffness: l.stiffness,
-                damping: l.damping,
-                displacement: l.displacement.clone(),
-            });
-        }
-        Ok(c)
-    }
-
-    /// Builds agent `i`'s controller-core agent.
-    pub fn core_agent(&self, i: usize) -> Result<CoreAgent, String> {
-        let c = self.agent_config(i)?;
-        CoreAgent::new(c).map_err(|e| format!("controller-core refused agent index {i}: {e:?}"))
     }
 
     /// `v*(t)`.

@@ -1,4 +1,17 @@
-//! Reports (placeholder).
+//! Reports of a run: the time series (`timeseries.csv`, or in memory), `summary.json`,
+//! the summary table and the figures (one file per figure under [`plot`]). They read
+//! what the engine produced and never drive a run (`docs/architecture.md`).
 
-pub mod csv;
+mod columns;
+mod csv;
 pub mod plot;
+mod series;
+mod summary;
+mod table;
+
+pub use columns::{for_each_cell, header, Cell, BASE_COLUMNS};
+pub use csv::CsvRecorder;
+pub use plot::{plot_run, PlotError};
+pub use series::TimeSeries;
+pub use summary::{summary_json, write_summary};
+pub use table::summary_table;

@@ -8,7 +8,7 @@
 
 use crate::model::graph::{strip_triangles, Graph};
 use crate::model::{AgentModel, AngleModel, Model, RadioModel, SensorModel, TriangleModel};
-use crate::scenario::{BearingRate, CriteriaSpec, Estimator, Mode};
+use crate::model::{BearingRate, Criteria, Estimator, Mode};
 use controller_core::{Limits, Schedule};
 
 /// A strip of `n ≥ 3` agents, printed-paper gains (c = 10, d = 1, c_e = 10), desired
@@ -69,7 +69,7 @@ pub fn strip_model(n: usize, duration: f64) -> Model {
         velocity_reference: Schedule::default(),
         sensors: SensorModel::ideal(BearingRate::FiniteDifference),
         radio: RadioModel::ideal(),
-        criteria: CriteriaSpec::default(),
+        criteria: Criteria::default(),
         graph: Graph::new(n, &tri, None),
     }
 }

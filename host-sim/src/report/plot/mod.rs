@@ -75,7 +75,7 @@ const FONT: &str = "sans-serif";
 /// Columns of `timeseries.csv` that every run must have (besides the
 /// per-agent, per-angle and per-estimate ones).
 const REQUIRED: [&str; 10] = {
-    let b = crate::report::csv::BASE_COLUMNS;
+    let b = crate::report::BASE_COLUMNS;
     [b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7], b[8], b[9]]
 };
 

@@ -1,0 +1,282 @@
+//! The failure monitor: watches the snapshots of a run for collision, estimate collapse
+//! and divergence (the run stops at a terminal failure), keeps the run's extremes, and
+//! gives the verdict at the end (`docs/outputs.md`, "Outcome").
+
+use super::outcome::{Event, Outcome};
+use super::snapshot::{Diagnostics, Snapshot};
+use crate::model::Model;
+
+/// Watches the snapshots of a run for failures and keeps the run's extremes.
+#[derive(Clone, Debug)]
+pub struct Monitor {
+    /// `V(0)`.
+    pub v0: Option<f64>,
+    run_min: f64,
+    epoch: usize,
+    /// Largest rise of `V` above its running minimum (reset when a reference switches).
+    pub max_rise: f64,
+    /// When the largest rise peaked.
+    pub max_rise_t: f64,
+    settle_candidate: Option<f64>,
+    /// Smallest estimate seen (`None` without estimates).
+    pub min_estimate: Option<f64>,
+    /// Smallest inter-agent distance seen, with time and pair.
+    pub min_distance: (f64, f64, usize, usize),
+    at_min_since: Vec<Option<f64>>,
+    collapsed: bool,
+    /// Failures detected, in order.
+    pub events: Vec<Event>,
+    /// A terminal failure (collision, divergence) has ended the run.
+    pub terminal: bool,
+}
+
+impl Monitor {
+    /// For `n_estimates` estimates.
+    pub fn new(n_estimates: usize) -> Self {
+        Self {
+            v0: None,
+            run_min: f64::INFINITY,
+            epoch: 0,
+            max_rise: 0.0,
+            max_rise_t: 0.0,
+            settle_candidate: None,
+            min_estimate: None,
+            min_distance: (f64::INFINITY, 0.0, 0, 0),
+            at_min_since: vec![None; n_estimates],
+            collapsed: false,
+            events: Vec::new(),
+            terminal: false,
+        }
+    }
+
+    /// The settle time: the first observed instant after which every angle error stayed
+    /// below the tolerance (`None` if the last one was above).
+    pub fn settle_time(&self) -> Option<f64> {
+        self.settle_candidate
+    }
+
+    /// Observes one snapshot and the estimates; returns `true` when the run must stop.
+    pub fn observe(&mut self, model: &Model, d: &Diagnostics, est: &[f64]) -> bool {
+        let s = &d.snap;
+        let cr = &model.criteria;
+        let name = |i: usize| model.agents.get(i).map_or(0, |a| a.id);
+        // V: its start, and its largest rise above the running minimum.
+        let epoch = model.schedule_epoch(s.t);
+        if self.v0.is_none() {
+            self.v0 = Some(s.v);
+        }
+        if epoch != self.epoch {
+            self.epoch = epoch;
+            self.run_min = f64::INFINITY;
+        }
+        if s.v.is_finite() {
+            self.run_min = self.run_min.min(s.v);
+            let rise = s.v - self.run_min;
+            if rise > self.max_rise {
+                self.max_rise = rise;
+                self.max_rise_t = s.t;
+            }
+        }
+        // Settling.
+        if s.max_angle_err < cr.angle_tolerance {
+            if self.settle_candidate.is_none() {
+                self.settle_candidate = Some(s.t);
+            }
+        } else {
+            self.settle_candidate = None;
+        }
+        // Extremes.
+        if s.min_dist < self.min_distance.0 {
+            self.min_distance = (s.min_dist, s.t, s.min_pair.0, s.min_pair.1);
+        }
+        for (k, &r) in est.iter().enumerate() {
+            self.min_estimate = Some(self.min_estimate.map_or(r, |m: f64| m.min(r)));
+            let held = r <= model.min_estimate * (1.0 + 1e-12);
+            let Some(since) = self.at_min_since.get_mut(k) else {
+                continue;
+            };
+            match (held, *since) {
+                (true, None) => *since = Some(s.t),
+                (false, _) => *since = None,
+                (true, Some(t0)) => {
+                    if !self.collapsed && s.t - t0 >= cr.collapse_time {
+                        self.collapse(model, d, k, t0);
+                    }
+                }
+            }
+        }
+        // Terminal failures.
+        if !s.finite {
+            return self.stop(
+                model,
+                d,
+                Outcome::Diverged,
+                "the state became non-finite (NaN or infinite)".to_owned(),
+            );
+        }
+        if s.max_speed > cr.divergence_speed {
+            return self.stop(
+                model,
+                d,
+                Outcome::Diverged,
+                format!(
+                    "an agent's speed reached {:.3e} m/s (> divergence_speed {} m/s)",
+                    s.max_speed, cr.divergence_speed
+                ),
+            );
+        }
+        let v_cap = cr.divergence_energy_factor * self.v0.unwrap_or(0.0).max(1.0);
+        if s.v.is_nan() || s.v > v_cap {
+            return self.stop(
+                model,
+                d,
+                Outcome::Diverged,
+                format!(
+                    "V reached {:.3e} (> {} × max(V(0), 1) = {:.3e})",
+                    s.v, cr.divergence_energy_factor, v_cap
+                ),
+            );
+        }
+        if s.min_dist < cr.collision_distance {
+            return self.stop(
+                model,
+                d,
+                Outcome::Collision,
+                format!(
+                    "agents {} and {} collided: distance {:.4} m < collision_distance {} m",
+                    name(s.min_pair.0),
+                    name(s.min_pair.1),
+                    s.min_dist,
+                    cr.collision_distance
+                ),
+            );
+        }
+        false
+    }
+
+    /// Records the collapse of estimate `k`, held at `r_min` since `t0`.
+    fn collapse(&mut self, model: &Model, d: &Diagnostics, k: usize, t0: f64) {
+        let name = |i: usize| model.agents.get(i).map_or(0, |a| a.id);
+        let s = &d.snap;
+        let Some(e) = d.estimates.get(k) else {
+            return;
+        };
+        self.collapsed = true;
+        let r_true = s.est_true.get(k).copied().unwrap_or(f64::NAN);
+        self.events.push(Event {
+            t: t0,
+            kind: Outcome::EstimateCollapse,
+            message: format!(
+                "estimate r̂ of edge {}–{} (owned by agent {}, angle at {} with other vertex {}) collapsed to r_min = {} m at t = {:.3} s and was still held there at t = {:.3} s (true distance then {:.3} m)",
+                name(e.apex),
+                name(e.far),
+                name(e.owner),
+                name(e.apex),
+                name(e.other),
+                model.min_estimate,
+                t0,
+                s.t,
+                r_true,
+            ),
+        });
+    }
+
+    /// Ends the run with a terminal failure. An estimate held at `r_min` at that moment
+    /// (for any time) is recorded first, as the likely cause.
+    fn stop(&mut self, model: &Model, d: &Diagnostics, kind: Outcome, message: String) -> bool {
+        if !self.collapsed {
+            let held = self
+                .at_min_since
+                .iter()
+                .enumerate()
+                .filter_map(|(k, s)| s.map(|t0| (k, t0)))
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            if let Some((k, t0)) = held {
+                self.collapse(model, d, k, t0);
+            }
+        }
+        let t = d.snap.t;
+        self.events.push(Event { t, kind, message });
+        self.terminal = true;
+        true
+    }
+
+    /// `max rise / V(0)` (0 when `V(0) = 0`).
+    pub fn v_max_increase_rel(&self) -> f64 {
+        match self.v0 {
+            Some(v0) if v0 > 0.0 => self.max_rise / v0,
+            _ => 0.0,
+        }
+    }
+
+    /// The outcome and its reason, given the last snapshot.
+    ///
+    /// A terminal failure preceded by an estimate collapse is reported as the collapse (the
+    /// cause); a collapse in a run that still converged is only an event.
+    pub fn verdict(&self, model: &Model, last: &Snapshot) -> (Outcome, String) {
+        let cr = &model.criteria;
+        let chain = || {
+            self.events
+                .iter()
+                .map(|e| format!("t = {:.3} s: {}", e.t, e.message))
+                .collect::<Vec<_>>()
+                .join("; then ")
+        };
+        let collapse = self
+            .events
+            .iter()
+            .find(|e| e.kind == Outcome::EstimateCollapse);
+        if self.terminal {
+            let kind = match (collapse, self.events.last()) {
+                (Some(c), Some(last)) if c.t <= last.t => Outcome::EstimateCollapse,
+                (_, Some(last)) => last.kind,
+                _ => Outcome::Diverged,
+            };
+            return (kind, chain());
+        }
+        let settled = self.settle_candidate.is_some();
+        let disp_ok = last.disp_err <= cr.displacement_tolerance;
+        let vel_ok = last.vel_err <= cr.velocity_tolerance;
+        if settled && disp_ok && vel_ok {
+            let mut why = format!(
+                "every angle error below {} rad from t = {:.3} s; final |z − z*| = {:.2e} m, max |v − v*| = {:.2e} m/s",
+                cr.angle_tolerance,
+                self.settle_candidate.unwrap_or(0.0),
+                last.disp_err,
+                last.vel_err
+            );
+            if !self.events.is_empty() {
+                why.push_str(&format!(" (despite: {})", chain()));
+            }
+            return (Outcome::Converged, why);
+        }
+        let mut missing = Vec::new();
+        if !settled {
+            missing.push(format!(
+                "max angle error {:.3e} rad ≥ {} rad",
+                last.max_angle_err, cr.angle_tolerance
+            ));
+        }
+        if !disp_ok {
+            missing.push(format!(
+                "|z − z*| = {:.3e} m > {} m",
+                last.disp_err, cr.displacement_tolerance
+            ));
+        }
+        if !vel_ok {
+            missing.push(format!(
+                "max |v − v*| = {:.3e} m/s > {} m/s",
+                last.vel_err, cr.velocity_tolerance
+            ));
+        }
+        let end = format!(
+            "not converged at t = {:.3} s: {}",
+            last.t,
+            missing.join(", ")
+        );
+        match collapse {
+            Some(_) => (Outcome::EstimateCollapse, format!("{}; {end}", chain())),
+            None => (Outcome::NotConverged, end),
+        }
+    }
+}

@@ -1,0 +1,140 @@
+//! Diagnostics of one instant (V and its terms S13, angle errors, estimates against true
+//! distances, maneuver errors, minimum distance), evaluated from the TRUE state, not
+//! from what the agents measured.
+
+use super::min_distance::MinDistance;
+use crate::model::{EstimateInfo, Model};
+use controller_core::{energy, Vec2};
+
+/// Everything the diagnostics know about one instant.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Snapshot {
+    /// Time (s).
+    pub t: f64,
+    /// `V` (S13).
+    pub v: f64,
+    /// Kinetic term `Σ ½ m |v − v*|²`.
+    pub v_kin: f64,
+    /// Angle term `Σ ½ c ỹ²`.
+    pub v_ang: f64,
+    /// Leader term `½ k_z |z̃|²`.
+    pub v_lead: f64,
+    /// Estimator term `Σ ½ c_e (r̂ − r)²`.
+    pub v_est: f64,
+    /// Signed angle errors `α − α*` (rad), model order (triangles, then angles).
+    pub angle_err: Vec<f64>,
+    /// `max |α − α*|`.
+    pub max_angle_err: f64,
+    /// True distances of the estimates, layout order.
+    pub est_true: Vec<f64>,
+    /// `|z − z*|` (0 without a leader edge).
+    pub disp_err: f64,
+    /// `max_n |v_n − v*|`.
+    pub vel_err: f64,
+    /// Smallest inter-agent distance.
+    pub min_dist: f64,
+    /// The closest pair (agent indices).
+    pub min_pair: (usize, usize),
+    /// Largest speed.
+    pub max_speed: f64,
+    /// Every position and velocity is finite.
+    pub finite: bool,
+}
+
+/// Evaluates [`Snapshot`]s without allocating.
+#[derive(Clone, Debug)]
+pub struct Diagnostics {
+    /// The estimates, in layout order.
+    pub estimates: Vec<EstimateInfo>,
+    /// The latest snapshot.
+    pub snap: Snapshot,
+    min_distance: MinDistance,
+}
+
+fn unit(d: Vec2<f64>) -> Vec2<f64> {
+    let n = d.norm();
+    if n > 0.0 {
+        d / n
+    } else {
+        Vec2::zeros()
+    }
+}
+
+impl Diagnostics {
+    /// For `model` with these estimates.
+    pub fn new(model: &Model, estimates: Vec<EstimateInfo>) -> Self {
+        let snap = Snapshot {
+            angle_err: vec![0.0; 2 * model.triangles.len()],
+            est_true: vec![0.0; estimates.len()],
+            ..Snapshot::default()
+        };
+        Self {
+            estimates,
+            snap,
+            min_distance: MinDistance::new(model.n()),
+        }
+    }
+
+    /// Evaluates the instant `t` with true positions `q`, velocities `v` and the current
+    /// estimate values `est` (layout order).
+    pub fn evaluate(
+        &mut self,
+        model: &Model,
+        t: f64,
+        q: &[Vec2<f64>],
+        v: &[Vec2<f64>],
+        est: &[f64],
+    ) {
+        let s = &mut self.snap;
+        s.t = t;
+        let vs = model.v_star(t);
+        let v_star = Vec2::new(vs[0], vs[1]);
+        s.v_kin = 0.0;
+        s.vel_err = 0.0;
+        s.max_speed = 0.0;
+        s.finite = true;
+        for ((a, qi), vi) in model.agents.iter().zip(q).zip(v) {
+            s.v_kin += energy::kinetic(a.mass, vi, &v_star);
+            s.vel_err = s.vel_err.max((vi - v_star).norm());
+            s.max_speed = s.max_speed.max(vi.norm());
+            s.finite &=
+                qi.x.is_finite() && qi.y.is_finite() && vi.x.is_finite() && vi.y.is_finite();
+        }
+        s.v_ang = 0.0;
+        s.max_angle_err = 0.0;
+        for (t_i, tri) in model.triangles.iter().enumerate() {
+            for (a_i, a) in tri.angles.iter().enumerate() {
+                let su = unit(q[a.far[0]] - q[a.apex]);
+                let sw = unit(q[a.far[1]] - q[a.apex]);
+                let y = su.dot(&sw);
+                s.v_ang += energy::angle(a.stiffness, y - a.desired.cos());
+                let err = y.clamp(-1.0, 1.0).acos() - a.desired;
+                if let Some(slot) = s.angle_err.get_mut(2 * t_i + a_i) {
+                    *slot = err;
+                }
+                // NaN propagates as "not settled".
+                s.max_angle_err = if err.is_nan() {
+                    f64::NAN
+                } else {
+                    s.max_angle_err.max(err.abs())
+                };
+            }
+        }
+        s.v_lead = 0.0;
+        s.disp_err = 0.0;
+        if let (Some(l), Some(zs)) = (&model.leader, model.z_star(t)) {
+            let zt = q[l.a] - q[l.b] - Vec2::new(zs[0], zs[1]);
+            s.v_lead = energy::leader(l.stiffness, &zt);
+            s.disp_err = zt.norm();
+        }
+        s.v_est = 0.0;
+        for ((e, r_hat), r_true) in self.estimates.iter().zip(est).zip(s.est_true.iter_mut()) {
+            *r_true = (q[e.apex] - q[e.far]).norm();
+            s.v_est += energy::estimate(e.gain, *r_hat, *r_true);
+        }
+        s.v = s.v_kin + s.v_ang + s.v_lead + s.v_est;
+        let (d, i, j) = self.min_distance.compute(q);
+        s.min_dist = d;
+        s.min_pair = (i, j);
+    }
+}

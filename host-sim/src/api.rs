@@ -1,0 +1,251 @@
+//! The library's front door, re-exported at the crate root: load a scenario, run it, read
+//! what it found. The command line is one client of it; sweeps and other tools are
+//! meant to be others.
+//!
+//! ```no_run
+//! # fn main() -> Result<(), host_sim::Error> {
+//! let model = host_sim::load("paper", &["radio.loss=0.1".to_owned()])?;
+//! let run = host_sim::Simulation::new(&model).run()?;
+//! println!("{}: {}", run.result.outcome, run.result.reason);
+//! let series = run.series.as_ref().expect("kept by default");
+//! let v = series.column("V").expect("column V");
+//! println!("V from {} to {}", v[0], v[v.len() - 1]);
+//! # Ok(())
+//! # }
+//! ```
+
+use crate::analysis::Outcome;
+use crate::engine::hil::{self, HilOptions};
+use crate::engine::{self, RunError, RunResult};
+use crate::exit_code;
+use crate::model::{estimate_layout, EstimateInfo, Model};
+use crate::report::{self, CsvRecorder, PlotError, TimeSeries};
+use crate::scenario::{self, ScenarioErrors, Source};
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// Loads a scenario: an existing file, else a built-in name (`host-sim list`), with
+/// `key=value` overrides applied before validation (`radio.loss=0.2`, `agents.0.mass=2`,
+/// as `--set`).
+pub fn load(scenario: &str, overrides: &[String]) -> Result<Model, ScenarioErrors> {
+    scenario::load(scenario, overrides)
+}
+
+/// Loads a scenario from TOML text (the schema of `docs/scenarios.md`); `name` labels
+/// errors and names the scenario when the text has no `name`.
+pub fn load_toml(text: &str, name: &str, overrides: &[String]) -> Result<Model, ScenarioErrors> {
+    let source = Source::from_text(name, text);
+    let file = source.parse(overrides)?;
+    scenario::validate(&file, &source.label, &source.default_name)
+}
+
+/// What stopped a library call: an invalid scenario, a run that could not finish, or an
+/// output that could not be written. Each has the exit code of `docs/outputs.md`.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Error {
+    /// The scenario is invalid (every problem found).
+    Scenario(ScenarioErrors),
+    /// The run stopped without a result.
+    Run(RunError),
+    /// An output file or directory could not be written.
+    Output(String),
+}
+
+impl Error {
+    /// The process exit code.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Self::Scenario(e) => e.exit_code(),
+            Self::Run(e) => e.exit_code(),
+            Self::Output(_) => exit_code::IO,
+        }
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Scenario(e) => e.fmt(f),
+            Self::Run(e) => e.fmt(f),
+            Self::Output(s) => f.write_str(s),
+        }
+    }
+}
+
+impl std::error::Error for Error {}
+
+impl From<ScenarioErrors> for Error {
+    fn from(e: ScenarioErrors) -> Self {
+        Self::Scenario(e)
+    }
+}
+
+impl From<RunError> for Error {
+    fn from(e: RunError) -> Self {
+        Self::Run(e)
+    }
+}
+
+/// Told how far a run has got, in simulated seconds; told once more when it is over
+/// (before any output is written). Any `FnMut(f64)` is one.
+pub trait Progress {
+    /// The run has simulated up to `t` (s).
+    fn update(&mut self, t: f64);
+    /// The simulation is over.
+    fn finish(&mut self) {}
+}
+
+impl<F: FnMut(f64)> Progress for F {
+    fn update(&mut self, t: f64) {
+        self(t);
+    }
+}
+
+/// A run to be made: by default in memory only, keeping the time series and writing no
+/// file.
+pub struct Simulation<'a> {
+    model: &'a Model,
+    keep_series: bool,
+    out: Option<(PathBuf, bool)>,
+    hil: Option<&'a HilOptions>,
+    progress: Option<&'a mut dyn Progress>,
+}
+
+impl<'a> Simulation<'a> {
+    /// A run of `model`.
+    pub fn new(model: &'a Model) -> Self {
+        Self {
+            model,
+            keep_series: true,
+            out: None,
+            hil: None,
+            progress: None,
+        }
+    }
+
+    /// Whether to keep the time series in memory ([`Run::series`]; default yes).
+    pub fn keep_series(mut self, keep: bool) -> Self {
+        self.keep_series = keep;
+        self
+    }
+
+    /// Also write `timeseries.csv` and `summary.json` into `dir` (created if needed), and
+    /// the figures if `plots`, as `host-sim run --out DIR` does.
+    pub fn write_to(mut self, dir: impl Into<PathBuf>, plots: bool) -> Self {
+        self.out = Some((dir.into(), plots));
+        self
+    }
+
+    /// Run some agents' controllers as firmware on emulated targets (`docs/hil.md`).
+    pub fn hil(mut self, options: &'a HilOptions) -> Self {
+        self.hil = Some(options);
+        self
+    }
+
+    /// Report progress to `progress`.
+    pub fn progress(mut self, progress: &'a mut dyn Progress) -> Self {
+        self.progress = Some(progress);
+        self
+    }
+
+    /// Runs to the end (or to a terminal failure: the outcome says which).
+    pub fn run(self) -> Result<Run, Error> {
+        let model = self.model;
+        if let Some((dir, _)) = &self.out {
+            std::fs::create_dir_all(dir).map_err(|e| {
+                Error::Output(format!(
+                    "cannot create output directory {}: {e}",
+                    dir.display()
+                ))
+            })?;
+        }
+        // The estimate layout (for the columns) comes from the agents' own configurations.
+        let estimates = estimate_layout(model).map_err(RunError::Failed)?;
+        let csv_path = self.out.as_ref().map(|(d, _)| d.join("timeseries.csv"));
+        let csv = match &csv_path {
+            Some(p) => Some(
+                CsvRecorder::create(p, model, &estimates)
+                    .map_err(|e| Error::Output(format!("cannot create {}: {e}", p.display())))?,
+            ),
+            None => None,
+        };
+        let series = self.keep_series.then(|| TimeSeries::new(model, &estimates));
+        let mut recorder = (csv, series);
+        let mut silent = |_: f64| {};
+        let progress: &mut dyn Progress = match self.progress {
+            Some(p) => p,
+            None => &mut silent,
+        };
+        let result = match self.hil {
+            Some(h) => hil::run(model, h, &mut recorder, &mut |t| progress.update(t)),
+            None => engine::run(model, &mut recorder, &mut |t| progress.update(t)),
+        };
+        progress.finish();
+        let result = result?;
+        let mut run = Run {
+            series: recorder.1,
+            result,
+            estimates,
+            files: Vec::new(),
+            plot_error: None,
+        };
+        if let (Some((dir, plots)), Some(csv_path)) = (&self.out, csv_path) {
+            run.write_outputs(model, dir, csv_path, *plots)?;
+        }
+        Ok(run)
+    }
+}
+
+/// What a run found.
+#[derive(Debug)]
+pub struct Run {
+    /// The outcome, its reason and every figure of `summary.json`.
+    pub result: RunResult,
+    /// The owned estimates, in the order of their columns.
+    pub estimates: Vec<EstimateInfo>,
+    /// Every logged row (when kept, see [`Simulation::keep_series`]).
+    pub series: Option<TimeSeries>,
+    /// The files written (see [`Simulation::write_to`]): `timeseries.csv`,
+    /// `summary.json`, then the figures.
+    pub files: Vec<PathBuf>,
+    /// Why the figures were not drawn (a failed plot does not fail the run).
+    pub plot_error: Option<PlotError>,
+}
+
+impl Run {
+    /// How the run ended.
+    pub fn outcome(&self) -> Outcome {
+        self.result.outcome
+    }
+
+    /// The exit code of `host-sim run` for this outcome.
+    pub fn exit_code(&self) -> u8 {
+        self.result.outcome.exit_code()
+    }
+
+    /// `summary.json` of this run of `model`.
+    pub fn summary_json(&self, model: &Model) -> serde_json::Value {
+        report::summary_json(model, &self.result, &self.estimates)
+    }
+
+    /// Writes `summary.json` next to the finished `timeseries.csv`, then the figures.
+    fn write_outputs(
+        &mut self,
+        model: &Model,
+        dir: &Path,
+        csv_path: PathBuf,
+        plots: bool,
+    ) -> Result<(), Error> {
+        let summary_path = dir.join("summary.json");
+        report::write_summary(&summary_path, &self.summary_json(model))
+            .map_err(|e| Error::Output(format!("cannot write {}: {e}", summary_path.display())))?;
+        self.files = vec![csv_path, summary_path];
+        if plots {
+            match report::plot_run(dir) {
+                Ok(p) => self.files.extend(p),
+                Err(e) => self.plot_error = Some(e),
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,179 @@
+//! The run driver shared by both simulators: the time loop (control ticks, RK4 steps),
+//! the diagnostics cadence (every control instant and every log instant), logging, and
+//! early stopping on a terminal failure found by [`crate::analysis::Monitor`].
+
+use super::continuous::ContinuousSim;
+use super::error::RunError;
+use super::hil::HilError;
+use super::record::{Recorder, Row};
+use super::result::RunResult;
+use super::sampled::SampledSim;
+use super::stats::{ControlStats, FrameCounts};
+use crate::analysis::{Diagnostics, Monitor};
+use crate::model::{EstimateInfo, Mode, Model};
+use controller_core::Vec2;
+use std::time::Instant;
+
+/// A simulation engine the driver advances: sampled or continuous.
+pub trait Engine {
+    /// Runs the controllers at a control instant `t` (sampled mode; no-op in continuous).
+    fn control(&mut self, t: f64);
+    /// Advances the state by one RK4 step from `t`.
+    fn integrate(&mut self, t: f64);
+    /// Refreshes the estimate values and returns `(q, v, estimates)`.
+    fn view(&mut self) -> (&[Vec2<f64>], &[Vec2<f64>], &[f64]);
+    /// The estimates' layout.
+    fn estimate_info(&self) -> &[EstimateInfo];
+    /// Frame counters so far.
+    fn frame_counts(&self) -> FrameCounts;
+    /// Controller counters so far.
+    fn control_stats(&self) -> ControlStats;
+    /// A controller failure that ends the run (a host-in-the-loop target that stopped
+    /// answering or sent a corrupt frame), taken once; checked after every
+    /// [`Self::control`].
+    fn take_error(&mut self) -> Option<HilError> {
+        None
+    }
+}
+
+fn signed_area(q: &[Vec2<f64>], t: [usize; 3]) -> f64 {
+    let a = q[t[1]] - q[t[0]];
+    let b = q[t[2]] - q[t[0]];
+    a.x * b.y - a.y * b.x
+}
+
+/// Runs `model` in its mode, logging rows to `recorder` and reporting the simulated time
+/// to `progress`.
+pub fn run(
+    model: &Model,
+    recorder: &mut dyn Recorder,
+    progress: &mut dyn FnMut(f64),
+) -> Result<RunResult, RunError> {
+    let mut warnings = Vec::new();
+    match model.mode {
+        Mode::Sampled => {
+            let mut e = SampledSim::new(model)?;
+            drive(model, &mut e, recorder, progress, warnings)
+        }
+        Mode::Continuous => {
+            if model.sensors.is_noisy() {
+                warnings.push(
+                    "continuous mode: sensor noise and bias are ignored (exact measurements)"
+                        .to_owned(),
+                );
+            }
+            if model.radio.is_faulty() {
+                warnings
+                    .push("continuous mode: the radio settings are ignored (no radio)".to_owned());
+            }
+            let mut e = ContinuousSim::new(model)?;
+            drive(model, &mut e, recorder, progress, warnings)
+        }
+    }
+}
+
+/// The time loop: control ticks, RK4 steps, diagnostics at every control instant and
+/// every log instant, logging, failure detection. A controller failure
+/// ([`Engine::take_error`]) ends it with [`RunError::Hil`].
+pub fn drive(
+    model: &Model,
+    engine: &mut dyn Engine,
+    recorder: &mut dyn Recorder,
+    progress: &mut dyn FnMut(f64),
+    warnings: Vec<String>,
+) -> Result<RunResult, RunError> {
+    let started = Instant::now();
+    let total = model.total_steps();
+    let spt = model.steps_per_tick.max(1);
+    let log_every = model.log_every.max(1);
+    let progress_every = (total / 200).max(1);
+    let mut diag = Diagnostics::new(model, engine.estimate_info().to_vec());
+    let mut monitor = Monitor::new(diag.estimates.len());
+    let tri: Vec<[usize; 3]> = model.triangles.iter().map(|t| t.vertices).collect();
+    let area0: Vec<f64> = {
+        let (q, _, _) = engine.view();
+        tri.iter().map(|&t| signed_area(q, t)).collect()
+    };
+    let mut steps = 0;
+    for k in 0..=total {
+        let t = model.time(k);
+        let tick = k.is_multiple_of(spt);
+        if tick {
+            engine.control(t);
+            if let Some(e) = engine.take_error() {
+                let _ = recorder.finish();
+                return Err(RunError::Hil(e));
+            }
+        }
+        let log = k.is_multiple_of(log_every) || k == total;
+        if tick || log {
+            let frames = engine.frame_counts();
+            let (q, v, est) = engine.view();
+            diag.evaluate(model, t, q, v, est);
+            let stop = monitor.observe(model, &diag, est);
+            if log || stop {
+                recorder
+                    .record(&Row {
+                        snap: &diag.snap,
+                        q,
+                        v,
+                        estimates: est,
+                        frames,
+                    })
+                    .map_err(|e| format!("cannot write the time series: {e}"))?;
+            }
+            if stop {
+                break;
+            }
+        }
+        if k == total {
+            break;
+        }
+        engine.integrate(t);
+        steps += 1;
+        if k.is_multiple_of(progress_every) {
+            progress(t);
+        }
+    }
+    recorder
+        .finish()
+        .map_err(|e| format!("cannot write the time series: {e}"))?;
+    progress(diag.snap.t);
+    let (q, v, est) = engine.view();
+    let (outcome, reason) = monitor.verdict(model, &diag.snap);
+    let s = &diag.snap;
+    Ok(RunResult {
+        outcome,
+        reason,
+        events: monitor.events.clone(),
+        final_time: s.t,
+        settle_time: monitor.settle_time(),
+        final_max_angle_error: s.max_angle_err,
+        final_displacement_error: s.disp_err,
+        final_velocity_error: s.vel_err,
+        min_estimate: monitor.min_estimate,
+        min_distance: monitor.min_distance,
+        v0: monitor.v0.unwrap_or(0.0),
+        v_final: s.v,
+        v_max_increase_rel: monitor.v_max_increase_rel(),
+        v_max_increase_t: monitor.max_rise_t,
+        final_positions: q.iter().map(|p| [p.x, p.y]).collect(),
+        final_velocities: v.iter().map(|p| [p.x, p.y]).collect(),
+        final_estimates: est
+            .iter()
+            .copied()
+            .zip(s.est_true.iter().copied())
+            .collect(),
+        orientation_kept: tri
+            .iter()
+            .zip(&area0)
+            .map(|(&t, &a0)| signed_area(q, t).signum() == a0.signum())
+            .collect(),
+        frames: engine.frame_counts(),
+        control: engine.control_stats(),
+        warnings,
+        steps,
+        wall_seconds: started.elapsed().as_secs_f64(),
+        hil: Vec::new(),
+    })
+}

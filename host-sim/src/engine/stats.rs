@@ -1,0 +1,76 @@
+//! Counters of a run: frames through the radio and what the controllers did.
+
+use controller_core::{Fault, Status};
+
+/// Cumulative frame counters of a run (link copies; see `docs/outputs.md`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FrameCounts {
+    /// Frames produced by the controllers (each broadcast counted once).
+    pub broadcasts: u64,
+    /// Link copies sent (one per receiver per broadcast).
+    pub sent: u64,
+    /// Copies that never arrived (loss or transmit-queue overflow).
+    pub dropped: u64,
+    /// Copies lost at random.
+    pub lost: u64,
+    /// Copies dropped by a full transmit queue (bandwidth limit).
+    pub queue_dropped: u64,
+    /// Extra copies made by duplication.
+    pub duplicated: u64,
+    /// Copies with a flipped bit.
+    pub corrupted: u64,
+    /// Copies delayed for reordering.
+    pub reordered: u64,
+    /// Copies handed to receivers.
+    pub delivered: u64,
+    /// Delivered copies the receivers' cores accepted.
+    pub accepted: u64,
+    /// Delivered copies the receivers' cores rejected (CRC, stale sequence, …).
+    pub rejected: u64,
+}
+
+/// What the controllers did over a run.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ControlStats {
+    /// Agent control ticks (sampled) or controller evaluations (continuous).
+    pub ticks: u64,
+    /// Of which produced the safe output.
+    pub safe: u64,
+    /// Safe outputs after `t = 0` (the first tick is always safe: nothing heard yet).
+    pub safe_after_start: u64,
+    /// Of which were saturated to `max_force`.
+    pub saturated: u64,
+    /// Of which reported a degenerate (near 0 or π) current angle.
+    pub degenerate: u64,
+    /// Largest commanded force norm.
+    pub max_force: f64,
+    /// The last fault after `t = 0`: time, agent index, fault.
+    pub last_fault: Option<(f64, usize, Fault)>,
+}
+
+impl ControlStats {
+    /// Counts one controller output at time `t` of agent `i`.
+    pub fn record(
+        &mut self,
+        t: f64,
+        i: usize,
+        status: Status,
+        saturated: bool,
+        degenerate: bool,
+        force: f64,
+    ) {
+        self.ticks += 1;
+        if let Status::Safe(f) = status {
+            self.safe += 1;
+            if t > 0.0 {
+                self.safe_after_start += 1;
+                self.last_fault = Some((t, i, f));
+            }
+        }
+        self.saturated += u64::from(saturated);
+        self.degenerate += u64::from(degenerate);
+        if force > self.max_force {
+            self.max_force = force;
+        }
+    }
+}

@@ -1,0 +1,38 @@
+//! When a run has failed or converged: the thresholds of the failure monitor.
+
+use serde::{Deserialize, Serialize};
+
+/// Failure detection and convergence tolerances (the scenario file's `[criteria]`, used
+/// as they are).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Criteria {
+    /// Two agents closer than this (m) have collided.
+    pub collision_distance: f64,
+    /// An estimate held at `r_min` for this long (s) has collapsed.
+    pub collapse_time: f64,
+    /// Any speed above this (m/s), or a non-finite state, is divergence.
+    pub divergence_speed: f64,
+    /// `V` above this multiple of `max(V(0), 1)` is divergence.
+    pub divergence_energy_factor: f64,
+    /// Every angle error below this (rad) counts as settled.
+    pub angle_tolerance: f64,
+    /// Final `|z − z*|` below this (m) counts as converged.
+    pub displacement_tolerance: f64,
+    /// Final `max_n |v_n − v*|` below this (m/s) counts as converged.
+    pub velocity_tolerance: f64,
+}
+
+impl Default for Criteria {
+    fn default() -> Self {
+        Self {
+            collision_distance: 0.05,
+            collapse_time: 0.25,
+            divergence_speed: 1e3,
+            divergence_energy_factor: 1e3,
+            angle_tolerance: 1e-3,
+            displacement_tolerance: 1e-2,
+            velocity_tolerance: 1e-2,
+        }
+    }
+}

@@ -1,0 +1,63 @@
+//! The formation, by agent index: the agents' plants and initial states, the triangles
+//! with their controlled angles, and the leader edge.
+
+use controller_core::Schedule;
+
+/// One agent's plant and initial state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AgentModel {
+    /// Wire id.
+    pub id: u8,
+    /// `q(0)`.
+    pub position: [f64; 2],
+    /// `v(0)`.
+    pub velocity: [f64; 2],
+    /// Mass.
+    pub mass: f64,
+    /// `D^r` (diagonal).
+    pub friction: [f64; 2],
+    /// `D^v` (diagonal).
+    pub velocity_damping: [f64; 2],
+}
+
+/// One controlled angle, by agent index.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AngleModel {
+    /// Apex `u`.
+    pub apex: usize,
+    /// Far vertices `[v, w]`, in the triangle's vertex order (as controller-core orders
+    /// them: edge 0 is `u–v`, edge 1 is `u–w`).
+    pub far: [usize; 2],
+    /// `α*` (rad).
+    pub desired: f64,
+    /// `c_α`.
+    pub stiffness: f64,
+    /// `d_α`.
+    pub damping: f64,
+    /// `c_e`.
+    pub estimator_gain: f64,
+}
+
+/// One triangle, by agent index.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TriangleModel {
+    /// The three vertices.
+    pub vertices: [usize; 3],
+    /// The two controlled angles.
+    pub angles: [AngleModel; 2],
+}
+
+/// The leader edge (S11), `z = q_a − q_b`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LeaderModel {
+    /// Agent `a`.
+    pub a: usize,
+    /// Agent `b`.
+    pub b: usize,
+    /// `k_z`.
+    pub stiffness: f64,
+    /// `D_z` (diagonal).
+    pub damping: [f64; 2],
+    /// `z*(t)`.
+    pub displacement: Schedule<f64>,
+}

@@ -1,0 +1,135 @@
+//! The run-wide sections of a scenario file: `[integration]`, `[controller]`,
+//! `[sensors]` and `[radio]`, with their defaults (`docs/scenarios.md`).
+
+use crate::model::{BearingRate, Estimator};
+use serde::{Deserialize, Serialize};
+
+/// `[integration]`: the plant integrator and the log.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Integration {
+    /// Fixed RK4 step (s).
+    pub dt: f64,
+    /// Simulated time between two logged rows of `timeseries.csv` (s).
+    pub log_interval: f64,
+}
+
+impl Default for Integration {
+    fn default() -> Self {
+        Self {
+            dt: 1e-3,
+            log_interval: 1e-2,
+        }
+    }
+}
+
+/// `[controller]`: what every agent's controller is configured with.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ControllerSpec {
+    /// Control rate (Hz); the period must be a whole number of RK4 steps.
+    pub rate_hz: f64,
+    /// Distance source.
+    pub estimator: Estimator,
+    /// `r̂(0)`.
+    pub initial_estimate: f64,
+    /// `r_min` of S10.
+    pub min_estimate: f64,
+    /// Force saturation (N).
+    pub max_force: f64,
+    /// A neighbour silent for longer than this (s) triggers the safe output.
+    pub neighbour_timeout: f64,
+    /// Safe output gain: `U = −safe_damping · v`.
+    pub safe_damping: f64,
+    /// Margin (degrees) that desired and current angles must keep from 0 and 180°.
+    pub angle_margin_deg: f64,
+}
+
+impl Default for ControllerSpec {
+    fn default() -> Self {
+        Self {
+            rate_hz: 100.0,
+            estimator: Estimator::Shared,
+            initial_estimate: 1.0,
+            min_estimate: 0.1,
+            max_force: 1e3,
+            neighbour_timeout: 0.1,
+            safe_damping: 1.0,
+            angle_margin_deg: 5.0,
+        }
+    }
+}
+
+/// `[sensors]`: what each agent's own sensors get wrong.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SensorSpec {
+    /// Standard deviation of the bearing angle noise (degrees).
+    pub bearing_noise_deg: f64,
+    /// Constant rotation added to every bearing (degrees).
+    pub bearing_bias_deg: f64,
+    /// Bearing rates: `finite_difference` or `exact`.
+    pub bearing_rate: BearingRate,
+    /// Standard deviation of each velocity component's noise (m/s).
+    pub velocity_noise: f64,
+    /// Constant velocity bias `[x, y]` (m/s).
+    pub velocity_bias: [f64; 2],
+    /// Standard deviation of each component of the leaders' relative-position noise (m).
+    pub offset_noise: f64,
+    /// Standard deviation of the range noise (m), `measured` estimator only.
+    pub range_noise: f64,
+}
+
+impl Default for SensorSpec {
+    fn default() -> Self {
+        Self {
+            bearing_noise_deg: 0.0,
+            bearing_bias_deg: 0.0,
+            bearing_rate: BearingRate::FiniteDifference,
+            velocity_noise: 0.0,
+            velocity_bias: [0.0, 0.0],
+            offset_noise: 0.0,
+            range_noise: 0.0,
+        }
+    }
+}
+
+/// `[radio]`: the link model between neighbours.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RadioSpec {
+    /// Fixed delivery latency (s).
+    pub latency: f64,
+    /// Extra delay, uniform in `[0, jitter]` (s).
+    pub jitter: f64,
+    /// Probability that one link copy of a frame is lost.
+    pub loss: f64,
+    /// Probability that a link copy is delivered twice.
+    pub duplication: f64,
+    /// Probability that a link copy is held back by an extra delay (reordering).
+    pub reordering: f64,
+    /// Largest extra delay of a reordered copy (s); default two control periods.
+    pub reorder_delay: Option<f64>,
+    /// Probability that a link copy has one random bit flipped.
+    pub corruption: f64,
+    /// Sender air-time limit in bytes per second (0 = unlimited).
+    pub bandwidth: f64,
+    /// Longest wait in a sender's transmit queue before a frame is dropped (s).
+    pub queue_limit: f64,
+}
+
+impl Default for RadioSpec {
+    fn default() -> Self {
+        Self {
+            latency: 0.0,
+            jitter: 0.0,
+            loss: 0.0,
+            duplication: 0.0,
+            reordering: 0.0,
+            reorder_delay: None,
+            corruption: 0.0,
+            bandwidth: 0.0,
+            queue_limit: 0.05,
+        }
+    }
+}

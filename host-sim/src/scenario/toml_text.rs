@@ -1,0 +1,120 @@
+//! Working on TOML text: setting a dotted key (`--set`) and telling where an error is
+//! (line, column, dotted field).
+
+pub(super) fn one_line(s: &str) -> String {
+    s.trim().replace('\n', " ")
+}
+
+/// Parses an override value as TOML (`0.2`, `"exact"`, `[1, 2]`, `true`), falling back to
+/// a bare string (`exact`).
+pub(super) fn parse_override_value(raw: &str) -> toml::Value {
+    let doc = format!("v = {raw}");
+    match toml::from_str::<toml::Table>(&doc) {
+        Ok(mut t) => t.remove("v").unwrap_or(toml::Value::String(raw.to_owned())),
+        Err(_) => toml::Value::String(raw.to_owned()),
+    }
+}
+
+pub(super) fn set_path(
+    root: &mut toml::Value,
+    key: &str,
+    value: toml::Value,
+) -> Result<(), String> {
+    let parts: Vec<&str> = key.split('.').collect();
+    if parts.iter().any(|p| p.is_empty()) {
+        return Err(format!("bad key `{key}`"));
+    }
+    let mut cur = root;
+    for (i, part) in parts.iter().enumerate() {
+        let last = i + 1 == parts.len();
+        cur = match cur {
+            toml::Value::Table(t) => {
+                if last {
+                    t.insert((*part).to_owned(), value);
+                    return Ok(());
+                }
+                t.entry((*part).to_owned())
+                    .or_insert_with(|| toml::Value::Table(toml::Table::new()))
+            }
+            toml::Value::Array(a) => {
+                let idx: usize = part
+                    .parse()
+                    .map_err(|_| format!("`{part}` in `{key}` must be an array index"))?;
+                let len = a.len();
+                let slot = a.get_mut(idx).ok_or_else(|| {
+                    format!("index {idx} in `{key}` is out of range (length {len})")
+                })?;
+                if last {
+                    *slot = value;
+                    return Ok(());
+                }
+                slot
+            }
+            _ => {
+                return Err(format!(
+                    "`{part}` in `{key}` is inside a value that is not a table"
+                ))
+            }
+        };
+    }
+    Ok(())
+}
+
+/// 1-based line and column of byte offset `pos`.
+pub(super) fn line_col(text: &str, pos: usize) -> (usize, usize) {
+    let before = text.get(..pos).unwrap_or(text);
+    let line = before.matches('\n').count() + 1;
+    let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, col)
+}
+
+/// Best guess of the dotted key at byte offset `pos`: the last table header before it
+/// (with its index for an array of tables, `agents[2]`) and the key on its line.
+pub(super) fn field_at(text: &str, pos: usize) -> String {
+    let before = text.get(..pos).unwrap_or(text);
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    let line_end = text
+        .get(pos..)
+        .and_then(|r| r.find('\n'))
+        .map_or(text.len(), |i| pos + i);
+    let line = text.get(line_start..line_end).unwrap_or("").trim();
+    // `[name]` → ("name", false); `[[name]]` → ("name", true).
+    let header_of = |l: &str| -> Option<(String, bool)> {
+        let l = l.trim();
+        let array = l.starts_with("[[");
+        let inner = l.strip_prefix('[')?.trim_start_matches('[');
+        let end = inner.find(']')?;
+        Some((inner.get(..end)?.trim().to_owned(), array))
+    };
+    let head = text.get(..line_end).unwrap_or("");
+    let named = |name: &str, array: bool| -> String {
+        if !array {
+            return name.to_owned();
+        }
+        let count = head
+            .lines()
+            .filter(|l| header_of(l).is_some_and(|(n, a)| a && n == name))
+            .count();
+        format!("{name}[{}]", count.saturating_sub(1))
+    };
+    if let Some((h, array)) = header_of(line) {
+        return named(&h, array);
+    }
+    let section = text
+        .get(..line_start)
+        .unwrap_or("")
+        .lines()
+        .rev()
+        .find_map(header_of)
+        .map(|(h, array)| named(&h, array))
+        .unwrap_or_default();
+    let key = line
+        .split_once('=')
+        .map(|(k, _)| k.trim().to_owned())
+        .unwrap_or_default();
+    match (section.is_empty(), key.is_empty()) {
+        (true, _) => key,
+        (false, true) => section,
+        (false, false) => format!("{section}.{key}"),
+    }
+}

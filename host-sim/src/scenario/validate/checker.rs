@@ -1,0 +1,118 @@
+//! The error collector every check writes to, and the small checks they share.
+
+use crate::scenario::error::{ErrorKind, ScenarioError};
+use crate::scenario::ScheduleSpec;
+use controller_core::{Schedule, ScheduleStep, MAX_SCHEDULE_STEPS};
+
+/// Collects errors while checking.
+pub(super) struct Checker<'a> {
+    pub(super) file: &'a str,
+    pub(super) errors: Vec<ScenarioError>,
+}
+
+impl Checker<'_> {
+    pub(super) fn err(&mut self, kind: ErrorKind, field: &str, reason: impl Into<String>) {
+        self.errors
+            .push(ScenarioError::new(kind, self.file, field, reason));
+    }
+
+    /// `x` finite and `> 0`.
+    pub(super) fn positive(&mut self, kind: ErrorKind, field: &str, x: f64) {
+        if !(x.is_finite() && x > 0.0) {
+            self.err(kind, field, format!("must be a finite number > 0, got {x}"));
+        }
+    }
+
+    /// `x` finite and `≥ 0`.
+    pub(super) fn non_negative(&mut self, kind: ErrorKind, field: &str, x: f64) {
+        if !(x.is_finite() && x >= 0.0) {
+            self.err(kind, field, format!("must be a finite number ≥ 0, got {x}"));
+        }
+    }
+
+    pub(super) fn probability(&mut self, field: &str, p: f64) {
+        if !(p.is_finite() && (0.0..=1.0).contains(&p)) {
+            self.err(
+                ErrorKind::InvalidValue,
+                field,
+                format!("must be a probability in [0, 1], got {p}"),
+            );
+        }
+    }
+
+    pub(super) fn finite2(&mut self, field: &str, v: [f64; 2]) {
+        if !(v[0].is_finite() && v[1].is_finite()) {
+            self.err(
+                ErrorKind::InvalidValue,
+                field,
+                format!("must be two finite numbers, got {v:?}"),
+            );
+        }
+    }
+
+    pub(super) fn schedule(&mut self, field: &str, s: &ScheduleSpec) -> Schedule<f64> {
+        let steps = s.steps();
+        let mut out = Schedule::default();
+        if steps.len() > MAX_SCHEDULE_STEPS {
+            self.err(
+                ErrorKind::InvalidValue,
+                field,
+                format!(
+                    "has {} steps; the controller holds at most {MAX_SCHEDULE_STEPS}",
+                    steps.len()
+                ),
+            );
+        }
+        let mut prev = f64::NEG_INFINITY;
+        for (k, st) in steps.iter().enumerate() {
+            let f = format!("{field}[{k}]");
+            if !(st.from.is_finite() && st.from >= 0.0) {
+                self.err(
+                    ErrorKind::InvalidValue,
+                    &format!("{f}.from"),
+                    format!("must be a finite time ≥ 0, got {}", st.from),
+                );
+            } else if st.from <= prev {
+                self.err(
+                    ErrorKind::InvalidValue,
+                    &format!("{f}.from"),
+                    "steps must be sorted by strictly increasing `from`",
+                );
+            }
+            prev = st.from;
+            self.finite2(&format!("{f}.value"), st.value);
+            let _ = out.steps.push(ScheduleStep {
+                from: st.from,
+                value: st.value,
+            });
+        }
+        out
+    }
+}
+
+/// Largest number of RK4 steps of one run.
+pub(super) const MAX_STEPS: f64 = 1e12;
+
+/// How many whole `dt` steps make `interval`, if it is a whole multiple.
+pub(super) fn whole_steps(interval: f64, dt: f64) -> Option<usize> {
+    let k = (interval / dt).round();
+    if k >= 1.0 && ((k * dt - interval).abs() <= 1e-9 * interval.max(dt)) {
+        Some(k as usize)
+    } else {
+        None
+    }
+}
+
+/// Interior angle at `p` of the triangle `p, a, b` (rad); NaN for coincident points.
+pub(super) fn interior_angle(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let u = [a[0] - p[0], a[1] - p[1]];
+    let w = [b[0] - p[0], b[1] - p[1]];
+    let nu = u[0].hypot(u[1]);
+    let nw = w[0].hypot(w[1]);
+    if nu == 0.0 || nw == 0.0 {
+        return f64::NAN;
+    }
+    ((u[0] * w[0] + u[1] * w[1]) / (nu * nw))
+        .clamp(-1.0, 1.0)
+        .acos()
+}

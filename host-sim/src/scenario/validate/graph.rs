@@ -1,0 +1,121 @@
+//! The graph: triangulated Laman (SPEC §3), no (nearly) collinear initial triangle, and
+//! every agent within the controller's capacity.
+
+use super::agents::agent_id;
+use super::checker::{interior_angle, Checker};
+use crate::model::graph::{laman_order, Graph, LamanError};
+use crate::model::{AgentModel, TriangleModel, MT, NB};
+use crate::scenario::error::ErrorKind::{self, InvalidValue};
+use crate::scenario::ScenarioFile;
+use std::f64::consts::PI;
+
+/// Checks that the triangles form a triangulated Laman graph and none is (nearly)
+/// collinear at the start (only when every id resolved: `ids_ok`).
+pub(super) fn check(
+    c: &mut Checker<'_>,
+    s: &ScenarioFile,
+    agents: &[AgentModel],
+    triangles: &[TriangleModel],
+    ids_ok: bool,
+    margin: f64,
+) {
+    let tri_idx: Vec<[usize; 3]> = triangles.iter().map(|t| t.vertices).collect();
+    let n = agents.len();
+    let id_of = |i: usize| agent_id(agents, i);
+    if ids_ok && n >= 3 && c.errors.iter().all(|e| e.kind != ErrorKind::DuplicateId) {
+        if let Err(e) = laman_order(n, &tri_idx) {
+            let (field, reason) = match e {
+                LamanError::Empty => (
+                    "triangles".to_owned(),
+                    "no triangles: the graph must be built from triangles".to_owned(),
+                ),
+                LamanError::Isolated(i) => (
+                    format!("agents[{i}]"),
+                    format!("agent {} belongs to no triangle", id_of(i)),
+                ),
+                LamanError::Count { agents, triangles } => (
+                    "triangles".to_owned(),
+                    format!(
+                        "{agents} agents need exactly {} triangles (N = M + 2), got {triangles}",
+                        agents.saturating_sub(2)
+                    ),
+                ),
+                LamanError::Unattached(rest) => {
+                    let first = rest.first().copied().unwrap_or(0);
+                    (
+                        format!("triangles[{first}]"),
+                        format!(
+                            "triangle {:?} does not join exactly one new agent to an edge of the triangles before it (triangles {:?} cannot be attached)",
+                            s.triangles.get(first).map(|t| t.vertices).unwrap_or_default(),
+                            rest
+                        ),
+                    )
+                }
+            };
+            c.err(ErrorKind::NotLaman, &field, reason);
+        }
+        // ---- collinear initial triangles
+        for (ti, t) in triangles.iter().enumerate() {
+            let p = t.vertices.map(|v| agents[v].position);
+            for k in 0..3 {
+                let ang = interior_angle(p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
+                if !(ang > margin && ang < PI - margin) {
+                    let what = if ang.is_nan() {
+                        "two vertices coincide".to_owned()
+                    } else {
+                        format!(
+                            "the angle at agent {} is {:.3}°, within the {:.1}° margin of 0 or 180°",
+                            id_of(t.vertices[k]),
+                            ang.to_degrees(),
+                            margin.to_degrees()
+                        )
+                    };
+                    c.err(
+                        ErrorKind::CollinearTriangle,
+                        &format!("triangles[{ti}]"),
+                        format!(
+                            "triangle {:?} is (nearly) collinear in the initial positions: {what}",
+                            t.vertices.map(id_of)
+                        ),
+                    );
+                    break;
+                }
+            }
+        }
+    }
+}
+
+/// Checks every agent's triangles and radio neighbours against the controller's
+/// capacity (`MT`, `NB`).
+pub(super) fn capacity(
+    c: &mut Checker<'_>,
+    agents: &[AgentModel],
+    graph: &Graph,
+    tri_idx: &[[usize; 3]],
+) {
+    let id_of = |i: usize| agent_id(agents, i);
+    for i in 0..agents.len() {
+        let tris = tri_idx.iter().filter(|t| t.contains(&i)).count();
+        if tris > MT {
+            c.err(
+                InvalidValue,
+                &format!("agents[{i}]"),
+                format!(
+                    "agent {} belongs to {tris} triangles; the controller holds at most {MT}",
+                    id_of(i)
+                ),
+            );
+        }
+        if graph.radio.of(i).len() > NB {
+            c.err(
+                InvalidValue,
+                &format!("agents[{i}]"),
+                format!(
+                    "agent {} has {} neighbours; the controller holds at most {NB}",
+                    id_of(i),
+                    graph.radio.of(i).len()
+                ),
+            );
+        }
+    }
+}

@@ -1,0 +1,115 @@
+//! Scenario validation: every check names the file, the field and the reason, and
+//! resolves a [`ScenarioFile`] into a [`Model`]. The checks run in the order of the
+//! file's sections (errors are reported in that order; the first one's kind gives the
+//! exit code).
+
+mod agents;
+mod checker;
+mod graph;
+mod references;
+mod settings;
+mod triangles;
+
+use crate::model::{Graph, Model, RadioModel, SensorModel};
+use crate::scenario::error::{ErrorKind::InvalidValue, ScenarioError, ScenarioErrors};
+use crate::scenario::ScenarioFile;
+use checker::Checker;
+use controller_core::Limits;
+
+/// Validates a parsed scenario file. `file` labels errors; `default_name` is used when the
+/// file has no `name`.
+pub fn validate(s: &ScenarioFile, file: &str, default_name: &str) -> Result<Model, ScenarioErrors> {
+    let mut c = Checker {
+        file,
+        errors: Vec::new(),
+    };
+    let settings::Timing {
+        dt,
+        steps_per_tick,
+        log_every,
+        margin,
+        reorder_delay,
+    } = settings::check(&mut c, s);
+    let (agents, index) = agents::check(&mut c, s);
+    let (triangles, ids_ok) = triangles::check(&mut c, s, &index, margin);
+    graph::check(&mut c, s, &agents, &triangles, ids_ok, margin);
+    let leader = references::leader(&mut c, s, &index);
+    let velocity_reference = c.schedule("velocity_reference", &s.velocity_reference);
+    let tri_idx: Vec<[usize; 3]> = triangles.iter().map(|t| t.vertices).collect();
+    let graph = Graph::new(agents.len(), &tri_idx, leader.as_ref().map(|l| [l.a, l.b]));
+    graph::capacity(&mut c, &agents, &graph, &tri_idx);
+
+    if !c.errors.is_empty() {
+        // A default gain used by several angles is reported once.
+        let mut seen = std::collections::HashSet::new();
+        c.errors.retain(|e| seen.insert(e.to_string()));
+        return Err(ScenarioErrors(c.errors));
+    }
+
+    let (ctl, se, ra) = (&s.controller, &s.sensors, &s.radio);
+    let limits = Limits {
+        max_force: ctl.max_force,
+        neighbour_timeout: ctl.neighbour_timeout,
+        safe_damping: ctl.safe_damping,
+        margin_cos: margin.cos(),
+        ..Limits::default()
+    };
+    let model = Model {
+        name: s.name.clone().unwrap_or_else(|| default_name.to_owned()),
+        source: file.to_owned(),
+        description: s.description.clone().unwrap_or_default(),
+        duration: s.duration,
+        seed: s.seed,
+        mode: s.mode,
+        dt,
+        log_every,
+        steps_per_tick,
+        estimator: ctl.estimator,
+        initial_estimate: ctl.initial_estimate,
+        min_estimate: ctl.min_estimate,
+        limits,
+        agents,
+        triangles,
+        leader,
+        velocity_reference,
+        sensors: SensorModel {
+            bearing_noise: se.bearing_noise_deg.to_radians(),
+            bearing_bias: se.bearing_bias_deg.to_radians(),
+            bearing_rate: se.bearing_rate,
+            velocity_noise: se.velocity_noise,
+            velocity_bias: se.velocity_bias,
+            offset_noise: se.offset_noise,
+            range_noise: se.range_noise,
+        },
+        radio: RadioModel {
+            latency: ra.latency,
+            jitter: ra.jitter,
+            loss: ra.loss,
+            duplication: ra.duplication,
+            reordering: ra.reordering,
+            reorder_delay,
+            corruption: ra.corruption,
+            bandwidth: ra.bandwidth,
+            queue_limit: ra.queue_limit,
+        },
+        criteria: s.criteria.clone(),
+        graph,
+    };
+    // Last line of defence: the core's own checks (should agree with the above).
+    let mut core_errors = Vec::new();
+    for i in 0..model.n() {
+        if let Err(e) = model.core_agent(i) {
+            core_errors.push(ScenarioError::new(
+                InvalidValue,
+                file,
+                &format!("agents[{i}]"),
+                e,
+            ));
+        }
+    }
+    if core_errors.is_empty() {
+        Ok(model)
+    } else {
+        Err(ScenarioErrors(core_errors))
+    }
+}
