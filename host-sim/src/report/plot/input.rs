@@ -1,0 +1,392 @@
+//! Reading a run directory: the fields of `summary.json` the figures use and the
+//! columns of `timeseries.csv` they draw, thinned while reading (two passes: count the
+//! rows, then keep an evenly spaced subset).
+
+use super::thinning::{spread, Thinning};
+use super::{PlotError, MAX_AGENT_PATHS, MAX_ANGLES, MAX_ESTIMATES, REQUIRED};
+use serde::Deserialize;
+use std::collections::HashMap;
+use std::fs::File;
+use std::io::BufReader;
+use std::path::Path;
+
+// ---------------------------------------------------------------------------
+// Input
+
+/// The fields of `summary.json` the plots use.
+#[derive(Debug, Deserialize)]
+pub(super) struct Summary {
+    pub(super) scenario: String,
+    pub(super) outcome: String,
+    #[serde(default)]
+    pub(super) outcome_reason: Option<String>,
+    pub(super) agents: Vec<i64>,
+    pub(super) edges: Vec<[i64; 2]>,
+    #[serde(default)]
+    pub(super) leaders: Option<[i64; 2]>,
+    #[serde(default)]
+    pub(super) mode: Option<serde_json::Value>,
+    #[serde(default)]
+    pub(super) estimator: Option<serde_json::Value>,
+}
+
+/// A labelled series aligned with [`Run::t`].
+pub(super) struct Named {
+    pub(super) label: String,
+    pub(super) values: Vec<f64>,
+}
+
+/// The kept path of one agent, aligned with [`Run::t`].
+pub(super) struct AgentPath {
+    pub(super) agent: usize,
+    pub(super) x: Vec<f64>,
+    pub(super) y: Vec<f64>,
+}
+
+/// All agent positions at one time.
+pub(super) struct Snapshot {
+    pub(super) t: f64,
+    pub(super) pos: Vec<(f64, f64)>,
+}
+
+/// One estimate and its true value, aligned with [`Run::t`].
+pub(super) struct Estimate {
+    pub(super) label: String,
+    pub(super) rhat: Vec<f64>,
+    pub(super) r: Vec<f64>,
+}
+
+/// Everything the figures draw, downsampled.
+pub(super) struct Run {
+    pub(super) summary: Summary,
+    /// Time of each kept row.
+    pub(super) t: Vec<f64>,
+    /// `V`, `V_kin`, `V_ang`, `V_lead`, `V_est`.
+    pub(super) energy: Vec<Named>,
+    pub(super) max_angle_err: Vec<f64>,
+    pub(super) disp_err: Vec<f64>,
+    pub(super) vel_err: Vec<f64>,
+    pub(super) min_dist: Vec<f64>,
+    /// Agent ids (as in the column names) in agent order.
+    pub(super) agent_ids: Vec<String>,
+    /// Indices into `agent_ids`.
+    pub(super) leaders: Vec<usize>,
+    /// Graph edges as index pairs into `agent_ids` (unknown ids dropped).
+    pub(super) edges: Vec<(usize, usize)>,
+    pub(super) paths: Vec<AgentPath>,
+    pub(super) snapshots: Vec<Snapshot>,
+    pub(super) angles: Vec<Named>,
+    pub(super) n_angles: usize,
+    pub(super) estimates: Vec<Estimate>,
+    pub(super) n_estimates: usize,
+}
+
+/// Column indices of the CSV header, by name.
+pub(super) struct Header<'a> {
+    pub(super) path: &'a Path,
+    pub(super) names: Vec<String>,
+    pub(super) index: HashMap<String, usize>,
+}
+
+impl Header<'_> {
+    pub(super) fn require(&self, column: &str) -> Result<usize, PlotError> {
+        self.index
+            .get(column)
+            .copied()
+            .ok_or_else(|| PlotError::MissingColumn {
+                path: self.path.to_path_buf(),
+                column: column.to_string(),
+            })
+    }
+
+    /// `(column index, suffix)` of every column whose name starts with
+    /// `prefix`, in column order.
+    pub(super) fn with_prefix(&self, prefix: &str) -> Vec<(usize, String)> {
+        self.names
+            .iter()
+            .enumerate()
+            .filter_map(|(i, n)| n.strip_prefix(prefix).map(|s| (i, s.to_string())))
+            .collect()
+    }
+}
+
+/// Downsampled columns being collected: `data[k]` holds the kept values of
+/// CSV column `src[k]`.
+#[derive(Default)]
+pub(super) struct Columns {
+    pub(super) src: Vec<usize>,
+    pub(super) data: Vec<Vec<f64>>,
+}
+
+impl Columns {
+    pub(super) fn add(&mut self, column: usize) -> usize {
+        self.src.push(column);
+        self.data.push(Vec::new());
+        self.src.len() - 1
+    }
+
+    pub(super) fn take(&mut self, slot: usize) -> Vec<f64> {
+        std::mem::take(&mut self.data[slot])
+    }
+}
+
+pub(super) fn open_csv(path: &Path) -> Result<csv::Reader<File>, PlotError> {
+    let file = File::open(path).map_err(|source| PlotError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    Ok(csv::ReaderBuilder::new()
+        .has_headers(true)
+        .from_reader(file))
+}
+
+/// Parses one field: empty → NaN; a number (including `NaN`/`inf`) → it;
+/// anything else → [`PlotError::BadValue`].
+pub(super) fn field(
+    rec: &csv::ByteRecord,
+    col: usize,
+    header: &Header<'_>,
+) -> Result<f64, PlotError> {
+    let raw = rec.get(col).unwrap_or(b"");
+    let text = String::from_utf8_lossy(raw);
+    let text = text.trim();
+    if text.is_empty() {
+        return Ok(f64::NAN);
+    }
+    text.parse::<f64>().map_err(|_| PlotError::BadValue {
+        path: header.path.to_path_buf(),
+        line: rec.position().map_or(0, |p| p.line()),
+        column: header.names.get(col).cloned().unwrap_or_default(),
+        value: text.chars().take(40).collect(),
+    })
+}
+
+pub(super) fn load_summary(path: &Path) -> Result<Summary, PlotError> {
+    let file = File::open(path).map_err(|source| PlotError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    serde_json::from_reader(BufReader::new(file)).map_err(|source| PlotError::Json {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+pub(super) fn load_run(dir: &Path) -> Result<Run, PlotError> {
+    let summary = load_summary(&dir.join("summary.json"))?;
+    let csv_path = dir.join("timeseries.csv");
+    let csv_err = |source| PlotError::Csv {
+        path: csv_path.clone(),
+        source,
+    };
+
+    // Header.
+    let mut reader = open_csv(&csv_path)?;
+    let names: Vec<String> = reader
+        .headers()
+        .map_err(csv_err)?
+        .iter()
+        .map(|s| s.trim().to_string())
+        .collect();
+    if names.iter().all(String::is_empty) {
+        return Err(PlotError::Empty {
+            path: csv_path,
+            reason: "no header row",
+        });
+    }
+    let mut index = HashMap::new();
+    for (i, n) in names.iter().enumerate() {
+        index.entry(n.clone()).or_insert(i);
+    }
+    let header = Header {
+        path: &csv_path,
+        names,
+        index,
+    };
+
+    // Columns.
+    let mut cols = Columns::default();
+    let fixed: Vec<usize> = REQUIRED
+        .iter()
+        .map(|name| header.require(name).map(|c| cols.add(c)))
+        .collect::<Result<_, _>>()?;
+    let t_col = header.require("t")?;
+
+    let agent_ids: Vec<String> = if summary.agents.is_empty() {
+        header
+            .with_prefix("x_")
+            .into_iter()
+            .map(|(_, s)| s)
+            .collect()
+    } else {
+        summary.agents.iter().map(i64::to_string).collect()
+    };
+    let mut agent_xy = Vec::with_capacity(agent_ids.len());
+    for id in &agent_ids {
+        agent_xy.push((
+            header.require(&format!("x_{id}"))?,
+            header.require(&format!("y_{id}"))?,
+        ));
+    }
+    let agent_index: HashMap<&str, usize> = agent_ids
+        .iter()
+        .enumerate()
+        .rev()
+        .map(|(i, id)| (id.as_str(), i))
+        .collect();
+    let lookup = |id: i64| agent_index.get(id.to_string().as_str()).copied();
+    let leaders: Vec<usize> = summary
+        .leaders
+        .map(|[a, b]| [lookup(a), lookup(b)].into_iter().flatten().collect())
+        .unwrap_or_default();
+    let edges: Vec<(usize, usize)> = summary
+        .edges
+        .iter()
+        .filter_map(|&[a, b]| Some((lookup(a)?, lookup(b)?)))
+        .collect();
+
+    let mut path_agents = spread(agent_ids.len(), MAX_AGENT_PATHS);
+    path_agents.extend(&leaders);
+    path_agents.sort_unstable();
+    path_agents.dedup();
+    let path_slots: Vec<(usize, usize, usize)> = path_agents
+        .iter()
+        .map(|&a| (a, cols.add(agent_xy[a].0), cols.add(agent_xy[a].1)))
+        .collect();
+
+    let angle_cols = header.with_prefix("angle_err_");
+    let n_angles = angle_cols.len();
+    let angle_slots: Vec<(String, usize)> = spread(n_angles, MAX_ANGLES)
+        .into_iter()
+        .map(|k| {
+            let (c, suffix) = &angle_cols[k];
+            (angle_label(suffix), cols.add(*c))
+        })
+        .collect();
+
+    let est_cols = header.with_prefix("rhat_");
+    let n_estimates = est_cols.len();
+    let mut est_slots = Vec::new();
+    for (c, suffix) in est_cols.iter().take(MAX_ESTIMATES) {
+        let r = header.require(&format!("r_{suffix}"))?;
+        est_slots.push((estimate_label(suffix), cols.add(*c), cols.add(r)));
+    }
+
+    // Pass 1: count the rows with a finite t.
+    let mut rec = csv::ByteRecord::new();
+    let mut valid = 0usize;
+    while reader.read_byte_record(&mut rec).map_err(csv_err)? {
+        if field(&rec, t_col, &header)?.is_finite() {
+            valid += 1;
+        }
+    }
+    if valid == 0 {
+        return Err(PlotError::Empty {
+            path: csv_path.clone(),
+            reason: "no data row with a finite `t`",
+        });
+    }
+    let thin = Thinning::new(valid);
+    let snapshot_at = thin.snapshots();
+
+    // Pass 2: keep the thinned rows.
+    let mut reader = open_csv(&csv_path)?;
+    let mut snapshots = Vec::with_capacity(snapshot_at.len());
+    let (mut v, mut kept) = (0usize, 0usize);
+    while reader.read_byte_record(&mut rec).map_err(csv_err)? {
+        let t = field(&rec, t_col, &header)?;
+        if !t.is_finite() {
+            continue;
+        }
+        if thin.keeps(v) {
+            for (slot, &c) in cols.src.iter().enumerate() {
+                let x = field(&rec, c, &header)?;
+                cols.data[slot].push(x);
+            }
+            if snapshot_at.contains(&kept) {
+                let pos = agent_xy
+                    .iter()
+                    .map(|&(cx, cy)| Ok((field(&rec, cx, &header)?, field(&rec, cy, &header)?)))
+                    .collect::<Result<_, PlotError>>()?;
+                snapshots.push(Snapshot { t, pos });
+            }
+            kept += 1;
+        }
+        v += 1;
+        if v == valid {
+            break; // the file changed between the passes; ignore the rest
+        }
+    }
+
+    let t = cols.take(fixed[0]);
+    let energy = ["V", "V_kin", "V_ang", "V_lead", "V_est"]
+        .iter()
+        .zip(&fixed[1..6])
+        .map(|(name, &slot)| Named {
+            label: (*name).to_string(),
+            values: cols.take(slot),
+        })
+        .collect();
+    let max_angle_err = cols.take(fixed[6]);
+    let disp_err = cols.take(fixed[7]);
+    let vel_err = cols.take(fixed[8]);
+    let min_dist = cols.take(fixed[9]);
+    let paths = path_slots
+        .into_iter()
+        .map(|(agent, sx, sy)| AgentPath {
+            agent,
+            x: cols.take(sx),
+            y: cols.take(sy),
+        })
+        .collect();
+    let angles = angle_slots
+        .into_iter()
+        .map(|(label, slot)| Named {
+            label,
+            values: cols.take(slot),
+        })
+        .collect();
+    let estimates = est_slots
+        .into_iter()
+        .map(|(label, sh, sr)| Estimate {
+            label,
+            rhat: cols.take(sh),
+            r: cols.take(sr),
+        })
+        .collect();
+
+    Ok(Run {
+        summary,
+        t,
+        energy,
+        max_angle_err,
+        disp_err,
+        vel_err,
+        min_dist,
+        agent_ids,
+        leaders,
+        edges,
+        paths,
+        snapshots,
+        angles,
+        n_angles,
+        estimates,
+        n_estimates,
+    })
+}
+
+/// `u_v_w` (apex u) → `∠v-u-w`.
+pub(super) fn angle_label(suffix: &str) -> String {
+    match suffix.split('_').collect::<Vec<_>>()[..] {
+        [u, v, w] => format!("∠{v}-{u}-{w}"),
+        _ => suffix.to_string(),
+    }
+}
+
+/// `o_u_f_w` → `o: u→f (w)`.
+pub(super) fn estimate_label(suffix: &str) -> String {
+    match suffix.split('_').collect::<Vec<_>>()[..] {
+        [o, u, f, w] => format!("{o}: {u}→{f} ({w})"),
+        _ => suffix.to_string(),
+    }
+}

@@ -1,0 +1,133 @@
+//! The house style: series colours, wide strokes without spikes, chart margins and
+//! label areas, axis fonts and grid.
+
+use super::{DrawResult, FONT};
+use plotters::coord::{CoordTranslate, Shift};
+use plotters::element::DashedPathElement;
+use plotters::prelude::*;
+
+/// Tableau 10 plus two darker colours: distinguishable series colours.
+pub(super) const PALETTE: [RGBColor; 12] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+    RGBColor(0, 70, 40),
+    RGBColor(100, 0, 110),
+];
+pub(super) const LEADER: RGBColor = RGBColor(200, 0, 0);
+pub(super) const DARK: RGBColor = RGBColor(20, 20, 20);
+
+pub(super) fn colour(i: usize) -> RGBColor {
+    PALETTE[i % PALETTE.len()]
+}
+
+/// Draws the polyline `pts` (in `area`'s coordinates), `width` pixels wide,
+/// solid or dashed.
+///
+/// On bitmaps a wide line is drawn as `width × width` one-pixel lines offset
+/// by a pixel each: plotters fills wide polylines as one polygon whose inner
+/// corners grow long spikes wherever the line turns sharply (a jump, a dip
+/// on a log axis). SVG strokes are drawn by the viewer and are fine.
+pub(super) fn stroke<DB, CT>(
+    area: &DrawingArea<DB, CT>,
+    pts: &[CT::From],
+    colour: RGBColor,
+    width: u32,
+    dashed: bool,
+    bitmap: bool,
+) -> DrawResult
+where
+    DB: DrawingBackend,
+    DB::ErrorType: 'static,
+    CT: CoordTranslate,
+    CT::From: Clone,
+{
+    const DASH: (i32, i32) = (9, 6);
+    if pts.len() < 2 {
+        return Ok(());
+    }
+    if !bitmap || width <= 1 {
+        let style = colour.stroke_width(width);
+        if dashed {
+            area.draw(&DashedPathElement::new(pts.to_vec(), DASH.0, DASH.1, style))?;
+        } else {
+            area.draw(&PathElement::new(pts.to_vec(), style))?;
+        }
+        return Ok(());
+    }
+    let pixels = area.strip_coord_spec();
+    let (bx, by) = pixels.get_base_pixel();
+    let mut base: Vec<(i32, i32)> = pts
+        .iter()
+        .map(|p| {
+            let (x, y) = area.map_coordinate(p);
+            (x - bx, y - by)
+        })
+        .collect();
+    base.dedup();
+    let w = i32::try_from(width).unwrap_or(1);
+    let lo = -(w - 1) / 2;
+    let style = colour.stroke_width(1);
+    for dx in lo..lo + w {
+        for dy in lo..lo + w {
+            let shifted: Vec<(i32, i32)> = base.iter().map(|&(x, y)| (x + dx, y + dy)).collect();
+            if dashed {
+                pixels.draw(&DashedPathElement::new(shifted, DASH.0, DASH.1, style))?;
+            } else {
+                pixels.draw(&PathElement::new(shifted, style))?;
+            }
+        }
+    }
+    Ok(())
+}
+
+pub(super) const CHART_MARGIN: u32 = 14;
+pub(super) const X_LABEL_AREA: u32 = 56;
+pub(super) const Y_LABEL_AREA: u32 = 96;
+
+/// A chart builder on `area` with the house margins and label areas.
+pub(super) fn chart_on<'a, 'b, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+) -> ChartBuilder<'a, 'b, DB> {
+    let mut builder = ChartBuilder::on(area);
+    builder
+        .margin(CHART_MARGIN)
+        .x_label_area_size(X_LABEL_AREA)
+        .y_label_area_size(Y_LABEL_AREA);
+    builder
+}
+
+/// The house style of every time-series panel's mesh: axis descriptions, fonts, grid.
+pub(super) fn styled_mesh<'m, 'a, 'b, X, Y, XT, YT, DB>(
+    mesh: &'m mut plotters::chart::MeshStyle<'a, 'b, X, Y, DB>,
+    y_desc: &str,
+) -> &'m mut plotters::chart::MeshStyle<'a, 'b, X, Y, DB>
+where
+    X: plotters::coord::ranged1d::Ranged<ValueType = XT>
+        + plotters::coord::ranged1d::ValueFormatter<XT>,
+    Y: plotters::coord::ranged1d::Ranged<ValueType = YT>
+        + plotters::coord::ranged1d::ValueFormatter<YT>,
+    DB: DrawingBackend,
+{
+    mesh.x_desc("time t (s)")
+        .y_desc(y_desc)
+        .label_style(label_style())
+        .axis_desc_style(desc_style())
+        .bold_line_style(BLACK.mix(0.12))
+        .light_line_style(BLACK.mix(0.04))
+}
+
+pub(super) fn label_style() -> TextStyle<'static> {
+    (FONT, 15).into_font().color(&BLACK)
+}
+
+pub(super) fn desc_style() -> TextStyle<'static> {
+    (FONT, 18).into_font().color(&BLACK)
+}
