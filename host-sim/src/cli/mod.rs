@@ -154,7 +154,7 @@ fn report(errors: &ScenarioErrors) -> u8 {
 }
 
 fn validate_command(scenario: &str, set: &[String], quiet: bool) -> u8 {
-    match crate::load(scenario, set) {
+    match crate::api::load(scenario, set) {
         Ok(m) => {
             if !quiet {
                 println!(
