@@ -2,20 +2,29 @@
 //!
 //! N `controller-core` agents over simulated dynamics (S1, fixed-step RK4) and simulated
 //! radio links. Each agent is one [`controller_core::Agent`] behind the
-//! [`controller::AgentController`] trait: it sees only what its own sensors measure and
-//! the frames its radio delivers, as real postcard bytes.
+//! [`engine::AgentController`] trait: it sees only what its own sensors measure and the
+//! frames its radio delivers, as real postcard bytes.
 //!
-//! * [`scenario`]: the TOML schema and the built-in scenarios (`paper`, `paper-printed`,
-//!   `formation-only`); [`validate`] turns a file into a [`model::Model`].
-//! * [`sim`]: the sampled simulator and the run driver; [`continuous`]: the
-//!   continuous-time mode for checking S14.
-//! * [`plant`], [`sensors`], [`radio`], [`controller`]: the pieces of one run.
-//! * [`diagnostics`]: V (S13), errors, failure detection; [`output`]: `timeseries.csv`
-//!   and `summary.json`; [`plot`]: the figures; [`cli`]: the command line.
-//! * [`hil`]: host-in-the-loop, some agents' controllers as firmware in QEMU behind an
-//!   emulated UART (`docs/hil.md`).
+//! ## The library
 //!
-//! Schemas: `docs/scenarios.md` (input) and `docs/outputs.md` (output, exit codes).
+//! [`load`] (a file or a built-in name) or [`load_toml`] gives a validated [`Model`];
+//! [`Simulation`] runs it, in memory unless asked to write (`write_to`), and returns a
+//! [`Run`]: the [`RunResult`] (outcome, reason, errors, extremes, counters), the
+//! [`TimeSeries`] and `summary.json` as a value. `examples/paper.rs` shows it:
+//! `cargo run -p host-sim --release --example paper`.
+//!
+//! ## The layers (`docs/architecture.md`), lowest first
+//!
+//! * [`model`]: the validated formation, resolved to agent indices and SI units.
+//! * [`scenario`]: the TOML schema, built-ins, `--set`, validation, the strip generator.
+//! * [`analysis`]: V (S13), errors, and the failure monitor the time loop stops on.
+//! * [`engine`]: plant, sensors, radio, controllers (and [`engine::hil`], agents as
+//!   firmware in QEMU), the sampled and continuous simulators, the driver.
+//! * [`report`]: `timeseries.csv`, the in-memory series, `summary.json`, the table, plots.
+//! * the API (re-exported here) and [`cli`], the command line.
+//!
+//! Imports point down only (checked by `tests/layers.rs`). Schemas: `docs/scenarios.md`
+//! (input) and `docs/outputs.md` (output, exit codes: [`exit_code`]).
 
 // `summary.json` is one large `serde_json::json!` literal.
 #![recursion_limit = "256"]

@@ -1,7 +1,7 @@
 //! [`HilController`]: one agent whose controller runs on an emulated target, behind a
-//! [`Link`]. It implements [`AgentController`] like the in-process agents, in two phases
-//! so that several targets compute at once: [`AgentController::start_tick`] sends the
-//! tick's `Radio` messages and its `Step`, [`AgentController::finish_tick`] reads the
+//! [`Link`]. It implements [`AgentController`](crate::engine::AgentController) like the in-process agents, in two phases
+//! so that several targets compute at once: [`AgentController::start_tick`](crate::engine::AgentController::start_tick) sends the
+//! tick's `Radio` messages and its `Step`, [`AgentController::finish_tick`](crate::engine::AgentController::finish_tick) reads the
 //! target's `Radio` messages, optional `Estimates` and the `Output`.
 
 mod target;
