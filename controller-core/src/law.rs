@@ -1,6 +1,79 @@
-//! The control law: SPEC S7–S12 as pure functions.
+//! The control law: SPEC S7–S12 as pure functions, and the per-angle kernels the agent
+//! runs (one implementation of each: [`apex_angle`] on the apex, [`far_effort`] for the
+//! wire, [`far_vertex_force`] on a far vertex).
 
+use crate::geometry::{self, AngleGeometry};
 use crate::{Real, Vec2};
+
+/// What one controlled angle gives its apex (see [`apex_angle`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ApexAngle<T: Real> {
+    /// S4: `y_α = cos α`.
+    pub y: T,
+    /// S7: `γ_α`.
+    pub gamma: T,
+    /// S5: the shares `t_{α,uv}`, `t_{α,uw}` of `ẏ_α`.
+    pub t: [T; 2],
+    /// S6: `g_{α,v}`, `g_{α,w}`.
+    pub g: [Vec2<T>; 2],
+    /// `σ = s_uv × s_uw = sin α` (signed): `g_{α,v} = σ J s_uv`, `g_{α,w} = −σ J s_uw`.
+    pub sigma: T,
+    /// S8: the force of the angle on its apex, with the distances `r` it was given.
+    pub force: Vec2<T>,
+}
+
+/// The kernel of one controlled angle `α = (u; v, w)` at its apex: S4–S6 from the apex's
+/// bearings `s = [s_uv, s_uw]` and rates `s_dot`, S7 with the angle's gains, and S8 on the
+/// apex with the distances `r = [r_uv, r_uw]` (estimates or ranges).
+#[inline]
+pub fn apex_angle<T: Real>(
+    s: &[Vec2<T>; 2],
+    s_dot: &[Vec2<T>; 2],
+    cos_desired: T,
+    stiffness: T,
+    damping: T,
+    r: [T; 2],
+) -> ApexAngle<T> {
+    // S4–S6.
+    let geo = AngleGeometry::new(s, s_dot);
+    // S7.
+    let gamma = port_effort(stiffness, damping, geo.y - cos_desired, geo.y_dot);
+    ApexAngle {
+        y: geo.y,
+        gamma,
+        t: geo.t,
+        g: geo.g,
+        sigma: geometry::cross(&s[0], &s[1]),
+        // S8.
+        force: apex_force(gamma, &geo.g, r),
+    }
+}
+
+/// What the apex sends far vertex `k` (0: `v`, 1: `w`) of the angle (the wire's effort,
+/// [`crate::wire`]): `γ_α σ_k`, divided by `r` when given. With `σ_v = σ`, `σ_w = −σ`,
+/// `g_{α,k} = σ_k J s_uk` (S6), so S8 on the far vertex is `−(γ σ_k / r) J s_uk`: with
+/// `r = r̂_{α,uk}` (shared estimates) the effort is that force's component along
+/// `J s_uk`; without `r` (per-agent estimates, measured ranges) the far vertex divides by
+/// its own distance.
+#[inline]
+pub fn far_effort<T: Real>(gamma: T, sigma: T, k: usize, r: Option<T>) -> T {
+    let e = if k == 0 {
+        gamma * sigma
+    } else {
+        -(gamma * sigma)
+    };
+    match r {
+        Some(r) => e / r,
+        None => e,
+    }
+}
+
+/// S8 on far vertex `k` from its effort over distance, `e/r`, and its own bearing to the
+/// apex `s_ku = −s_uk` (SPEC §2): `−(e/r) J s_uk = (e/r) J s_ku`.
+#[inline]
+pub fn far_vertex_force<T: Real>(effort_over_r: T, s_to_apex: &Vec2<T>) -> Vec2<T> {
+    geometry::perp(s_to_apex) * effort_over_r
+}
 
 /// S7: port effort `γ_α = c_α ỹ_α + d_α ẏ_α`.
 #[inline]
@@ -15,12 +88,6 @@ pub fn angle_forces<T: Real>(gamma: T, g: &[Vec2<T>; 2], r: [T; 2]) -> [Vec2<T>;
     let fv = g[0] * (-gamma / r[0]);
     let fw = g[1] * (-gamma / r[1]);
     [-(fv + fw), fv, fw]
-}
-
-/// S8: force of one angle on its far vertex `k` (`g_k` = `g_{α,e}` of its edge, `r` = `r̂_{α,e}`).
-#[inline]
-pub fn far_vertex_force<T: Real>(gamma: T, g_k: &Vec2<T>, r: T) -> Vec2<T> {
-    g_k * (-gamma / r)
 }
 
 /// S8: force of one angle on its apex.

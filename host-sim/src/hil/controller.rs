@@ -12,7 +12,6 @@ use crate::radio::RadioFrame;
 use controller_core::link::{
     HostMsg, LinkBearing, LinkError, LinkOutput, LinkStep, TargetMsg, LINK_VERSION,
 };
-use controller_core::wire::{decode_frame, WireItem};
 use controller_core::{
     AgentConfig, Fault, FrameStats, Measurements, OwnedEstimate, Status, StepOutput, Vec2,
 };
@@ -196,11 +195,15 @@ impl HilController {
         }
         let deadline = Instant::now() + timeout;
         match c.recv(deadline, When::Configure, "waiting for Ready")? {
-            TargetMsg::Ready { id: got, version } if got == id && version == LINK_VERSION => {
+            TargetMsg::Ready {
+                id: got, version, ..
+            } if got == id && version == LINK_VERSION => {
                 c.startup = started.elapsed();
                 Ok(c)
             }
-            TargetMsg::Ready { id: got, version } => Err(HilError::Corrupt {
+            TargetMsg::Ready {
+                id: got, version, ..
+            } => Err(HilError::Corrupt {
                 agent: id,
                 when: When::Configure,
                 what: format!(
@@ -212,7 +215,7 @@ impl HilController {
                 reason: format!(
                     "the firmware answered Configure with Error({e:?}){}",
                     match e {
-                        LinkError::Config(code) => format!(" ({})", config_error_name(code)),
+                        LinkError::Config(e) => format!(" ({e})"),
                         _ => String::new(),
                     }
                 ),
@@ -396,9 +399,6 @@ impl HilController {
             match msg {
                 TargetMsg::Radio(v) => {
                     outbox.push(RadioFrame::new(&v));
-                    if !self.estimates_from_target {
-                        self.estimates_from_frame(&v);
-                    }
                     frames += 1;
                 }
                 TargetMsg::Estimates(list) => {
@@ -437,7 +437,7 @@ impl HilController {
             }
             messages += 1;
         };
-        if usize::from(out.frames) != frames {
+        if usize::try_from(out.frames) != Ok(frames) {
             return Err(HilError::Corrupt {
                 agent: self.id,
                 when,
@@ -452,30 +452,6 @@ impl HilController {
         self.wall += start.elapsed();
         self.ticks += 1;
         Ok(step_output(&out))
-    }
-
-    /// Reads the owned estimates from one of the agent's own broadcast frames (used when
-    /// the target does not send `Estimates`).
-    fn estimates_from_frame(&mut self, bytes: &[u8]) {
-        let Ok(frame) = decode_frame(bytes, f32::INFINITY) else {
-            return;
-        };
-        for item in &frame.items {
-            let WireItem::Angle { far: [v, w], r, .. } = *item else {
-                continue;
-            };
-            for (far, other, r) in [(v, w, r[0]), (w, v, r[1])] {
-                if let Some(k) = self
-                    .slots
-                    .iter()
-                    .position(|s| s.far == far && s.other == other)
-                {
-                    if let Some(slot) = self.estimates.get_mut(k) {
-                        *slot = f64::from(r);
-                    }
-                }
-            }
-        }
     }
 
     /// The counters and timings of this agent's link.
@@ -507,38 +483,13 @@ impl HilController {
     }
 }
 
-/// The `ConfigError` named by a `LinkError::Config` code (see `LinkError::config`).
-pub fn config_error_name(code: u8) -> &'static str {
-    match code {
-        1 => "NotInTriangle",
-        2 => "RepeatedVertex",
-        3 => "BadApex",
-        4 => "InfeasibleAngles",
-        5 => "BadGain",
-        6 => "TooManyNeighbours",
-        7 => "BadParameter",
-        8 => "BadLeader",
-        _ => "unknown configuration error",
-    }
-}
-
-/// The host form of a target's output. The link carries no fault kind and no
-/// degenerate flag: a safe output naming a neighbour is reported as
-/// `Fault::MissingData(neighbour)`, one without as `Fault::NonFinite`.
+/// The host form of a target's output (the link carries the status with its fault).
 pub fn step_output(o: &LinkOutput) -> StepOutput<f64> {
-    let status = if o.nominal {
-        Status::Nominal
-    } else {
-        Status::Safe(
-            o.fault_neighbour
-                .map_or(Fault::NonFinite, Fault::MissingData),
-        )
-    };
     StepOutput {
         force: Vec2::new(f64::from(o.force[0]), f64::from(o.force[1])),
-        status,
+        status: o.status,
         saturated: o.saturated,
-        degenerate: false,
+        degenerate: o.degenerate,
     }
 }
 
