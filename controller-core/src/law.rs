@@ -1,6 +1,6 @@
 //! The control law: SPEC S7–S12 as pure functions, and the per-angle kernels the agent
-//! runs (one implementation of each: [`apex_angle`] on the apex, [`far_effort`] for the
-//! wire, [`far_vertex_force`] on a far vertex).
+//! runs (one implementation of each: [`apex_angle`] on the apex, [`far_angle`] on a far
+//! vertex).
 
 use crate::geometry::{self, AngleGeometry};
 use crate::{Real, Vec2};
@@ -49,30 +49,33 @@ pub fn apex_angle<T: Real>(
     }
 }
 
-/// What the apex sends far vertex `k` (0: `v`, 1: `w`) of the angle (the wire's effort,
-/// [`crate::wire`]): `γ_α σ_k`, divided by `r` when given. With `σ_v = σ`, `σ_w = −σ`,
-/// `g_{α,k} = σ_k J s_uk` (S6), so S8 on the far vertex is `−(γ σ_k / r) J s_uk`: with
-/// `r = r̂_{α,uk}` (shared estimates) the effort is that force's component along
-/// `J s_uk`; without `r` (per-agent estimates, measured ranges) the far vertex divides by
-/// its own distance.
+/// The far vertex `k` of an angle `α = (u; v, w)` (`k = 0` for `v`, 1 for `w`): its S8 force
+/// and its port effort, from what the apex sent — `γ_α` (S7), `σ = s_uv × s_uw` — and its
+/// own fresh bearing to the apex `s_ku` (`s_uk = −s_ku`, SPEC §2), its distance `r_k` to
+/// the apex (the apex's shared estimate, its own copy, or its range: SPEC §6), and its own
+/// motion relative to the apex since the apex measured: displacement `δ` and change of
+/// own velocity `Δv`. With `n_k = J s_uk` and `σ_k = ±σ`, `g_{α,k} = σ_k n_k` (S6), so to
+/// first order `Δy = g_kᵀ δ / r_k` and `Δẏ = g_kᵀ Δv / r_k` (S4, S5), and
+/// `γ_k = γ_α + c_α Δy + d_α Δẏ` (S7): the far vertex's own stiffness and damping act on
+/// fresh measurements. Returns `(γ_k, g_k, U_k)` with `U_k = −(γ_k / r_k) g_k` (S8).
 #[inline]
-pub fn far_effort<T: Real>(gamma: T, sigma: T, k: usize, r: Option<T>) -> T {
-    let e = if k == 0 {
-        gamma * sigma
-    } else {
-        -(gamma * sigma)
-    };
-    match r {
-        Some(r) => e / r,
-        None => e,
-    }
-}
-
-/// S8 on far vertex `k` from its effort over distance, `e/r`, and its own bearing to the
-/// apex `s_ku = −s_uk` (SPEC §2): `−(e/r) J s_uk = (e/r) J s_ku`.
-#[inline]
-pub fn far_vertex_force<T: Real>(effort_over_r: T, s_to_apex: &Vec2<T>) -> Vec2<T> {
-    geometry::perp(s_to_apex) * effort_over_r
+#[allow(clippy::too_many_arguments)]
+pub fn far_angle<T: Real>(
+    gamma: T,
+    sigma: T,
+    k: usize,
+    r_k: T,
+    s_to_apex: &Vec2<T>,
+    stiffness: T,
+    damping: T,
+    delta: &Vec2<T>,
+    dv: &Vec2<T>,
+) -> (T, Vec2<T>, Vec2<T>) {
+    let sigma_k = if k == 0 { sigma } else { -sigma };
+    // n_k = J s_uk = −J s_ku.
+    let g = geometry::perp(s_to_apex) * -sigma_k;
+    let gamma_k = gamma + g.dot(&(delta * stiffness + dv * damping)) / r_k;
+    (gamma_k, g, g * (-gamma_k / r_k))
 }
 
 /// S7: port effort `γ_α = c_α ỹ_α + d_α ẏ_α`.

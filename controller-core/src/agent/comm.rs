@@ -2,26 +2,32 @@
 //! its neighbours' broadcasts ([`Agent::receive`], [`Agent::receive_direct`]). The frame
 //! layout is [`crate::wire`]'s.
 
-use super::state::{AngleState, Role};
+use super::state::{AngleState, Remote, Role};
 use super::{pick, Agent};
 use crate::config::AgentId;
 use crate::wire::{check_frame, mode_byte, quant, FrameError};
 use crate::{Real, Vec2};
 
-/// A broadcast item at full precision (the wire rounds efforts to binary16).
+/// A broadcast item at full precision (the wire rounds the angle's values to binary16).
 #[derive(Clone, Copy, Debug)]
 enum Item<T: Real> {
     /// The sender's velocity.
     Velocity(Vec2<T>),
-    /// An angle `(sender; far[0], far[1])` and its efforts for the two far vertices.
-    Angle { far: [AgentId; 2], effort: [T; 2] },
+    /// An angle `(sender; far[0], far[1])`: `γ`, `σ` and the distances `ρ` (see
+    /// [`crate::wire`]).
+    Angle {
+        far: [AgentId; 2],
+        gamma: T,
+        sigma: T,
+        rho: [T; 2],
+    },
 }
 
 impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// Encodes this tick's broadcast into frames of at most 60 bytes and passes each to
     /// `send`; returns the number of frames. The broadcast is the agent's velocity and,
     /// for every controlled angle it is the apex of and computed when it last sensed,
-    /// the efforts of the angle's far vertices (see [`crate::wire`]). Sends nothing (and
+    /// what the angle's far vertices need (see [`crate::wire`]). Sends nothing (and
     /// returns 0) on the steps that [`crate::AgentConfig::comm_every`] skips.
     pub fn frames(&mut self, mut send: impl FnMut(&[u8])) -> usize {
         if !self.comm_due {
@@ -37,13 +43,11 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         let (writer, angles) = (&mut self.writer, &self.angles);
         writer.start(mode, id, seq, velocity);
         for a in angles.iter().flatten() {
-            let Some(effort) = sent_effort(a) else {
+            let Some((gamma, sigma, rho)) = sent_angle(a) else {
                 continue;
             };
-            let code = [
-                quant::encode(effort[0].as_f32()).0,
-                quant::encode(effort[1].as_f32()).0,
-            ];
+            let q = |x: T| quant::encode(x.as_f32()).0;
+            let code = [q(gamma), q(sigma), q(rho[0]), q(rho[1])];
             if !writer.push_angle(a.far, code) {
                 send(writer.finish());
                 count += 1;
@@ -87,8 +91,16 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 return Err(FrameError::StaleSequence { sender, seq });
             }
         }
-        // The whole frame is valid before anything is applied.
+        // The whole frame is valid before anything is applied. With estimators, the
+        // distances are estimates: at least r_min (as rounded: rounding is monotone).
         frame.validate()?;
+        let rho_min = self.rho_min_code;
+        if frame
+            .raw_items()
+            .any(|(_, [_, _, r0, r1])| r0 < rho_min || r1 < rho_min)
+        {
+            return Err(FrameError::InvalidValue);
+        }
         if let Some(n) = self.neighbours.get_mut(slot) {
             n.last_seq = Some(seq);
             n.age = T::zero();
@@ -100,16 +112,17 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         );
         let me = self.config.id;
         for (far, code) in frame.raw_items() {
-            // Only the items for angles of which this agent is a far vertex.
+            // Only the items for angles of which this agent is a far vertex (`apply`
+            // checks it again; this saves decoding the others).
             if far.contains(&me) {
-                let e = |c: u16| T::of_f32(quant::decode(c).unwrap_or(0.0));
-                self.apply(
-                    slot,
-                    Item::Angle {
-                        far,
-                        effort: [e(code[0]), e(code[1])],
-                    },
-                );
+                let v = |c: u16| T::of_f32(quant::decode(c).unwrap_or(0.0));
+                let item = Item::Angle {
+                    far,
+                    gamma: v(code[0]),
+                    sigma: v(code[1]),
+                    rho: [v(code[2]), v(code[3])],
+                };
+                self.apply(slot, item);
             }
         }
         Ok(())
@@ -125,8 +138,17 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         }
         self.apply(slot, Item::Velocity(from.velocity));
         for a in from.angles.iter().flatten() {
-            if let Some(effort) = sent_effort(a) {
-                self.apply(slot, Item::Angle { far: a.far, effort });
+            if let Some((gamma, sigma, rho)) = sent_angle(a) {
+                let far = a.far;
+                self.apply(
+                    slot,
+                    Item::Angle {
+                        far,
+                        gamma,
+                        sigma,
+                        rho,
+                    },
+                );
             }
         }
         Ok(())
@@ -141,7 +163,12 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     n.velocity = Some(v);
                 }
             }
-            Item::Angle { far, effort } => {
+            Item::Angle {
+                far,
+                gamma,
+                sigma,
+                rho,
+            } => {
                 let me = self.config.id;
                 let mine = if far[0] == me {
                     0
@@ -167,8 +194,14 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     };
                     if let Role::Far(k) = a.role {
                         if pick(&a.far, 1 - k.min(1)) == other && pick(&a.far, k) == me {
-                            a.effort = pick(&effort, mine);
-                            a.effort_age = T::zero();
+                            a.remote = Some(Remote {
+                                gamma,
+                                sigma,
+                                rho: pick(&rho, mine),
+                                delta: Vec2::zeros(),
+                                v_ref: None,
+                            });
+                            a.remote_age = T::zero();
                         }
                     }
                 }
@@ -177,12 +210,17 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     }
 }
 
-/// The efforts an apex sends for angle `a`: those of its last sense, if it computed them
-/// and they are finite.
+/// What an apex sends of angle `a` (`γ`, `σ`, `ρ`): the values of its last sense, if it
+/// computed them and they are finite.
 #[inline]
-fn sent_effort<T: Real>(a: &AngleState<T>) -> Option<[T; 2]> {
+#[allow(clippy::type_complexity)]
+fn sent_angle<T: Real>(a: &AngleState<T>) -> Option<(T, T, [T; 2])> {
     match (a.role, &a.part) {
-        (Role::Apex, Ok(p)) if p.effort[0].finite() && p.effort[1].finite() => Some(p.effort),
+        (Role::Apex, Ok(p))
+            if p.gamma.finite() && p.sigma.finite() && p.rho[0].finite() && p.rho[1].finite() =>
+        {
+            Some((p.gamma, p.sigma, p.rho))
+        }
         _ => None,
     }
 }

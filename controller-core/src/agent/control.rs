@@ -143,26 +143,36 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     Role::Far(k) => {
                         let n = self.neighbour(a.slots[0])?;
                         let (s_ku, _) = n.bearing()?;
-                        if !within(a.effort_age, timeout) {
-                            return Err(Fault::MissingData(a.apex));
-                        }
+                        let remote = match a.remote {
+                            Some(r) if within(a.remote_age, timeout) => r,
+                            _ => return Err(Fault::MissingData(a.apex)),
+                        };
+                        // SPEC §6: the apex's shared estimate, the own copy, or the range.
                         let r = match mode {
-                            EstimatorMode::Shared => T::one(),
+                            EstimatorMode::Shared => remote.rho,
                             EstimatorMode::PerAgent => pick(&a.estimate, k),
                             EstimatorMode::Measured => n.range()?,
                         };
-                        // S8 on this far vertex (the effort is γσ_k, or γσ_k/r̂ in shared mode).
-                        force += law::far_vertex_force(a.effort / r, &s_ku);
+                        let dv = remote.v_ref.map_or(Vec2::zeros(), |v_ref| v - v_ref);
+                        // S6–S8 on this far vertex.
+                        let (gamma_k, g_k, f) = law::far_angle(
+                            remote.gamma,
+                            remote.sigma,
+                            k,
+                            r,
+                            &s_ku,
+                            a.stiffness,
+                            a.damping,
+                            &remote.delta,
+                            &dv,
+                        );
+                        force += f;
                         if mode == EstimatorMode::PerAgent {
                             // S9 on the own copy r̂^k (SPEC §6): ṙ_uk = s_ukᵀ(v_k − v_u) with
-                            // s_uk = −s_ku, and the share f^k = +g_kᵀ v_k / r̂^k. Since
-                            // g_k = σ_k J s_uk, γ f^k = (γσ_k)(J s_uk)ᵀ v_k / r̂^k: the effort
-                            // γσ_k stands for γ and J s_uk for g_k.
-                            let s_uk = -s_ku;
-                            let rr = geometry::range_rate(&s_uk, &(v - n.velocity()?));
-                            let share = law::own_share(&geometry::perp(&s_uk), &v, r, true);
-                            let flow =
-                                law::estimator_rate(rr, a.effort, share, a.estimator_gain, r);
+                            // s_uk = −s_ku (S3), and the share f^k = +g_kᵀ v_k / r̂^k.
+                            let rr = geometry::range_rate(&-s_ku, &(v - n.velocity()?));
+                            let share = law::own_share(&g_k, &v, r, true);
+                            let flow = law::estimator_rate(rr, gamma_k, share, a.estimator_gain, r);
                             rate(ti, ai, k, law::projected_rate(r, flow, r_min));
                         }
                     }
@@ -235,7 +245,7 @@ mod tests {
             partner_offset: None,
         };
         a.sense(&m).unwrap();
-        a.angles[0][0].effort_age = 0.0;
+        a.angles[0][0].remote_age = 0.0;
         a.angles[0][0].slots[0] = 7;
         assert_eq!(a.evaluate().err(), Some(Fault::Internal));
     }

@@ -58,6 +58,9 @@ pub struct Agent<T: Real, const MT: usize, const NB: usize> {
     comm_due: bool,
     /// Frame buffer reused by [`Agent::frames`] (no zeroing per tick).
     writer: FrameWriter,
+    /// Smallest binary16 code of a received distance: `r_min` as rounded (estimator
+    /// modes), or the smallest positive value (measured ranges).
+    rho_min_code: u16,
     stats: FrameStats,
 }
 

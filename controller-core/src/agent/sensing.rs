@@ -32,7 +32,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         // The checks read nothing that aging changes: age after them.
         let checked = self.check_measurements(m);
         for a in self.angles.as_mut_slice().as_flattened_mut() {
-            a.effort_age += dt;
+            a.remote_age += dt;
         }
         let in_order = match checked {
             Ok(in_order) => in_order,
@@ -48,6 +48,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 return Err(fault);
             }
         };
+        let v_prev = self.velocity;
         self.time = m.time;
         self.velocity = m.velocity;
         self.partner_offset = m.partner_offset;
@@ -73,8 +74,19 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         let (mode, v) = (self.config.estimator, self.velocity);
         let nbs = self.neighbours.as_slice();
         for a in self.angles.as_mut_slice().as_flattened_mut() {
-            if a.role == Role::Apex {
-                a.part = apex_part(nbs, mode, a, &v);
+            match (a.role, a.remote.as_mut()) {
+                (Role::Apex, _) => a.part = apex_part(nbs, mode, a, &v),
+                (Role::Far(_), Some(remote)) => {
+                    // Own motion relative to the apex since it measured, taken as the
+                    // previous tick (the apex's velocity is the one it sent with it).
+                    let v_apex = nbs
+                        .get(a.slots[0])
+                        .and_then(|n| n.velocity)
+                        .unwrap_or(v_prev);
+                    remote.delta += (v_prev - v_apex) * dt;
+                    remote.v_ref.get_or_insert(v_prev);
+                }
+                (Role::Far(_), None) => {}
             }
         }
         Ok(())
@@ -138,8 +150,8 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
 
 /// The kernel of an angle this agent is the apex of (S4–S8, [`law::apex_angle`]) from its
 /// fresh bearings and rates to both far vertices and its distances to them (own estimates,
-/// or measured ranges), with the motion shares its estimators need (S9) and the efforts
-/// for the far vertices ([`law::far_effort`]).
+/// or measured ranges), with the motion shares its estimators need (S9) and what the far
+/// vertices need (`γ`, `σ`, the distances).
 #[inline]
 fn apex_part<T: Real, const MT: usize>(
     nbs: &[Neighbour<T, MT>],
@@ -162,33 +174,23 @@ fn apex_part<T: Real, const MT: usize>(
         a.damping,
         r,
     );
-    let (share, effort) = match mode {
-        // S9 with the angle's own shares t_{α,e} (S5); the far vertex gets its S8 force.
-        EstimatorMode::Shared => (
-            k.t,
-            [
-                law::far_effort(k.gamma, k.sigma, 0, Some(r[0])),
-                law::far_effort(k.gamma, k.sigma, 1, Some(r[1])),
-            ],
-        ),
-        // SPEC §6: the apex's own shares f^u_{α,e} = −g_{α,e}ᵀ v_u / r̂^u_{α,e}.
-        EstimatorMode::PerAgent | EstimatorMode::Measured => (
-            [
-                law::own_share(&k.g[0], v, r[0], false),
-                law::own_share(&k.g[1], v, r[1], false),
-            ],
-            [
-                law::far_effort(k.gamma, k.sigma, 0, None),
-                law::far_effort(k.gamma, k.sigma, 1, None),
-            ],
-        ),
+    let share = match mode {
+        // S9 with the angle's own shares t_{α,e} (S5).
+        EstimatorMode::Shared => k.t,
+        // SPEC §6: the apex's own shares f^u_{α,e} = −g_{α,e}ᵀ v_u / r̂^u_{α,e} (unused in
+        // measured mode, which has no estimator).
+        EstimatorMode::PerAgent | EstimatorMode::Measured => [
+            law::own_share(&k.g[0], v, r[0], false),
+            law::own_share(&k.g[1], v, r[1], false),
+        ],
     };
     Ok(ApexPart {
         y: k.y,
         gamma: k.gamma,
         share,
         force: k.force,
-        effort,
+        sigma: k.sigma,
+        rho: r,
     })
 }
 

@@ -3,8 +3,8 @@
 
 use super::state::{AngleState, Neighbour, Role, SELF_SLOT};
 use super::{Agent, Fault};
-use crate::config::{AgentConfig, AgentId, ConfigError, Limits, TriangleConfig};
-use crate::wire::FrameWriter;
+use crate::config::{AgentConfig, AgentId, ConfigError, EstimatorMode, Limits, TriangleConfig};
+use crate::wire::{quant, FrameWriter};
 use crate::{FrameStats, Real, Vec2};
 
 fn finite_pair<T: Real>(v: &[T; 2], min: T) -> bool {
@@ -66,8 +66,8 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     estimator_gain: a.estimator_gain,
                     estimate: [config.initial_estimate; 2],
                     part: Err(Fault::MissingBearing(far[0])),
-                    effort: T::zero(),
-                    effort_age: T::lit(f64::INFINITY),
+                    remote: None,
+                    remote_age: T::lit(f64::INFINITY),
                 });
             }
             if let [Some(a0), Some(a1)] = pair {
@@ -81,6 +81,12 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             None => SELF_SLOT,
         };
         let writer = FrameWriter::new(config.integrity);
+        let rho_min_code = match config.estimator {
+            EstimatorMode::Measured => 1,
+            EstimatorMode::Shared | EstimatorMode::PerAgent => {
+                quant::encode(config.min_estimate.as_f32()).0
+            }
+        };
         let comm_countdown = config.comm_phase;
         Ok(Self {
             config,
@@ -94,6 +100,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             comm_countdown,
             comm_due: true,
             writer,
+            rho_min_code,
             stats: FrameStats::default(),
         })
     }

@@ -30,8 +30,26 @@ pub(super) struct ApexPart<T: Real> {
     pub share: [T; 2],
     /// S8 on the apex.
     pub force: Vec2<T>,
-    /// The efforts for the far vertices (wire format, [`crate::wire`]).
-    pub effort: [T; 2],
+    /// `σ_α = s_uv × s_uw` (for the far vertices).
+    pub sigma: T,
+    /// The distances used in S8 (estimates or ranges), sent to the far vertices.
+    pub rho: [T; 2],
+}
+
+/// What a far vertex last received of an angle from its apex, and its own motion since.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Remote<T: Real> {
+    /// `γ_α` (S7) as the apex computed it.
+    pub gamma: T,
+    /// `σ_α`.
+    pub sigma: T,
+    /// The apex's distance to this agent (`ρ_k`).
+    pub rho: T,
+    /// Own displacement relative to the apex since the apex measured.
+    pub delta: Vec2<T>,
+    /// Own velocity when the apex measured (`None` until the first sense after receipt:
+    /// then no correction).
+    pub v_ref: Option<Vec2<T>>,
 }
 
 /// One controlled angle `α = (apex; far[0], far[1])` this agent belongs to.
@@ -50,10 +68,10 @@ pub(super) struct AngleState<T: Real> {
     pub estimate: [T; 2],
     /// Apex: the result of the last sense, or the fault that prevented it.
     pub part: Result<ApexPart<T>, Fault>,
-    /// Far vertex: the apex's last effort for this agent's edge.
-    pub effort: T,
-    /// Far vertex: seconds since that effort arrived (`∞` before the first).
-    pub effort_age: T,
+    /// Far vertex: what the apex last sent of this angle.
+    pub remote: Option<Remote<T>>,
+    /// Far vertex: seconds since it arrived (`∞` before the first).
+    pub remote_age: T,
 }
 
 /// One neighbour: a triangle neighbour or the leader partner.

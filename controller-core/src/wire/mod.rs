@@ -10,36 +10,34 @@
 //! | 1 | 1 | sender id ([`AgentId`]) |
 //! | 2 | 2 | sequence number (`u16`, +1 per frame, wrapping) |
 //! | 4 | 8 | sender velocity `v_n` (S1): `f32` x, `f32` y (m/s) |
-//! | 12 | 6·k | k angle items (below) |
-//! | 12 + 6k | 0 or 2 | integrity trailer: CRC-16/IBM-SDLC of bytes `0..12+6k` ([`Integrity::Crc16`]), nothing ([`Integrity::Link`]) |
+//! | 12 | 10·k | k angle items (below) |
+//! | 12 + 10k | 0 or 2 | integrity trailer: CRC-16/IBM-SDLC of bytes `0..12+10k` ([`Integrity::Crc16`]), nothing ([`Integrity::Link`]) |
 //!
-//! One angle item per controlled angle `α = (n; v, w)` whose apex `n` is the sender:
+//! One angle item per controlled angle `α = (n; v, w)` whose apex `n` is the sender
+//! (values in IEEE 754 binary16, see [`quant`]):
 //!
 //! | offset | bytes | field |
 //! |---|---|---|
 //! | 0 | 1 | far vertex `v` |
 //! | 1 | 1 | far vertex `w` |
-//! | 2 | 2 | effort `e_v` for `v` (IEEE 754 binary16) |
-//! | 4 | 2 | effort `e_w` for `w` (binary16) |
+//! | 2 | 2 | `γ_α`, the port effort (S7) |
+//! | 4 | 2 | `σ_α = s_nv × s_nw = sin α` (signed, in `[−1, 1]`; S6: `g_{α,v} = σ J s_nv`, `g_{α,w} = −σ J s_nw`) |
+//! | 6 | 2 | `ρ_v`: the distance `n`–`v` the apex used in its S8 (`r̂_{α,nv}` with shared or per-agent estimates, the measured range otherwise), > 0 |
+//! | 8 | 2 | `ρ_w`: the same for `n`–`w` |
 //!
-//! The effort is what the far vertex needs of the angle for its S8 force and nothing
-//! more (see [`crate::law::far_effort`]): with `n_k = J s_nk` (`s_nk` rotated by +90°)
-//! and `σ_k = n_k · s_n,other` (so that `g_{α,k} = σ_k n_k`, S6),
-//! - [`EstimatorMode::Shared`]: `e_k = γ_α σ_k / r̂_{α,nk}` (N), with the apex's own
-//!   estimate of the edge; the far vertex's force is `−e_k n_k` (S8);
-//! - [`EstimatorMode::PerAgent`], [`EstimatorMode::Measured`]: `e_k = γ_α σ_k` (N·m); the
-//!   far vertex divides by its own distance (its own copy `r̂^k`, or its range).
-//!
-//! The far vertex computes `n_k` from its own fresh bearing (`s_nk = −s_kn`, SPEC §2).
+//! This is what a far vertex needs of the angle and nothing more (see
+//! [`crate::law::far_angle`]): with its own fresh bearing to the apex it forms
+//! `g_{α,k}`, brings `γ_α` up to date with its own motion since, and applies S8 with
+//! `ρ_k` (shared estimates: SPEC §6) or its own distance (per-agent copy, range).
 //!
 //! The item count follows from the length. A frame holds at most
-//! [`Integrity::max_angles`] items (7 with CRC-16, 8 on a checked link); an agent that is
-//! the apex of more angles sends several frames, each with its own sequence number and
-//! the velocity. Rounding of an effort to binary16: see [`quant`].
+//! [`Integrity::max_angles`] items (4); an agent that is the apex of more angles sends
+//! several frames, each with its own sequence number and the velocity.
 //!
 //! Receivers reject, with a typed [`FrameError`] counted in [`crate::FrameStats`], every
 //! frame whose length, CRC, version, integrity or estimator mode, sender, sequence number
-//! or values are wrong; a rejected frame changes nothing but the counters.
+//! or values (non-finite, `|σ| > 1`, `ρ ≤ 0`, an estimate below the receiver's `r_min`)
+//! are wrong; a rejected frame changes nothing but the counters.
 
 mod cobs;
 pub mod quant;
@@ -75,14 +73,18 @@ pub mod offset {
     pub const ITEM_FAR0: usize = 0;
     /// Within an angle item: far vertex `w`.
     pub const ITEM_FAR1: usize = 1;
-    /// Within an angle item: effort for `v` (binary16 LE).
-    pub const ITEM_EFFORT0: usize = 2;
-    /// Within an angle item: effort for `w` (binary16 LE).
-    pub const ITEM_EFFORT1: usize = 4;
+    /// Within an angle item: `γ_α` (binary16 LE).
+    pub const ITEM_GAMMA: usize = 2;
+    /// Within an angle item: `σ_α` (binary16 LE).
+    pub const ITEM_SIGMA: usize = 4;
+    /// Within an angle item: `ρ_v` (binary16 LE).
+    pub const ITEM_RHO0: usize = 6;
+    /// Within an angle item: `ρ_w` (binary16 LE).
+    pub const ITEM_RHO1: usize = 8;
 }
 
 /// Bytes of one angle item.
-pub const ANGLE_ITEM_LEN: usize = 6;
+pub const ANGLE_ITEM_LEN: usize = 10;
 /// Bytes before the angle items (header and velocity).
 pub const FIXED_LEN: usize = offset::ANGLES;
 /// Most angle items one frame can hold (on a link without trailer).
@@ -181,7 +183,8 @@ pub enum FrameError {
         /// The rejected sequence number.
         seq: u16,
     },
-    /// A velocity or effort is NaN or infinite.
+    /// A value is NaN or infinite, `|σ| > 1`, a distance is not positive, or an estimate
+    /// is below the receiver's `r_min`.
     InvalidValue,
     /// A COBS stream chunk that does not decode.
     Cobs,
@@ -205,7 +208,10 @@ impl core::fmt::Display for FrameError {
                 f,
                 "stale or repeated sequence number {seq} from agent {sender}"
             ),
-            Self::InvalidValue => write!(f, "non-finite velocity or effort"),
+            Self::InvalidValue => write!(
+                f,
+                "non-finite value, |σ| > 1, non-positive distance or estimate below r_min"
+            ),
             Self::Cobs => write!(f, "COBS chunk does not decode"),
         }
     }

@@ -16,15 +16,22 @@ fn get<const N: usize>(b: &[u8], at: usize) -> [u8; N] {
         .unwrap_or([0; N])
 }
 
-/// One angle item, decoded.
+/// One angle item, decoded (fields: see [`super`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct AngleItem {
     /// The far vertices `v`, `w` of the angle `(sender; v, w)`.
     pub far: [AgentId; 2],
-    /// The efforts `e_v`, `e_w` (meaning by estimator mode: see [`super`]).
-    pub effort: [f32; 2],
+    /// `γ_α` (S7).
+    pub gamma: f32,
+    /// `σ_α = s_nv × s_nw`.
+    pub sigma: f32,
+    /// `[ρ_v, ρ_w]`: the distances the apex used.
+    pub rho: [f32; 2],
 }
+
+/// binary16 `1.0` (`|σ| ≤ 1`).
+const F16_ONE: u16 = 0x3C00;
 
 /// A frame whose length, trailer, version and modes are checked; its items are read in
 /// place (no copy of the frame).
@@ -49,22 +56,26 @@ impl<'a> FrameView<'a> {
         self.items.is_empty()
     }
 
-    /// The raw items: far vertices and binary16 effort codes.
+    /// The raw items: far vertices and the binary16 codes of `[γ, σ, ρ_v, ρ_w]`.
     #[inline]
-    pub(crate) fn raw_items(&self) -> impl Iterator<Item = ([AgentId; 2], [u16; 2])> + 'a {
+    pub(crate) fn raw_items(&self) -> impl Iterator<Item = ([AgentId; 2], [u16; 4])> + 'a {
         self.items.chunks_exact(ANGLE_ITEM_LEN).map(|b| {
+            let code = |at| u16::from_le_bytes(get(b, at));
             (
                 get::<2>(b, offset::ITEM_FAR0),
                 [
-                    u16::from_le_bytes(get(b, offset::ITEM_EFFORT0)),
-                    u16::from_le_bytes(get(b, offset::ITEM_EFFORT1)),
+                    code(offset::ITEM_GAMMA),
+                    code(offset::ITEM_SIGMA),
+                    code(offset::ITEM_RHO0),
+                    code(offset::ITEM_RHO1),
                 ],
             )
         })
     }
 
-    /// Checks every value: a finite velocity, finite efforts, two distinct far vertices
-    /// per item. Reads nothing but bits (no float conversion).
+    /// Checks every value: a finite velocity, and per item two distinct far vertices, a
+    /// finite `γ`, `|σ| ≤ 1`, finite positive distances. Reads nothing but bits (no float
+    /// conversion).
     #[inline]
     pub fn validate(&self) -> Result<(), FrameError> {
         let [vx, vy] = self.velocity;
@@ -72,30 +83,37 @@ impl<'a> FrameView<'a> {
         if vx * 0.0 + vy * 0.0 != 0.0 {
             return Err(FrameError::InvalidValue);
         }
-        let mut finite = true;
-        for (far, [e0, e1]) in self.raw_items() {
+        let mut ok = true;
+        for (far, [gamma, sigma, rho0, rho1]) in self.raw_items() {
             if far[0] == far[1] {
                 return Err(FrameError::Malformed);
             }
-            // binary16 exponent all ones: infinity or NaN.
-            finite &= (e0 & 0x7C00 != 0x7C00) & (e1 & 0x7C00 != 0x7C00);
+            // binary16: exponent all ones is ∞ or NaN; magnitude bits order the values.
+            // A positive finite value is 0x0001..=0x7BFF.
+            let positive = |c: u16| c.wrapping_sub(1) < 0x7BFF;
+            ok &= (gamma & 0x7C00 != 0x7C00)
+                & (sigma & 0x7FFF <= F16_ONE)
+                & positive(rho0)
+                & positive(rho1);
         }
-        if finite {
+        if ok {
             Ok(())
         } else {
             Err(FrameError::InvalidValue)
         }
     }
 
-    /// The decoded angle items (non-finite efforts read as NaN; call
-    /// [`FrameView::validate`] first).
+    /// The decoded angle items (invalid codes read as NaN; call [`FrameView::validate`]
+    /// first).
     pub fn angles(&self) -> impl Iterator<Item = AngleItem> + 'a {
-        self.raw_items().map(|(far, [e0, e1])| AngleItem {
-            far,
-            effort: [
-                quant::decode(e0).unwrap_or(f32::NAN),
-                quant::decode(e1).unwrap_or(f32::NAN),
-            ],
+        self.raw_items().map(|(far, [g, s, r0, r1])| {
+            let v = |c| quant::decode(c).unwrap_or(f32::NAN);
+            AngleItem {
+                far,
+                gamma: v(g),
+                sigma: v(s),
+                rho: [v(r0), v(r1)],
+            }
         })
     }
 }

@@ -43,18 +43,20 @@ impl FrameWriter {
         self.len = FIXED_LEN;
     }
 
-    /// Appends one angle item (far vertices and their binary16 effort codes, see
-    /// [`super::quant`]); `false`, and nothing written, if the frame is full.
+    /// Appends one angle item: far vertices and the binary16 codes (see [`super::quant`])
+    /// of `[γ, σ, ρ_v, ρ_w]`; `false`, and nothing written, if the frame is full.
     #[inline]
-    pub fn push_angle(&mut self, far: [AgentId; 2], effort: [u16; 2]) -> bool {
+    pub fn push_angle(&mut self, far: [AgentId; 2], codes: [u16; 4]) -> bool {
         if self.len + ANGLE_ITEM_LEN + self.integrity.trailer_len() > MAX_FRAME_LEN {
             return false;
         }
         let at = self.len;
         let b = &mut self.buf;
         put(b, at + offset::ITEM_FAR0, far);
-        put(b, at + offset::ITEM_EFFORT0, effort[0].to_le_bytes());
-        put(b, at + offset::ITEM_EFFORT1, effort[1].to_le_bytes());
+        put(b, at + offset::ITEM_GAMMA, codes[0].to_le_bytes());
+        put(b, at + offset::ITEM_SIGMA, codes[1].to_le_bytes());
+        put(b, at + offset::ITEM_RHO0, codes[2].to_le_bytes());
+        put(b, at + offset::ITEM_RHO1, codes[3].to_le_bytes());
         self.len += ANGLE_ITEM_LEN;
         true
     }
