@@ -5,7 +5,7 @@
 use super::state::{AngleState, Remote, Role};
 use super::{pick, Agent};
 use crate::config::AgentId;
-use crate::wire::{check_frame, mode_byte, quant, FrameError};
+use crate::wire::{check_frame, mode_byte, quant, FrameError, RawAngle};
 use crate::{Real, Vec2};
 
 /// A broadcast item at full precision (the wire rounds the angle's values to binary16).
@@ -93,14 +93,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         }
         // The whole frame is valid before anything is applied. With estimators, the
         // distances are estimates: at least r_min (as rounded: rounding is monotone).
-        frame.validate()?;
-        let rho_min = self.rho_min_code;
-        if frame
-            .raw_items()
-            .any(|(_, [_, _, r0, r1])| r0 < rho_min || r1 < rho_min)
-        {
-            return Err(FrameError::InvalidValue);
-        }
+        frame.validate(self.rho_min_code)?;
         if let Some(n) = self.neighbours.get_mut(slot) {
             n.last_seq = Some(seq);
             n.age = T::zero();
@@ -111,16 +104,16 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             Item::Velocity(Vec2::new(T::of_f32(vx), T::of_f32(vy))),
         );
         let me = self.config.id;
-        for (far, code) in frame.raw_items() {
+        for RawAngle { far, codes } in frame.raw_items() {
             // Only the items for angles of which this agent is a far vertex (`apply`
-            // checks it again; this saves decoding the others).
+            // checks it again; this saves decoding the others). Validated: finite.
             if far.contains(&me) {
-                let v = |c: u16| T::of_f32(quant::decode(c).unwrap_or(0.0));
+                let v = |c: u16| T::of_f32(quant::from_code(c));
                 let item = Item::Angle {
                     far,
-                    gamma: v(code[0]),
-                    sigma: v(code[1]),
-                    rho: [v(code[2]), v(code[3])],
+                    gamma: v(codes[0]),
+                    sigma: v(codes[1]),
+                    rho: [v(codes[2]), v(codes[3])],
                 };
                 self.apply(slot, item);
             }
@@ -194,13 +187,13 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     };
                     if let Role::Far(k) = a.role {
                         if pick(&a.far, 1 - k.min(1)) == other && pick(&a.far, k) == me {
-                            a.remote = Some(Remote {
+                            a.remote = Remote {
                                 gamma,
                                 sigma,
                                 rho: pick(&rho, mine),
                                 delta: Vec2::zeros(),
                                 v_ref: None,
-                            });
+                            };
                             a.remote_age = T::zero();
                         }
                     }
@@ -211,16 +204,10 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
 }
 
 /// What an apex sends of angle `a` (`γ`, `σ`, `ρ`): the values of its last sense, if it
-/// computed them and they are finite.
+/// computed them (they are then finite: see `sensing::apex_part`).
 #[inline]
 #[allow(clippy::type_complexity)]
 fn sent_angle<T: Real>(a: &AngleState<T>) -> Option<(T, T, [T; 2])> {
-    match (a.role, &a.part) {
-        (Role::Apex, Ok(p))
-            if p.gamma.finite() && p.sigma.finite() && p.rho[0].finite() && p.rho[1].finite() =>
-        {
-            Some((p.gamma, p.sigma, p.rho))
-        }
-        _ => None,
-    }
+    let p = &a.part;
+    (a.role == Role::Apex && a.fault.is_none()).then_some((p.gamma, p.sigma, p.rho))
 }

@@ -15,23 +15,15 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// the same law; simulators that integrate the estimators themselves (continuous
     /// time) call [`Agent::sense`], exchange, then this.
     pub fn evaluate(&self) -> Result<Evaluation<T, MT>, Fault> {
-        let mut rates = heapless::Vec::new();
-        for _ in 0..self.angles.len() {
-            // Capacity equals the number of triangles: cannot fail.
-            let _ = rates.push([[T::zero(); 2]; 2]);
-        }
-        let (force, degenerate) = self.law(|ti, ai, e, rate| {
-            if let Some(r) = rates
-                .get_mut(ti)
-                .and_then(|t| t.get_mut(ai))
-                .and_then(|a| a.get_mut(e))
-            {
-                *r = rate;
-            }
-        })?;
+        let (force, degenerate) = self.law()?;
+        let estimate_rates = self
+            .angles
+            .iter()
+            .map(|[a0, a1]| [a0.rate.get(), a1.rate.get()])
+            .collect();
         Ok(Evaluation {
             force,
-            estimate_rates: rates,
+            estimate_rates,
             degenerate,
         })
     }
@@ -41,7 +33,13 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// is the documented safe command `U = −safe_damping · v` (no formation force) and the
     /// estimates hold still.
     pub fn step(&mut self, m: &Measurements<'_, T>) -> StepOutput<T> {
-        let result = self.sense(m).and_then(|()| self.control(m.dt));
+        let result = self.sense(m).and_then(|()| self.law());
+        if result.is_ok() {
+            // The law's flows, over dt (sampled S10: `r̂ ← max(r_min, r̂ + Δt·S9)`; the
+            // continuous projection the law applies first changes nothing here: it acts
+            // only when r̂ ≤ r_min and S9 < 0, and then both give r_min).
+            self.integrate(m.dt);
+        }
         self.comm_due = self.comm_countdown == 0;
         self.comm_countdown = match self.comm_countdown.checked_sub(1) {
             Some(c) => c,
@@ -75,109 +73,99 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         }
     }
 
-    /// The law, then the owned estimates integrated over `dt` (sampled S10:
-    /// `r̂ ← max(r_min, r̂ + Δt·S9)`; the continuous projection the law applies first
-    /// changes nothing here, since it acts only when r̂ ≤ r_min and S9 < 0, and then both
-    /// give r_min). Returns the unsaturated force and `degenerate`.
-    fn control(&mut self, dt: T) -> Result<(Vec2<T>, bool), Fault> {
-        let mut rates = [[[T::zero(); 2]; 2]; MT];
-        let out = self.law(|ti, ai, e, rate| {
-            if let Some(r) = rates
-                .get_mut(ti)
-                .and_then(|t| t.get_mut(ai))
-                .and_then(|a| a.get_mut(e))
-            {
-                *r = rate;
-            }
-        })?;
-        self.integrate(&rates, dt);
-        Ok(out)
-    }
-
     /// The law S7–S12: the sum of the angles' S8 forces, S11 and S12, and the S9 flow
-    /// with the S10 projection of every owned estimate, reported as
-    /// `rate(triangle, angle, edge, flow)`. Returns the unsaturated force and whether a
-    /// current angle (of which this agent is the apex) is degenerate. Reads only; the
-    /// first fault in angle order wins (after staleness).
+    /// with the S10 projection of every owned estimate (left in each angle's `rate`).
+    /// Returns the unsaturated force and whether a current angle (of which this agent is
+    /// the apex) is degenerate. The first fault in angle order wins (after staleness).
     #[inline]
-    fn law(&self, mut rate: impl FnMut(usize, usize, usize, T)) -> Result<(Vec2<T>, bool), Fault> {
+    fn law(&self) -> Result<(Vec2<T>, bool), Fault> {
         self.check_fresh()?;
         let c = &self.config;
         let v = self.velocity;
         let v_star = vec2(c.velocity_reference.at(self.time));
         let (mode, r_min) = (c.estimator, c.min_estimate);
         let timeout = c.limits.neighbour_timeout;
+        let zero = T::zero();
         // S12.
         let mut force = law::velocity_force(&c.friction, &c.velocity_damping, &v, &v_star);
         // Largest |y| (NaN ignored): degenerate iff above the margin.
-        let mut y_max = T::zero();
-        for (ti, tri) in self.angles.iter().enumerate() {
-            for (ai, a) in tri.iter().enumerate() {
-                match a.role {
-                    Role::Apex => {
-                        let p = a.part?;
-                        let y_abs = p.y.abs();
-                        if y_abs > y_max {
-                            y_max = y_abs;
-                        }
-                        // S8 on the apex (computed when sensing).
-                        force += p.force;
-                        if mode == EstimatorMode::Measured {
-                            continue;
-                        }
-                        for e in 0..2 {
-                            let n = self.neighbour(pick(&[a.slots[1], a.slots[2]], e))?;
-                            let r_hat = pick(&a.estimate, e);
-                            // S3 with the own bearing s_uv and the far vertex's velocity.
-                            let rr = geometry::range_rate(&n.s, &(n.velocity()? - v));
-                            let flow = law::estimator_rate(
-                                rr,
-                                p.gamma,
-                                pick(&p.share, e),
-                                a.estimator_gain,
-                                r_hat,
-                            );
-                            rate(ti, ai, e, law::projected_rate(r_hat, flow, r_min));
-                        }
+        let mut y_max = zero;
+        for a in self.angles.as_slice().as_flattened() {
+            let rate = match a.role {
+                Role::Apex => {
+                    if let Some(fault) = a.fault {
+                        return Err(fault);
                     }
-                    Role::Far(k) => {
-                        let n = self.neighbour(a.slots[0])?;
-                        let (s_ku, _) = n.bearing()?;
-                        let remote = match a.remote {
-                            Some(r) if within(a.remote_age, timeout) => r,
-                            _ => return Err(Fault::MissingData(a.apex)),
+                    let p = &a.part;
+                    let y_abs = p.y.abs();
+                    if y_abs > y_max {
+                        y_max = y_abs;
+                    }
+                    // S8 on the apex (computed when sensing).
+                    force += p.force;
+                    if mode == EstimatorMode::Measured {
+                        [zero; 2]
+                    } else {
+                        // S9 with S3 for ṙ_e (own bearing, the far vertex's velocity), S10.
+                        let flow = |slot: usize, e: usize| -> Result<T, Fault> {
+                            let n = self.neighbour(slot)?;
+                            let rr = geometry::range_rate(&n.s, &(n.velocity()? - v));
+                            let r_hat = pick(&a.estimate, e);
+                            let share = pick(&p.share, e);
+                            let f =
+                                law::estimator_rate(rr, p.gamma, share, a.estimator_gain, r_hat);
+                            Ok(law::projected_rate(r_hat, f, r_min))
                         };
-                        // SPEC §6: the apex's shared estimate, the own copy, or the range.
-                        let r = match mode {
-                            EstimatorMode::Shared => remote.rho,
-                            EstimatorMode::PerAgent => pick(&a.estimate, k),
-                            EstimatorMode::Measured => n.range()?,
-                        };
-                        let dv = remote.v_ref.map_or(Vec2::zeros(), |v_ref| v - v_ref);
-                        // S6–S8 on this far vertex.
-                        let (gamma_k, g_k, f) = law::far_angle(
-                            remote.gamma,
-                            remote.sigma,
-                            k,
-                            r,
-                            &s_ku,
-                            a.stiffness,
-                            a.damping,
-                            &remote.delta,
-                            &dv,
-                        );
-                        force += f;
-                        if mode == EstimatorMode::PerAgent {
-                            // S9 on the own copy r̂^k (SPEC §6): ṙ_uk = s_ukᵀ(v_k − v_u) with
-                            // s_uk = −s_ku (S3), and the share f^k = +g_kᵀ v_k / r̂^k.
-                            let rr = geometry::range_rate(&-s_ku, &(v - n.velocity()?));
-                            let share = law::own_share(&g_k, &v, r, true);
-                            let flow = law::estimator_rate(rr, gamma_k, share, a.estimator_gain, r);
-                            rate(ti, ai, k, law::projected_rate(r, flow, r_min));
-                        }
+                        [flow(a.slots[1], 0)?, flow(a.slots[2], 1)?]
                     }
                 }
-            }
+                Role::Far(k) => {
+                    let n = self.neighbour(a.slots[0])?;
+                    let (s_ku, _) = n.bearing()?;
+                    if !within(a.remote_age, timeout) {
+                        return Err(Fault::MissingData(a.apex));
+                    }
+                    let remote = &a.remote;
+                    // SPEC §6: the apex's shared estimate, the own copy, or the range.
+                    let r = match mode {
+                        EstimatorMode::Shared => remote.rho,
+                        EstimatorMode::PerAgent => pick(&a.estimate, k),
+                        EstimatorMode::Measured => n.range()?,
+                    };
+                    let dv = match remote.v_ref {
+                        Some(v_ref) => v - v_ref,
+                        None => Vec2::zeros(),
+                    };
+                    // S6–S8 on this far vertex.
+                    let (gamma_k, g_k, f) = law::far_angle(
+                        remote.gamma,
+                        remote.sigma,
+                        k,
+                        r,
+                        &s_ku,
+                        a.stiffness,
+                        a.damping,
+                        &remote.delta,
+                        &dv,
+                    );
+                    force += f;
+                    if mode == EstimatorMode::PerAgent {
+                        // S9 on the own copy r̂^k (SPEC §6): ṙ_uk = s_ukᵀ(v_k − v_u) with
+                        // s_uk = −s_ku (S3), and the share f^k = +g_kᵀ v_k / r̂^k.
+                        let rr = geometry::range_rate(&-s_ku, &(v - n.velocity()?));
+                        let share = law::own_share(&g_k, &v, r, true);
+                        let flow = law::estimator_rate(rr, gamma_k, share, a.estimator_gain, r);
+                        let mut rate = [zero; 2];
+                        if let Some(x) = rate.get_mut(k) {
+                            *x = law::projected_rate(r, flow, r_min);
+                        }
+                        rate
+                    } else {
+                        [zero; 2]
+                    }
+                }
+            };
+            a.rate.set(rate);
         }
         if let Some(l) = &c.leader {
             // S11 with z = q_a − q_b; the partner offset p = q_partner − q_self.

@@ -61,16 +61,15 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         }
     }
 
-    /// One sampled step of every estimate: `r̂ ← max(r_min, r̂ + Δt·rate)` (S10), with the
-    /// rates indexed `[triangle][angle][edge]` (zero for the estimates not owned, which
-    /// then stay as they are: they are never below `r_min`).
-    pub(super) fn integrate(&mut self, rates: &[[[T; 2]; 2]; MT], dt: T) {
+    /// One sampled step of every estimate with the flows the law left in `rate`:
+    /// `r̂ ← max(r_min, r̂ + Δt·rate)` (S10). Estimates not owned have rate zero and stay as
+    /// they are (they are never below `r_min`).
+    pub(super) fn integrate(&mut self, dt: T) {
         let r_min = self.config.min_estimate;
-        for (tri, tri_rates) in self.angles.iter_mut().zip(rates.iter()) {
-            for (a, ar) in tri.iter_mut().zip(tri_rates.iter()) {
-                for (est, rate) in a.estimate.iter_mut().zip(ar.iter()) {
-                    *est = law::estimator_step(*est, *rate, dt, r_min);
-                }
+        for a in self.angles.as_mut_slice().as_flattened_mut() {
+            let rate = a.rate.get();
+            for (est, rate) in a.estimate.iter_mut().zip(rate) {
+                *est = law::estimator_step(*est, rate, dt, r_min);
             }
         }
     }

@@ -43,7 +43,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 }
                 let fault = Fault::Measurement(e);
                 for a in self.angles.as_mut_slice().as_flattened_mut() {
-                    a.part = Err(fault);
+                    a.fault = Some(fault);
                 }
                 return Err(fault);
             }
@@ -74,19 +74,22 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         let (mode, v) = (self.config.estimator, self.velocity);
         let nbs = self.neighbours.as_slice();
         for a in self.angles.as_mut_slice().as_flattened_mut() {
-            match (a.role, a.remote.as_mut()) {
-                (Role::Apex, _) => a.part = apex_part(nbs, mode, a, &v),
-                (Role::Far(_), Some(remote)) => {
-                    // Own motion relative to the apex since it measured, taken as the
-                    // previous tick (the apex's velocity is the one it sent with it).
-                    let v_apex = nbs
-                        .get(a.slots[0])
-                        .and_then(|n| n.velocity)
-                        .unwrap_or(v_prev);
-                    remote.delta += (v_prev - v_apex) * dt;
-                    remote.v_ref.get_or_insert(v_prev);
+            if a.role == Role::Apex {
+                match apex_part(nbs, mode, a, &v) {
+                    Ok(p) => {
+                        a.part = p;
+                        a.fault = None;
+                    }
+                    Err(f) => a.fault = Some(f),
                 }
-                (Role::Far(_), None) => {}
+            } else if let Some(Some(v_apex)) = nbs.get(a.slots[0]).map(|n| n.velocity) {
+                // Own motion relative to the apex since it measured, taken as the previous
+                // tick (the apex's velocity is the one it sent with it).
+                let r = &mut a.remote;
+                r.delta += (v_prev - v_apex) * dt;
+                if r.v_ref.is_none() {
+                    r.v_ref = Some(v_prev);
+                }
             }
         }
         Ok(())
@@ -174,6 +177,11 @@ fn apex_part<T: Real, const MT: usize>(
         a.damping,
         r,
     );
+    // γ is finite whenever the measurements are (they were checked) unless a rate
+    // overflowed; σ and the distances are finite. Only finite values are sent.
+    if !finite(k.gamma) {
+        return Err(Fault::NonFinite);
+    }
     let share = match mode {
         // S9 with the angle's own shares t_{α,e} (S5).
         EstimatorMode::Shared => k.t,

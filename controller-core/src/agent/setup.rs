@@ -1,11 +1,12 @@
 //! Building an [`Agent`] from its configuration: the checks of SPEC §3 and of every
 //! parameter, the angle states and the neighbour table.
 
-use super::state::{AngleState, Neighbour, Role, SELF_SLOT};
+use super::state::{AngleState, ApexPart, Neighbour, Remote, Role, SELF_SLOT};
 use super::{Agent, Fault};
 use crate::config::{AgentConfig, AgentId, ConfigError, EstimatorMode, Limits, TriangleConfig};
 use crate::wire::{quant, FrameWriter};
 use crate::{FrameStats, Real, Vec2};
+use core::cell::Cell;
 
 fn finite_pair<T: Real>(v: &[T; 2], min: T) -> bool {
     v[0].finite() && v[1].finite() && v[0] >= min && v[1] >= min
@@ -65,8 +66,10 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     damping: a.damping,
                     estimator_gain: a.estimator_gain,
                     estimate: [config.initial_estimate; 2],
-                    part: Err(Fault::MissingBearing(far[0])),
-                    remote: None,
+                    rate: Cell::new([T::zero(); 2]),
+                    part: ApexPart::default(),
+                    fault: Some(Fault::MissingBearing(far[0])),
+                    remote: Remote::default(),
                     remote_age: T::lit(f64::INFINITY),
                 });
             }

@@ -4,6 +4,7 @@
 use super::Fault;
 use crate::config::AgentId;
 use crate::{Real, Vec2};
+use core::cell::Cell;
 
 /// No neighbour slot (the vertex is this agent itself).
 pub(super) const SELF_SLOT: usize = usize::MAX;
@@ -19,7 +20,7 @@ pub(super) enum Role {
 
 /// What the apex of an angle computed from its own measurements at the last sense
 /// (S4–S8, see [`crate::law::apex_angle`]), and what its estimators and far vertices need.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub(super) struct ApexPart<T: Real> {
     /// `y_α` (S4), for the degeneracy check.
     pub y: T,
@@ -37,7 +38,7 @@ pub(super) struct ApexPart<T: Real> {
 }
 
 /// What a far vertex last received of an angle from its apex, and its own motion since.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Remote<T: Real> {
     /// `γ_α` (S7) as the apex computed it.
     pub gamma: T,
@@ -53,7 +54,7 @@ pub(super) struct Remote<T: Real> {
 }
 
 /// One controlled angle `α = (apex; far[0], far[1])` this agent belongs to.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub(super) struct AngleState<T: Real> {
     pub apex: AgentId,
     pub far: [AgentId; 2],
@@ -66,10 +67,16 @@ pub(super) struct AngleState<T: Real> {
     pub estimator_gain: T,
     /// Own estimates for edges `[apex–far0, apex–far1]` (only the owned ones are used).
     pub estimate: [T; 2],
-    /// Apex: the result of the last sense, or the fault that prevented it.
-    pub part: Result<ApexPart<T>, Fault>,
+    /// The S9 flows (with the S10 projection) of `estimate` found by the last evaluation
+    /// of the law (zero where not owned): written by the read-only law, read by the
+    /// integration that follows it.
+    pub rate: Cell<[T; 2]>,
+    /// Apex: the result of the last sense (valid when `fault` is `None`).
+    pub part: ApexPart<T>,
+    /// Apex: why the last sense could not compute the angle.
+    pub fault: Option<Fault>,
     /// Far vertex: what the apex last sent of this angle.
-    pub remote: Option<Remote<T>>,
+    pub remote: Remote<T>,
     /// Far vertex: seconds since it arrived (`∞` before the first).
     pub remote_age: T,
 }

@@ -29,12 +29,13 @@ pub const ABS_ERROR: f32 = 1.0 / 33_554_432.0;
 pub const MIN_NORMAL: f32 = 1.0 / 16384.0;
 
 /// The binary16 code of `x`, saturated to `±MAX`, and whether it saturated. `x` must not
-/// be NaN (the caller sends only finite efforts; a NaN would give a NaN code, which
+/// be NaN (the caller sends only finite values; a NaN would give a NaN code, which
 /// receivers refuse).
 #[inline]
 pub fn encode(x: f32) -> (u16, bool) {
     let saturated = x.abs() > MAX;
-    (f16::from_f32(x.clamp(-MAX, MAX)).to_bits(), saturated)
+    let clamped = if saturated { MAX.copysign(x) } else { x };
+    (to_code(clamped), saturated)
 }
 
 /// The value of a binary16 code; `None` for infinity and NaN.
@@ -44,6 +45,76 @@ pub fn decode(code: u16) -> Option<f32> {
     if code & 0x7C00 == 0x7C00 {
         None
     } else {
-        Some(f16::from_bits(code).to_f32())
+        Some(from_code(code))
     }
+}
+
+/// IEEE 754 conversion `f32` → binary16, round to nearest even (the `half` crate).
+#[inline]
+pub fn to_code_portable(x: f32) -> u16 {
+    f16::from_f32(x).to_bits()
+}
+
+/// IEEE 754 conversion binary16 → `f32`, exact (the `half` crate).
+#[inline]
+pub fn from_code_portable(code: u16) -> f32 {
+    f16::from_bits(code).to_f32()
+}
+
+/// `f32` → binary16 with the FPU's `vcvtb.f16.f32` (ARMv7E-M's single-precision FPU
+/// converts half precision in hardware: IEEE format with the reset `FPSCR.AHP = 0`,
+/// round to nearest even, subnormals kept with the reset `FPSCR.FZ = 0`). The firmware
+/// checks it against [`to_code_portable`] (`measure`, `FWCHECK f16`).
+#[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+#[inline]
+pub fn to_code(x: f32) -> u16 {
+    let out: u32;
+    // SAFETY: reads and writes only the FPU register s15, declared clobbered; no memory.
+    unsafe {
+        core::arch::asm!(
+            "vmov s15, {x}",
+            "vcvtb.f16.f32 s15, s15",
+            "vmov {y}, s15",
+            x = in(reg) x.to_bits(),
+            y = out(reg) out,
+            out("s15") _,
+            options(pure, nomem, nostack),
+        );
+    }
+    // The conversion writes the low half of s15.
+    (out & 0xFFFF) as u16
+}
+
+/// binary16 → `f32` with the FPU's `vcvtb.f32.f16` (see [`to_code`]).
+#[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+#[inline]
+pub fn from_code(code: u16) -> f32 {
+    let out: u32;
+    // SAFETY: reads and writes only the FPU register s15, declared clobbered; no memory.
+    unsafe {
+        core::arch::asm!(
+            "vmov s15, {x}",
+            "vcvtb.f32.f16 s15, s15",
+            "vmov {y}, s15",
+            x = in(reg) u32::from(code),
+            y = out(reg) out,
+            out("s15") _,
+            options(pure, nomem, nostack),
+        );
+    }
+    f32::from_bits(out)
+}
+
+/// `f32` → binary16 elsewhere: [`to_code_portable`].
+#[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
+#[inline]
+pub fn to_code(x: f32) -> u16 {
+    to_code_portable(x)
+}
+
+/// binary16 → `f32` elsewhere: [`from_code_portable`].
+#[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
+#[inline]
+pub fn from_code(code: u16) -> f32 {
+    from_code_portable(code)
 }

@@ -232,7 +232,7 @@ impl<P: SerialPort> Session<P> {
         let report = control.tick(&mut board);
         let out = LinkOutput::new(
             &report.output,
-            report.frames_sent,
+            usize::from(report.frames_sent),
             control.agent().stats().rejected(),
         );
         // At most 3 · MT ≤ MAX_LINK_ESTIMATES: never refused for this board.
