@@ -4,9 +4,12 @@
 use crate::Real;
 use serde::{Deserialize, Serialize};
 
-/// An agent identifier. It must be unique among the agents within two hops of each agent
-/// in the graph (frames name neighbours and their neighbours by id); a formation of at most
-/// 256 agents can simply number them.
+pub use crate::wire::Integrity;
+
+/// An agent identifier on the wire. It must be unique among the agents within two hops of
+/// each agent in the graph (frames name neighbours and their neighbours by id) and among
+/// the agents whose frames one receiver can hear; a formation of at most 256 agents can
+/// simply number them, a larger one colours its graph (host-sim does).
 pub type AgentId = u8;
 
 /// Capacity of a piecewise-constant schedule (`v*`, `z*`).
@@ -61,8 +64,9 @@ pub struct ScheduleStep<T> {
     pub value: [T; 2],
 }
 
-/// A piecewise-constant 2-D schedule, steps sorted by `from`. Before the first step the
-/// first value holds; an empty schedule is zero.
+/// A piecewise-constant 2-D schedule, steps sorted by strictly increasing `from` (checked by
+/// [`crate::Agent::new`]). Before the first step the first value holds; an empty schedule
+/// is zero.
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Schedule<T> {
@@ -80,6 +84,19 @@ impl<T: Real> Schedule<T> {
             value,
         });
         Self { steps }
+    }
+
+    /// Every time and value is finite and the times strictly increase.
+    pub fn is_valid(&self) -> bool {
+        let finite = self
+            .steps
+            .iter()
+            .all(|st| st.from.finite() && st.value[0].finite() && st.value[1].finite());
+        finite
+            && self
+                .steps
+                .windows(2)
+                .all(|w| matches!(w, [a, b] if a.from < b.from))
     }
 
     /// The value at time `t`.
@@ -177,6 +194,16 @@ pub struct AgentConfig<T, const MT: usize> {
     pub leader: Option<LeaderConfig<T>>,
     /// Safety limits.
     pub limits: Limits<T>,
+    /// How frames are protected ([`Integrity`]); the same for every agent of a swarm.
+    pub integrity: Integrity,
+    /// Broadcast every `comm_every`-th control step (`≥ 1`; 1 = every step). The agent
+    /// controls every step on its own fresh measurements and the neighbour data it last
+    /// heard; [`Limits::neighbour_timeout`] must exceed the communication period.
+    pub comm_every: u16,
+    /// Which step of each `comm_every` broadcasts (`< comm_every`): step `k` (counted from
+    /// 0) broadcasts when `k mod comm_every = comm_phase`. Spreading the phases spreads the
+    /// swarm's frames over the communication period.
+    pub comm_phase: u16,
 }
 
 impl<T: Real, const MT: usize> AgentConfig<T, MT> {
@@ -193,12 +220,15 @@ impl<T: Real, const MT: usize> AgentConfig<T, MT> {
             velocity_reference: Schedule::default(),
             leader: None,
             limits: Limits::default(),
+            integrity: Integrity::Crc16,
+            comm_every: 1,
+            comm_phase: 0,
         }
     }
 }
 
 /// Why a configuration was refused by [`crate::Agent::new`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum ConfigError {
     /// Triangle `triangle` does not contain this agent.
@@ -229,9 +259,17 @@ pub enum ConfigError {
     },
     /// More distinct neighbours than the capacity `NB`.
     TooManyNeighbours,
-    /// A scalar parameter (estimate, limit, friction, damping, schedule, leader gain) is
-    /// not finite or out of range.
+    /// More triangles than the agent type can index (`MT` above
+    /// [`crate::agent::MAX_MT`]).
+    TooManyTriangles,
+    /// A scalar parameter (estimate, limit, friction, damping, leader gain) is not finite
+    /// or out of range.
     BadParameter,
+    /// A `v*` or `z*` schedule has a non-finite entry or times that do not strictly
+    /// increase.
+    BadSchedule,
+    /// `comm_every` is 0 or `comm_phase ≥ comm_every`.
+    BadCommRate,
     /// The leader partner is this agent itself.
     BadLeader,
 }
@@ -244,8 +282,11 @@ impl core::fmt::Display for ConfigError {
             Self::BadApex { triangle } => write!(f, "triangle {triangle}: an apex is not a vertex, or both angles share it"),
             Self::InfeasibleAngles { triangle } => write!(f, "triangle {triangle}: desired angles outside (margin, 180° − margin) or summing to 180° or more"),
             Self::BadGain { triangle } => write!(f, "triangle {triangle}: a gain is not finite or not positive"),
-            Self::TooManyNeighbours => write!(f, "more neighbours or triangles than the agent's capacity"),
+            Self::TooManyNeighbours => write!(f, "more neighbours than the agent's capacity"),
+            Self::TooManyTriangles => write!(f, "more triangles than the agent type can index"),
             Self::BadParameter => write!(f, "a scalar parameter is not finite or out of range"),
+            Self::BadSchedule => write!(f, "a schedule has a non-finite entry or times that do not strictly increase"),
+            Self::BadCommRate => write!(f, "comm_every is 0 or comm_phase is not below comm_every"),
             Self::BadLeader => write!(f, "the leader partner is the agent itself"),
         }
     }

@@ -69,14 +69,13 @@ fn look(table: &[u16; 256], index: u32) -> u32 {
 pub fn checksum(data: &[u8]) -> u16 {
     let [t0, t1, t2, t3] = &TABLES;
     let mut crc = u32::from(INIT);
-    let mut words = data.chunks_exact(4);
-    for w in &mut words {
-        let w: [u8; 4] = w.try_into().unwrap_or_default();
+    let (words, rest) = data.as_chunks::<4>();
+    for w in words {
         // Four bytes at once: the register's two bytes meet the first two data bytes.
-        let x = u32::from_le_bytes(w) ^ crc;
+        let x = u32::from_le_bytes(*w) ^ crc;
         crc = look(t3, x) ^ look(t2, x >> 8) ^ look(t1, x >> 16) ^ look(t0, x >> 24);
     }
-    for &b in words.remainder() {
+    for &b in rest {
         crc = (crc >> 8) ^ look(t0, crc ^ u32::from(b));
     }
     (crc as u16) ^ XOR_OUT

@@ -11,6 +11,20 @@ pub fn project<T: Real>(s: &Vec2<T>, x: &Vec2<T>) -> Vec2<T> {
     x - s * s.dot(x)
 }
 
+/// `J x`: `x` rotated by +90° (`J = [[0, −1], [1, 0]]`). For a unit `s`, `P(s) = (Js)(Js)ᵀ`
+/// in the plane, so `P(s) x = ((Js)·x) Js` (SPEC §2).
+#[inline]
+pub fn perp<T: Real>(x: &Vec2<T>) -> Vec2<T> {
+    Vec2::new(-x.y, x.x)
+}
+
+/// `a × b = (Ja)·b = a_x b_y − a_y b_x`: for the apex bearings of an angle,
+/// `σ = s_uv × s_uw = sin α` (signed), and `g_{α,v} = σ J s_uv`, `g_{α,w} = −σ J s_uw` (S6).
+#[inline]
+pub fn cross<T: Real>(a: &Vec2<T>, b: &Vec2<T>) -> T {
+    a.x * b.y - a.y * b.x
+}
+
 /// Euclidean norm through [`Real::sqrt_fast`] (hardware square root on target).
 #[inline]
 pub fn norm<T: Real>(x: &Vec2<T>) -> T {

@@ -1,6 +1,82 @@
-//! The control law: SPEC S7–S12 as pure functions.
+//! The control law: SPEC S7–S12 as pure functions, and the per-angle kernels the agent
+//! runs (one implementation of each: [`apex_angle`] on the apex, [`far_angle`] on a far
+//! vertex).
 
+use crate::geometry::{self, AngleGeometry};
 use crate::{Real, Vec2};
+
+/// What one controlled angle gives its apex (see [`apex_angle`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ApexAngle<T: Real> {
+    /// S4: `y_α = cos α`.
+    pub y: T,
+    /// S7: `γ_α`.
+    pub gamma: T,
+    /// S5: the shares `t_{α,uv}`, `t_{α,uw}` of `ẏ_α`.
+    pub t: [T; 2],
+    /// S6: `g_{α,v}`, `g_{α,w}`.
+    pub g: [Vec2<T>; 2],
+    /// `σ = s_uv × s_uw = sin α` (signed): `g_{α,v} = σ J s_uv`, `g_{α,w} = −σ J s_uw`.
+    pub sigma: T,
+    /// S8: the force of the angle on its apex, with the distances `r` it was given.
+    pub force: Vec2<T>,
+}
+
+/// The kernel of one controlled angle `α = (u; v, w)` at its apex: S4–S6 from the apex's
+/// bearings `s = [s_uv, s_uw]` and rates `s_dot`, S7 with the angle's gains, and S8 on the
+/// apex with the distances `r = [r_uv, r_uw]` (estimates or ranges).
+#[inline]
+pub fn apex_angle<T: Real>(
+    s: &[Vec2<T>; 2],
+    s_dot: &[Vec2<T>; 2],
+    cos_desired: T,
+    stiffness: T,
+    damping: T,
+    r: [T; 2],
+) -> ApexAngle<T> {
+    // S4–S6.
+    let geo = AngleGeometry::new(s, s_dot);
+    // S7.
+    let gamma = port_effort(stiffness, damping, geo.y - cos_desired, geo.y_dot);
+    ApexAngle {
+        y: geo.y,
+        gamma,
+        t: geo.t,
+        g: geo.g,
+        sigma: geometry::cross(&s[0], &s[1]),
+        // S8.
+        force: apex_force(gamma, &geo.g, r),
+    }
+}
+
+/// The far vertex `k` of an angle `α = (u; v, w)` (`k = 0` for `v`, 1 for `w`): its S8 force
+/// and its port effort, from what the apex sent — `γ_α` (S7), `σ = s_uv × s_uw` — and its
+/// own fresh bearing to the apex `s_ku` (`s_uk = −s_ku`, SPEC §2), its distance `r_k` to
+/// the apex (the apex's shared estimate, its own copy, or its range: SPEC §6), and its own
+/// motion relative to the apex since the apex measured: displacement `δ` and change of
+/// own velocity `Δv`. With `n_k = J s_uk` and `σ_k = ±σ`, `g_{α,k} = σ_k n_k` (S6), so to
+/// first order `Δy = g_kᵀ δ / r_k` and `Δẏ = g_kᵀ Δv / r_k` (S4, S5), and
+/// `γ_k = γ_α + c_α Δy + d_α Δẏ` (S7): the far vertex's own stiffness and damping act on
+/// fresh measurements. Returns `(γ_k, g_k, U_k)` with `U_k = −(γ_k / r_k) g_k` (S8).
+#[inline]
+#[allow(clippy::too_many_arguments)]
+pub fn far_angle<T: Real>(
+    gamma: T,
+    sigma: T,
+    k: usize,
+    r_k: T,
+    s_to_apex: &Vec2<T>,
+    stiffness: T,
+    damping: T,
+    delta: &Vec2<T>,
+    dv: &Vec2<T>,
+) -> (T, Vec2<T>, Vec2<T>) {
+    let sigma_k = if k == 0 { sigma } else { -sigma };
+    // n_k = J s_uk = −J s_ku.
+    let g = geometry::perp(s_to_apex) * -sigma_k;
+    let gamma_k = gamma + g.dot(&(delta * stiffness + dv * damping)) / r_k;
+    (gamma_k, g, g * (-gamma_k / r_k))
+}
 
 /// S7: port effort `γ_α = c_α ỹ_α + d_α ẏ_α`.
 #[inline]
@@ -15,12 +91,6 @@ pub fn angle_forces<T: Real>(gamma: T, g: &[Vec2<T>; 2], r: [T; 2]) -> [Vec2<T>;
     let fv = g[0] * (-gamma / r[0]);
     let fw = g[1] * (-gamma / r[1]);
     [-(fv + fw), fv, fw]
-}
-
-/// S8: force of one angle on its far vertex `k` (`g_k` = `g_{α,e}` of its edge, `r` = `r̂_{α,e}`).
-#[inline]
-pub fn far_vertex_force<T: Real>(gamma: T, g_k: &Vec2<T>, r: T) -> Vec2<T> {
-    g_k * (-gamma / r)
 }
 
 /// S8: force of one angle on its apex.

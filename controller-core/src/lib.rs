@@ -2,7 +2,7 @@
 //!
 //! ONE agent's angle-based port-Hamiltonian formation controller (Li, Borja, van der
 //! Schaft, Scherpen), its passive distance estimators and its wire frames, as it runs on
-//! one microcontroller. The math is `SPEC.md` (equations cited as `S<n>`).
+//! one microcontroller. The math is `docs/spec.md` (equations cited as `S<n>`).
 //!
 //! * `no_std`, no heap, fixed capacity: [`Agent<T, MT, NB>`] holds at most `MT` triangles
 //!   and `NB` neighbours.
@@ -15,7 +15,8 @@
 //! 1. [`Agent::receive`] every frame heard since the last tick;
 //! 2. [`Agent::step`] with [`Measurements`] (bearings, optional rates, own velocity, `Δt`,
 //!    the leader's partner offset) → [`StepOutput`] (force, status);
-//! 3. [`Agent::frames`] → frames of at most 60 bytes to broadcast.
+//! 3. [`Agent::frames`] → one frame of at most 60 bytes to broadcast (two for the apex
+//!    of more than 7 angles; none on the ticks [`AgentConfig::comm_every`] skips).
 #![no_std]
 #![deny(
     clippy::unwrap_used,
@@ -45,12 +46,24 @@ pub use agent::{
     Status, StepOutput,
 };
 pub use config::{
-    AgentConfig, AgentId, AngleConfig, ConfigError, EstimatorMode, LeaderConfig, LeaderRole,
-    Limits, Schedule, ScheduleStep, TriangleConfig, MAX_SCHEDULE_STEPS,
+    AgentConfig, AgentId, AngleConfig, ConfigError, EstimatorMode, Integrity, LeaderConfig,
+    LeaderRole, Limits, Schedule, ScheduleStep, TriangleConfig, MAX_SCHEDULE_STEPS,
 };
 pub use scalar::Real;
 pub use stats::FrameStats;
 pub use wire::{FrameError, MAX_FRAME_LEN};
+
+/// Triangles per agent of the standard agent type ([`StandardAgent`]): what the host
+/// simulator, the C ABI and the tests use, and what `host-sim validate` checks a scenario
+/// against. (Firmware may choose smaller capacities for its RAM: see
+/// `firmware-example`'s boards.)
+pub const MAX_TRIANGLES: usize = 8;
+/// Neighbours per agent of the standard agent type ([`StandardAgent`]).
+pub const MAX_NEIGHBOURS: usize = 12;
+/// The standard agent: [`MAX_TRIANGLES`] triangles, [`MAX_NEIGHBOURS`] neighbours.
+pub type StandardAgent<T> = Agent<T, MAX_TRIANGLES, MAX_NEIGHBOURS>;
+/// The configuration of a [`StandardAgent`].
+pub type StandardConfig<T> = AgentConfig<T, MAX_TRIANGLES>;
 
 /// A 2-D column vector (world frame).
 pub type Vec2<T> = nalgebra::Vector2<T>;

@@ -11,7 +11,7 @@
 //!
 //! All values are `f32`, as on the target.
 
-use crate::agent::{Agent, BearingMeasurement, Fault, OwnedEstimate, Status};
+use crate::agent::{Agent, BearingMeasurement, Fault, OwnedEstimate, Status, StepOutput};
 use crate::config::{AgentConfig, AgentId, ConfigError};
 use crate::wire::{FrameError, MAX_FRAME_LEN};
 use serde::{Deserialize, Serialize};
@@ -21,7 +21,7 @@ pub const MAX_LINK_BEARINGS: usize = 12;
 /// Largest encoded link message (before COBS), in bytes.
 pub const MAX_LINK_MSG: usize = 512;
 /// Link protocol version, sent in [`TargetMsg::Ready`].
-pub const LINK_VERSION: u8 = 1;
+pub const LINK_VERSION: u8 = 2;
 
 /// One bearing measurement on the link (see [`crate::BearingMeasurement`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -79,34 +79,41 @@ pub enum HostMsg<const MT: usize> {
     Finish,
 }
 
-/// What a step produced, in a link-friendly form.
+/// What a step produced, as it crosses the link.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct LinkOutput {
     /// The force command.
     pub force: [f32; 2],
-    /// `true` for [`Status::Nominal`].
-    pub nominal: bool,
-    /// The fault's neighbour, if the safe output names one.
-    pub fault_neighbour: Option<AgentId>,
+    /// Control law or safe output, with the fault itself.
+    pub status: Status,
     /// Force saturated.
     pub saturated: bool,
+    /// A current angle is degenerate.
+    pub degenerate: bool,
     /// Frames sent this tick (the preceding [`TargetMsg::Radio`] messages).
-    pub frames: u8,
+    pub frames: u32,
     /// Frames the target's agent rejected so far.
     pub rejected: u32,
 }
 
 impl LinkOutput {
-    /// Builds the link form of a step's status.
-    pub fn new(
-        force: [f32; 2],
-        status: Status,
-        saturated: bool,
-        frames: u8,
-        rejected: u32,
-    ) -> Self {
-        let fault_neighbour = match status {
+    /// The link form of a step's output, with the tick's frame count and the rejection
+    /// counter.
+    pub fn new(out: &StepOutput<f32>, frames: usize, rejected: u32) -> Self {
+        Self {
+            force: [out.force.x, out.force.y],
+            status: out.status,
+            saturated: out.saturated,
+            degenerate: out.degenerate,
+            frames: u32::try_from(frames).unwrap_or(u32::MAX),
+            rejected,
+        }
+    }
+
+    /// The neighbour the fault names, if any.
+    pub fn fault_neighbour(&self) -> Option<AgentId> {
+        match self.status {
             Status::Safe(
                 Fault::Stale(id)
                 | Fault::MissingBearing(id)
@@ -114,14 +121,6 @@ impl LinkOutput {
                 | Fault::MissingRange(id),
             ) => Some(id),
             _ => None,
-        };
-        Self {
-            force,
-            nominal: status == Status::Nominal,
-            fault_neighbour,
-            saturated,
-            frames,
-            rejected,
         }
     }
 }
@@ -132,48 +131,20 @@ impl LinkOutput {
 pub enum LinkError {
     /// A message that does not decode (COBS or postcard).
     Malformed,
-    /// A configuration the core refused (its [`ConfigError`] as text-free code).
-    Config(u8),
+    /// A configuration the core refused, with the core's reason.
+    Config(ConfigError),
     /// `Step` or `Radio` before a successful `Configure`.
     NotConfigured,
     /// A radio frame the agent rejected (informational; the tick goes on).
-    Frame(u8),
+    Frame(FrameError),
+    /// The agent owns more estimates than one [`TargetMsg::Estimates`] holds.
+    TooManyEstimates,
 }
 
-impl LinkError {
-    /// Compact code of a configuration error.
-    pub fn config(e: ConfigError) -> Self {
-        Self::Config(match e {
-            ConfigError::NotInTriangle { .. } => 1,
-            ConfigError::RepeatedVertex { .. } => 2,
-            ConfigError::BadApex { .. } => 3,
-            ConfigError::InfeasibleAngles { .. } => 4,
-            ConfigError::BadGain { .. } => 5,
-            ConfigError::TooManyNeighbours => 6,
-            ConfigError::BadParameter => 7,
-            ConfigError::BadLeader => 8,
-        })
-    }
-
-    /// Compact code of a frame error.
-    pub fn frame(e: FrameError) -> Self {
-        Self::Frame(match e {
-            FrameError::TooShort => 1,
-            FrameError::TooLong => 2,
-            FrameError::BadCrc => 3,
-            FrameError::UnknownVersion(_) => 4,
-            FrameError::Malformed => 5,
-            FrameError::UnknownSender(_) => 6,
-            FrameError::OwnFrame => 7,
-            FrameError::StaleSequence { .. } => 8,
-            FrameError::InvalidValue => 9,
-            FrameError::Cobs => 10,
-        })
-    }
-}
-
-/// Largest number of estimates in one [`TargetMsg::Estimates`].
-pub const MAX_LINK_ESTIMATES: usize = 16;
+/// Largest number of estimates in one [`TargetMsg::Estimates`]: an agent owns at most 3
+/// per triangle (2 as an apex, 1 more as a far vertex in per-agent mode), for up to
+/// [`crate::MAX_TRIANGLES`] triangles.
+pub const MAX_LINK_ESTIMATES: usize = 3 * crate::MAX_TRIANGLES;
 
 /// One owned estimate, reported to the host for diagnostics (see [`crate::OwnedEstimate`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -193,42 +164,52 @@ pub struct LinkEstimate {
     pub value: f32,
 }
 
-impl From<OwnedEstimate<f32>> for LinkEstimate {
-    fn from(e: OwnedEstimate<f32>) -> Self {
-        let small = |x: usize| u8::try_from(x).unwrap_or(u8::MAX);
-        Self {
+impl TryFrom<OwnedEstimate<f32>> for LinkEstimate {
+    type Error = LinkError;
+
+    fn try_from(e: OwnedEstimate<f32>) -> Result<Self, LinkError> {
+        let small = |x: usize| u8::try_from(x).map_err(|_| LinkError::TooManyEstimates);
+        Ok(Self {
             apex: e.apex,
             far: e.far,
-            triangle: small(e.triangle),
-            angle: small(e.angle),
-            edge: small(e.edge),
+            triangle: small(e.triangle)?,
+            angle: small(e.angle)?,
+            edge: small(e.edge)?,
             value: e.value,
-        }
+        })
     }
 }
 
-/// The estimates `agent` owns, in link form (at most [`MAX_LINK_ESTIMATES`]; an agent in
-/// at most 4 triangles owns at most 16).
+/// The estimates `agent` owns, in link form, or [`LinkError::TooManyEstimates`] when
+/// they do not fit one message (more than [`MAX_LINK_ESTIMATES`]): never truncated.
 pub fn link_estimates<const MT: usize, const NB: usize>(
     agent: &Agent<f32, MT, NB>,
-) -> heapless::Vec<LinkEstimate, MAX_LINK_ESTIMATES> {
-    agent
-        .owned_estimates()
-        .take(MAX_LINK_ESTIMATES)
-        .map(LinkEstimate::from)
-        .collect()
+) -> Result<heapless::Vec<LinkEstimate, MAX_LINK_ESTIMATES>, LinkError> {
+    let mut out = heapless::Vec::new();
+    for e in agent.owned_estimates() {
+        out.push(LinkEstimate::try_from(e)?)
+            .map_err(|_| LinkError::TooManyEstimates)?;
+    }
+    Ok(out)
 }
 
 /// Target → host.
+// `Estimates` is the large variant (~300 bytes): messages live on the stack of a no-heap
+// target, one at a time.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum TargetMsg {
-    /// Configured: agent id and [`LINK_VERSION`].
+    /// Configured: agent id, [`LINK_VERSION`] and the target agent's capacity.
     Ready {
         /// The agent's id.
         id: AgentId,
         /// [`LINK_VERSION`].
         version: u8,
+        /// Triangles the target's agent type holds (`MT`).
+        max_triangles: u16,
+        /// Neighbours the target's agent type holds (`NB`).
+        max_neighbours: u16,
     },
     /// A frame to broadcast.
     Radio(heapless::Vec<u8, MAX_FRAME_LEN>),

@@ -14,6 +14,8 @@ pub struct FrameStats {
     pub bad_crc: u32,
     /// Unknown wire version.
     pub unknown_version: u32,
+    /// Integrity or estimator mode different from this agent's.
+    pub mode_mismatch: u32,
     /// Undecodable body.
     pub malformed: u32,
     /// Sender not a neighbour, or this agent itself.
@@ -32,6 +34,7 @@ impl FrameStats {
             Err(FrameError::TooShort | FrameError::TooLong) => &mut self.bad_length,
             Err(FrameError::BadCrc) => &mut self.bad_crc,
             Err(FrameError::UnknownVersion(_)) => &mut self.unknown_version,
+            Err(FrameError::ModeMismatch(_)) => &mut self.mode_mismatch,
             Err(FrameError::Malformed | FrameError::Cobs) => &mut self.malformed,
             Err(FrameError::UnknownSender(_) | FrameError::OwnFrame) => &mut self.unknown_sender,
             Err(FrameError::StaleSequence { .. }) => &mut self.stale,
@@ -45,6 +48,7 @@ impl FrameStats {
         self.bad_length
             .saturating_add(self.bad_crc)
             .saturating_add(self.unknown_version)
+            .saturating_add(self.mode_mismatch)
             .saturating_add(self.malformed)
             .saturating_add(self.unknown_sender)
             .saturating_add(self.stale)

@@ -1,81 +1,60 @@
-//! Communication of one agent: what it broadcasts ([`Agent::frames`]) and how it takes
-//! in its neighbours' frames ([`Agent::receive`]).
+//! Communication of one agent: what it broadcasts ([`Agent::frames`]) and how it takes in
+//! its neighbours' broadcasts ([`Agent::receive`], [`Agent::receive_direct`]). The frame
+//! layout is [`crate::wire`]'s.
 
-use super::{pick, Agent, AngleState, ApexBearings, Neighbour, Role};
-use crate::config::{AgentId, EstimatorMode};
-use crate::wire::{check_frame, FrameError, RawItem, WireItem, MAX_ITEMS_PER_FRAME};
+use super::state::{AngleState, Remote, Role};
+use super::{pick, Agent};
+use crate::config::AgentId;
+use crate::wire::{check_frame, mode_byte, quant, FrameError, RawAngle};
 use crate::{Real, Vec2};
 
+/// A broadcast item at full precision (the wire rounds the angle's values to binary16).
+#[derive(Clone, Copy, Debug)]
+enum Item<T: Real> {
+    /// The sender's velocity.
+    Velocity(Vec2<T>),
+    /// An angle `(sender; far[0], far[1])`: `γ`, `σ` and the distances `ρ` (see
+    /// [`crate::wire`]).
+    Angle {
+        far: [AgentId; 2],
+        gamma: T,
+        sigma: T,
+        rho: [T; 2],
+    },
+}
+
 impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
-    /// The fresh bearings `[s_uv, s_uw]` and rates of an angle this agent is the apex of
-    /// (`None` without a fresh bearing to both far vertices).
-    fn apex_bearings(
-        neighbours: &[Neighbour<T, MT>],
-        a: &AngleState<T>,
-    ) -> Option<ApexBearings<T>> {
-        let bearing = |slot: usize| match neighbours.get(slot) {
-            Some(n) if n.fresh => n.bearing.map(|s| (s, n.rate)),
-            _ => None,
-        };
-        let ((s0, d0), (s1, d1)) = (bearing(a.slots[1])?, bearing(a.slots[2])?);
-        Some(([s0, s1], [d0, d1]))
-    }
-
-    /// Calls `f` for everything this agent broadcasts, at full precision: its velocity, and
-    /// for every controlled angle it is the apex of (and has fresh bearings for), the
-    /// bearings and rates its far vertices need, with the estimates it owns in shared mode.
-    /// [`Agent::frames`] sends the same, rounded to `f32`.
-    fn for_each_item(&self, mut f: impl FnMut(Item<T>)) {
-        f(Item::Velocity(self.velocity));
-        let shared = self.config.estimator == EstimatorMode::Shared;
-        for a in self.angles.iter().flatten() {
-            if a.role != Role::Apex {
-                continue;
-            }
-            if let Some((s, rate)) = Self::apex_bearings(&self.neighbours, a) {
-                f(Item::Angle {
-                    far: a.far,
-                    s,
-                    rate,
-                    r: shared.then_some(a.estimate),
-                });
-            }
-        }
-    }
-
-    /// Encodes this tick's broadcast (what `for_each_item` lists, as [`WireItem`]s) into
-    /// frames of at most 60 bytes and passes each to `send`. Returns the number of frames.
+    /// Encodes this tick's broadcast into frames of at most 60 bytes and passes each to
+    /// `send`; returns the number of frames. The broadcast is the agent's velocity and,
+    /// for every controlled angle it is the apex of and computed when it last sensed,
+    /// what the angle's far vertices need (see [`crate::wire`]). Sends nothing (and
+    /// returns 0) on the steps that [`crate::AgentConfig::comm_every`] skips.
     pub fn frames(&mut self, mut send: impl FnMut(&[u8])) -> usize {
-        let id = self.config.id;
-        let shared = self.config.estimator == EstimatorMode::Shared;
-        let w = |v: Vec2<T>| [v.x.as_f32(), v.y.as_f32()];
+        if !self.comm_due {
+            return 0;
+        }
+        let (id, mode) = (
+            self.config.id,
+            mode_byte(self.config.integrity, self.config.estimator),
+        );
+        let velocity = [self.velocity.x.as_f32(), self.velocity.y.as_f32()];
         let mut seq = self.seq;
         let mut count = 0;
-        let (writer, angles, neighbours) = (&mut self.writer, &self.angles, &self.neighbours);
-        writer.reset(id, seq);
-        // The velocity always fits in an empty frame.
-        let _ = writer.push(&WireItem::Velocity(w(self.velocity)));
+        let (writer, angles) = (&mut self.writer, &self.angles);
+        writer.start(mode, id, seq, velocity);
         for a in angles.iter().flatten() {
-            if a.role != Role::Apex {
-                continue;
-            }
-            let Some((s, rate)) = Self::apex_bearings(neighbours, a) else {
+            let Some((gamma, sigma, rho)) = sent_angle(a) else {
                 continue;
             };
-            let (far, s, rate) = (a.far, [w(s[0]), w(s[1])], [w(rate[0]), w(rate[1])]);
-            let item = if shared {
-                let r = [a.estimate[0].as_f32(), a.estimate[1].as_f32()];
-                WireItem::Angle { far, s, rate, r }
-            } else {
-                WireItem::AngleBearings { far, s, rate }
-            };
-            if !writer.push(&item) {
+            let q = |x: T| quant::encode(x.as_f32()).0;
+            let code = [q(gamma), q(sigma), q(rho[0]), q(rho[1])];
+            if !writer.push_angle(a.far, code) {
                 send(writer.finish());
                 count += 1;
                 seq = seq.wrapping_add(1);
-                writer.reset(id, seq);
-                // A single item always fits in an empty frame.
-                let _ = writer.push(&item);
+                writer.start(mode, id, seq, velocity);
+                // One item always fits in an empty frame.
+                let _ = writer.push_angle(a.far, code);
             }
         }
         send(writer.finish());
@@ -83,7 +62,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         count + 1
     }
 
-    /// Decodes and applies one received frame. Rejected frames change nothing but the
+    /// Checks and applies one received frame. Rejected frames change nothing but the
     /// counters. A neighbour that was stale may restart its sequence numbers.
     pub fn receive(&mut self, bytes: &[u8]) -> Result<(), FrameError> {
         let result = self.receive_inner(bytes);
@@ -92,7 +71,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     }
 
     fn receive_inner(&mut self, bytes: &[u8]) -> Result<(), FrameError> {
-        let frame = check_frame(bytes)?;
+        let frame = check_frame(bytes, self.config.integrity, self.config.estimator)?;
         let sender = frame.header.sender;
         if sender == self.config.id {
             return Err(FrameError::OwnFrame);
@@ -105,131 +84,130 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             .ok_or(FrameError::UnknownSender(sender))?;
         let seq = frame.header.seq;
         if let Some(last) = n.last_seq {
-            // Serial-number arithmetic: newer means ahead by 1..=32767.
+            // Serial-number arithmetic: newer means ahead by 1..=32767. A neighbour not
+            // heard within the timeout may have restarted.
             let ahead = seq.wrapping_sub(last);
-            let resync = !n.heard || n.age > timeout;
-            if (ahead == 0 || ahead >= 0x8000) && !resync {
+            if (ahead == 0 || ahead >= 0x8000) && n.age <= timeout {
                 return Err(FrameError::StaleSequence { sender, seq });
             }
         }
-        // One pass over the items: split, check, and keep (without copying) what concerns
-        // this agent. The whole frame is valid before anything is applied.
-        let me = self.config.id;
-        let tol = self.config.limits.bearing_tolerance.as_f32();
-        let mut kept: heapless::Vec<RawItem<'_>, MAX_ITEMS_PER_FRAME> = heapless::Vec::new();
-        let mut rest = frame.item_bytes();
-        while !rest.is_empty() {
-            let item = RawItem::next(&mut rest).ok_or(FrameError::Malformed)?;
-            if !item.valid(tol) {
-                return Err(FrameError::InvalidValue);
-            }
-            if item.far().is_none_or(|far| far.contains(&me)) {
-                // At most MAX_ITEMS_PER_FRAME items fit in a frame.
-                kept.push(item).map_err(|_| FrameError::Malformed)?;
-            }
-        }
+        // The whole frame is valid before anything is applied. With estimators, the
+        // distances are estimates: at least r_min (as rounded: rounding is monotone).
+        frame.validate(self.rho_min_code)?;
         if let Some(n) = self.neighbours.get_mut(slot) {
             n.last_seq = Some(seq);
-            n.heard = true;
             n.age = T::zero();
         }
-        let v = |a: [f32; 2]| Vec2::new(T::of_f32(a[0]), T::of_f32(a[1]));
-        for item in &kept {
-            if let Some(vel) = item.velocity() {
-                self.apply(sender, slot, Item::Velocity(v(vel)));
-            } else if let Some(far) = item.far() {
-                self.for_far_angles(sender, slot, far, |a, mine| {
-                    let (s, rate) = item.bearing(1 - mine);
-                    a.remote_bearing = Some((v(s), v(rate)));
-                    if let Some(r) = item.estimate(mine) {
-                        a.remote_estimate = Some(T::of_f32(r));
-                    }
-                });
+        let [vx, vy] = frame.velocity;
+        self.apply(
+            slot,
+            Item::Velocity(Vec2::new(T::of_f32(vx), T::of_f32(vy))),
+        );
+        let me = self.config.id;
+        for RawAngle { far, codes } in frame.raw_items() {
+            // Only the items for angles of which this agent is a far vertex (`apply`
+            // checks it again; this saves decoding the others). Validated: finite.
+            if far.contains(&me) {
+                let v = |c: u16| T::of_f32(quant::from_code(c));
+                let item = Item::Angle {
+                    far,
+                    gamma: v(codes[0]),
+                    sigma: v(codes[1]),
+                    rho: [v(codes[2]), v(codes[3])],
+                };
+                self.apply(slot, item);
             }
         }
         Ok(())
     }
 
-    /// Takes a neighbour's broadcast directly, without the wire (no `f32` rounding, no
-    /// sequence numbers): for in-process simulation and tests.
+    /// Takes a neighbour's broadcast directly, without the wire (no rounding, no sequence
+    /// numbers): for in-process simulation and tests.
     pub fn receive_direct(&mut self, from: &Self) -> Result<(), FrameError> {
         let sender = from.id();
         let slot = self.slot(sender).ok_or(FrameError::UnknownSender(sender))?;
         if let Some(n) = self.neighbours.get_mut(slot) {
-            n.heard = true;
             n.age = T::zero();
         }
-        from.for_each_item(|item| self.apply(sender, slot, item));
+        self.apply(slot, Item::Velocity(from.velocity));
+        for a in from.angles.iter().flatten() {
+            if let Some((gamma, sigma, rho)) = sent_angle(a) {
+                let far = a.far;
+                self.apply(
+                    slot,
+                    Item::Angle {
+                        far,
+                        gamma,
+                        sigma,
+                        rho,
+                    },
+                );
+            }
+        }
         Ok(())
     }
 
-    fn apply(&mut self, sender: AgentId, slot: usize, item: Item<T>) {
+    /// Stores one item from the neighbour in `slot`: its velocity, or the effort of an
+    /// angle `(sender; far[0], far[1])` of which this agent is a far vertex.
+    fn apply(&mut self, slot: usize, item: Item<T>) {
         match item {
             Item::Velocity(v) => {
                 if let Some(n) = self.neighbours.get_mut(slot) {
                     n.velocity = Some(v);
                 }
             }
-            Item::Angle { far, s, rate, r } => {
-                self.for_far_angles(sender, slot, far, |a, mine| {
-                    a.remote_bearing = Some((pick(&s, 1 - mine), pick(&rate, 1 - mine)));
-                    if let Some(r) = r {
-                        a.remote_estimate = Some(pick(&r, mine));
+            Item::Angle {
+                far,
+                gamma,
+                sigma,
+                rho,
+            } => {
+                let me = self.config.id;
+                let mine = if far[0] == me {
+                    0
+                } else if far[1] == me {
+                    1
+                } else {
+                    return;
+                };
+                let other = pick(&far, 1 - mine);
+                let Some(n) = self.neighbours.get(slot) else {
+                    return;
+                };
+                // The angles whose apex is the sender and of which this agent is a far
+                // vertex (at most one per triangle), matched by the other far vertex.
+                for &flat in &n.apex_of {
+                    let flat = usize::from(flat);
+                    let Some(a) = self
+                        .angles
+                        .get_mut(flat / 2)
+                        .and_then(|t| t.get_mut(flat % 2))
+                    else {
+                        continue;
+                    };
+                    if let Role::Far(k) = a.role {
+                        if pick(&a.far, 1 - k.min(1)) == other && pick(&a.far, k) == me {
+                            a.remote = Remote {
+                                gamma,
+                                sigma,
+                                rho: pick(&rho, mine),
+                                delta: Vec2::zeros(),
+                                v_ref: None,
+                            };
+                            a.remote_age = T::zero();
+                        }
                     }
-                });
-            }
-        }
-    }
-
-    /// Calls `f(angle, mine)` for the angle(s) `(sender; far[0], far[1])` of which this
-    /// agent is the far vertex `far[mine]`: the other far vertex's bearing is what it
-    /// needs (S4–S6), with the estimate of its own edge (S8).
-    fn for_far_angles(
-        &mut self,
-        sender: AgentId,
-        slot: usize,
-        far: [AgentId; 2],
-        mut f: impl FnMut(&mut AngleState<T>, usize),
-    ) {
-        let me = self.config.id;
-        let mine = if far[0] == me {
-            0
-        } else if far[1] == me {
-            1
-        } else {
-            return;
-        };
-        let other = pick(&far, 1 - mine);
-        let Some(n) = self.neighbours.get(slot) else {
-            return;
-        };
-        // Only the angles whose apex is the sender and of which this agent is a far vertex.
-        for &flat in &n.apex_of {
-            let flat = usize::from(flat);
-            let Some(a) = self
-                .angles
-                .get_mut(flat / 2)
-                .and_then(|t| t.get_mut(flat % 2))
-            else {
-                continue;
-            };
-            let Role::Far(k) = a.role else { continue };
-            if a.apex == sender && pick(&a.far, 1 - k.min(1)) == other {
-                f(a, mine);
+                }
             }
         }
     }
 }
 
-/// A broadcast item at full precision (the wire form is [`WireItem`]).
-#[derive(Clone, Copy, Debug)]
-enum Item<T: Real> {
-    Velocity(Vec2<T>),
-    /// A controlled angle of which the sender is the apex; `r` in shared mode only.
-    Angle {
-        far: [AgentId; 2],
-        s: [Vec2<T>; 2],
-        rate: [Vec2<T>; 2],
-        r: Option<[T; 2]>,
-    },
+/// What an apex sends of angle `a` (`γ`, `σ`, `ρ`): the values of its last sense, if it
+/// computed them (they are then finite: see `sensing::apex_part`).
+#[inline]
+#[allow(clippy::type_complexity)]
+fn sent_angle<T: Real>(a: &AngleState<T>) -> Option<(T, T, [T; 2])> {
+    let p = &a.part;
+    (a.role == Role::Apex && a.fault.is_none()).then_some((p.gamma, p.sigma, p.rho))
 }

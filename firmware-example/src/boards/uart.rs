@@ -201,10 +201,12 @@ impl<P: SerialPort> Session<P> {
                 self.send(&TargetMsg::Ready {
                     id,
                     version: LINK_VERSION,
+                    max_triangles: MT as u16,
+                    max_neighbours: NB as u16,
                 });
                 Event::Configured(id)
             }
-            Err(e) => self.refuse(LinkError::config(e)),
+            Err(e) => self.refuse(LinkError::Config(e)),
         }
     }
 
@@ -228,17 +230,18 @@ impl<P: SerialPort> Session<P> {
             clock: LinkClock { us: now },
         };
         let report = control.tick(&mut board);
-        // At most MT · 2 angles · 2 edges = 16 = MAX_LINK_ESTIMATES.
-        let estimates = link_estimates(control.agent());
         let out = LinkOutput::new(
-            board.actuator.force,
-            report.output.status,
-            report.output.saturated,
-            report.frames_sent,
+            &report.output,
+            usize::from(report.frames_sent),
             control.agent().stats().rejected(),
         );
-        if !estimates.is_empty() {
-            send_msg(&mut self.port, &TargetMsg::Estimates(estimates));
+        // At most 3 · MT ≤ MAX_LINK_ESTIMATES: never refused for this board.
+        match link_estimates(control.agent()) {
+            Ok(estimates) if !estimates.is_empty() => {
+                send_msg(&mut self.port, &TargetMsg::Estimates(estimates));
+            }
+            Ok(_) => {}
+            Err(e) => send_msg(&mut self.port, &TargetMsg::Error(e)),
         }
         self.send(&TargetMsg::Output(out));
         Event::Ticked(report)

@@ -75,10 +75,12 @@ pub fn serve(stream: TcpStream, behaviour: FakeBehaviour) -> Result<(), String> 
                         &TargetMsg::Ready {
                             id,
                             version: LINK_VERSION,
+                            max_triangles: TARGET_MT as u16,
+                            max_neighbours: FAKE_NB as u16,
                         },
                     )?;
                 }
-                Err(e) => reply(&mut link, &TargetMsg::Error(LinkError::config(e)))?,
+                Err(e) => reply(&mut link, &TargetMsg::Error(LinkError::Config(e)))?,
             },
             HostMsg::Radio(f) => queue.push(f.to_vec()),
             HostMsg::Step(s) => {
@@ -99,6 +101,8 @@ pub fn serve(stream: TcpStream, behaviour: FakeBehaviour) -> Result<(), String> 
                         &TargetMsg::Ready {
                             id: 0,
                             version: LINK_VERSION,
+                            max_triangles: TARGET_MT as u16,
+                            max_neighbours: FAKE_NB as u16,
                         },
                     )?;
                     steps += 1;
@@ -130,16 +134,12 @@ pub fn serve(stream: TcpStream, behaviour: FakeBehaviour) -> Result<(), String> 
                 }
                 // As the firmware: only an agent that owns estimates reports them.
                 if behaviour.send_estimates && a.owned_estimates().next().is_some() {
-                    let est = link_estimates(a);
-                    link.queue_value(&TargetMsg::Estimates(est))?;
+                    match link_estimates(a) {
+                        Ok(est) => link.queue_value(&TargetMsg::Estimates(est))?,
+                        Err(e) => link.queue_value(&TargetMsg::Error(e))?,
+                    }
                 }
-                let o = LinkOutput::new(
-                    [out.force.x, out.force.y],
-                    out.status,
-                    out.saturated,
-                    frames.len() as u8,
-                    a.stats().rejected(),
-                );
+                let o = LinkOutput::new(&out, frames.len(), a.stats().rejected());
                 reply(&mut link, &TargetMsg::Output(o))?;
             }
             HostMsg::Finish => {

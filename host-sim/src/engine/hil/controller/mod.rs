@@ -136,11 +136,15 @@ impl HilController {
         }
         let deadline = Instant::now() + timeout;
         match c.recv(deadline, When::Configure, "waiting for Ready")? {
-            TargetMsg::Ready { id: got, version } if got == id && version == LINK_VERSION => {
+            TargetMsg::Ready {
+                id: got, version, ..
+            } if got == id && version == LINK_VERSION => {
                 c.startup = started.elapsed();
                 Ok(c)
             }
-            TargetMsg::Ready { id: got, version } => Err(HilError::Corrupt {
+            TargetMsg::Ready {
+                id: got, version, ..
+            } => Err(HilError::Corrupt {
                 agent: id,
                 when: When::Configure,
                 what: format!(
@@ -152,7 +156,7 @@ impl HilController {
                 reason: format!(
                     "the firmware answered Configure with Error({e:?}){}",
                     match e {
-                        LinkError::Config(code) => format!(" ({})", config_error_name(code)),
+                        LinkError::Config(e) => format!(" ({e})"),
                         _ => String::new(),
                     }
                 ),
@@ -274,21 +278,6 @@ impl HilController {
             target_rejected: self.finished.map(|f| f.1),
             exit_code: self.exit_code,
         }
-    }
-}
-
-/// The `ConfigError` named by a `LinkError::Config` code (see `LinkError::config`).
-pub fn config_error_name(code: u8) -> &'static str {
-    match code {
-        1 => "NotInTriangle",
-        2 => "RepeatedVertex",
-        3 => "BadApex",
-        4 => "InfeasibleAngles",
-        5 => "BadGain",
-        6 => "TooManyNeighbours",
-        7 => "BadParameter",
-        8 => "BadLeader",
-        _ => "unknown configuration error",
     }
 }
 

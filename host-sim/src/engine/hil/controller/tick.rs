@@ -7,7 +7,6 @@ use crate::engine::controller::AgentController;
 use crate::engine::hil::{HilError, LinkStats, When};
 use crate::engine::radio::RadioFrame;
 use controller_core::link::{HostMsg, LinkBearing, LinkError, LinkOutput, LinkStep, TargetMsg};
-use controller_core::wire::{decode_frame, WireItem};
 use controller_core::{Fault, FrameStats, Measurements, OwnedEstimate, Status, StepOutput, Vec2};
 use std::time::{Duration, Instant};
 
@@ -100,9 +99,6 @@ impl HilController {
             match msg {
                 TargetMsg::Radio(v) => {
                     outbox.push(RadioFrame::new(&v));
-                    if !self.estimates_from_target {
-                        self.estimates_from_frame(&v);
-                    }
                     frames += 1;
                 }
                 TargetMsg::Estimates(list) => {
@@ -141,7 +137,7 @@ impl HilController {
             }
             messages += 1;
         };
-        if usize::from(out.frames) != frames {
+        if usize::try_from(out.frames) != Ok(frames) {
             return Err(HilError::Corrupt {
                 agent: self.id,
                 when,
@@ -157,49 +153,15 @@ impl HilController {
         self.ticks += 1;
         Ok(step_output(&out))
     }
-
-    /// Reads the owned estimates from one of the agent's own broadcast frames (used when
-    /// the target does not send `Estimates`).
-    fn estimates_from_frame(&mut self, bytes: &[u8]) {
-        let Ok(frame) = decode_frame(bytes, f32::INFINITY) else {
-            return;
-        };
-        for item in &frame.items {
-            let WireItem::Angle { far: [v, w], r, .. } = *item else {
-                continue;
-            };
-            for (far, other, r) in [(v, w, r[0]), (w, v, r[1])] {
-                if let Some(k) = self
-                    .slots
-                    .iter()
-                    .position(|s| s.far == far && s.other == other)
-                {
-                    if let Some(slot) = self.estimates.get_mut(k) {
-                        *slot = f64::from(r);
-                    }
-                }
-            }
-        }
-    }
 }
 
-/// The host form of a target's output. The link carries no fault kind and no
-/// degenerate flag: a safe output naming a neighbour is reported as
-/// `Fault::MissingData(neighbour)`, one without as `Fault::NonFinite`.
+/// The host form of a target's output (the link carries the status with its fault).
 pub fn step_output(o: &LinkOutput) -> StepOutput<f64> {
-    let status = if o.nominal {
-        Status::Nominal
-    } else {
-        Status::Safe(
-            o.fault_neighbour
-                .map_or(Fault::NonFinite, Fault::MissingData),
-        )
-    };
     StepOutput {
         force: Vec2::new(f64::from(o.force[0]), f64::from(o.force[1])),
-        status,
+        status: o.status,
         saturated: o.saturated,
-        degenerate: false,
+        degenerate: o.degenerate,
     }
 }
 

@@ -1,31 +1,16 @@
-//! Finite-difference bearing rates (SPEC §2), as the agent broadcasts them.
+//! Finite-difference bearing rates (SPEC §2), as the agent computes them.
 
-use controller_core::wire::{decode_frame, WireItem};
+mod testkit;
+
 use controller_core::{BearingMeasurement, Measurements, Vec2};
-use ph_formation_tests::{rng, strip, strip_positions, Formation};
-
-/// The rate agent 1 broadcasts for its bearing to agent 2 after one step.
-fn broadcast_rate(a: &mut ph_formation_tests::HostAgent<f64>) -> Option<Vec2<f64>> {
-    let mut rate = None;
-    a.frames(|bytes| {
-        let f = decode_frame(bytes, 1e-3).expect("own frame decodes");
-        for it in f.items {
-            if let WireItem::Angle { far, rate: r, .. } = it {
-                if let Some(k) = far.iter().position(|&v| v == 2) {
-                    rate = Some(Vec2::new(f64::from(r[k][0]), f64::from(r[k][1])));
-                }
-            }
-        }
-    });
-    rate
-}
+use testkit::{rng, strip, strip_positions, Formation};
 
 #[test]
 fn finite_difference_rate_tracks_a_rotating_bearing_across_missed_ticks() {
     let mut r = rng(0);
     let mut f = Formation::random(4, strip(4), &strip_positions(4, 0.1, &mut r), &mut r);
     f.leader = None;
-    let mut a = ph_formation_tests::HostAgent::<f64>::new(f.config(0)).expect("valid");
+    let mut a = testkit::HostAgent::<f64>::new(f.config(0)).expect("valid");
     let (omega, dt) = (0.8, 0.01);
     let bearing = |k: usize, to: u8| {
         let th = omega * dt * k as f64 + f64::from(to);
@@ -51,9 +36,9 @@ fn finite_difference_rate_tracks_a_rotating_bearing_across_missed_ticks() {
             partner_offset: None,
         };
         let _ = a.step(&m);
-        let rate = broadcast_rate(&mut a);
+        let rate = a.bearing(2).map(|(_, rate)| rate);
         if k == 0 || k == 3 {
-            // First tick: zero rate; missed tick: no bearing to broadcast.
+            // First tick: zero rate; missed tick: no bearing this tick.
             assert!(
                 rate.is_none_or(|r| r == Vec2::zeros()),
                 "tick {k}: {rate:?}"

@@ -1,17 +1,19 @@
-//! `Agent::step` takes a fused fast path in shared mode. It must agree with the reference
-//! definition: `sense`, then `evaluate`, then the owned estimates integrated with the
-//! sampled S10 (`law::estimator_step`) and the force saturated — or, on a fault, the same
-//! fault with the estimates held still. Checked on random formations, states, estimates,
-//! measurement orders and faults, in f32 and f64 and every estimator mode.
+//! `Agent::step` is, bit for bit, its definition: `sense`, then `evaluate`, then the owned
+//! estimates integrated with the sampled S10 (`law::estimator_step`) and the force
+//! saturated — or, on a fault, the same fault with the estimates held still. Checked on
+//! random formations, states, estimates, measurement orders and faults, in f32 and f64
+//! and every estimator mode, comparing the bits of every value (as `f64::to_bits`).
+
+mod testkit;
 
 use controller_core::{law, EstimatorMode, Measurements, Real, Status, Vec2};
-use ph_formation_tests::{
-    bearings, fan, fan_positions, rng, sense_and_exchange, strip, strip_positions, Formation,
-    HostAgent, State,
-};
 use rand::seq::SliceRandom;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
+use testkit::{
+    bearings, fan, fan_positions, rng, sense_and_exchange, strip, strip_positions, Formation,
+    HostAgent, State,
+};
 
 fn random_state(q0: &[Vec2<f64>], r: &mut ChaCha8Rng) -> State {
     State {
@@ -26,14 +28,23 @@ fn random_state(q0: &[Vec2<f64>], r: &mut ChaCha8Rng) -> State {
     }
 }
 
-/// `|a − b| ≤ tol · (1 + |b|)`.
-fn close<T: Real>(a: T, b: T, tol: f64) -> bool {
-    let (a, b) = (a.as_f32() as f64, b.as_f32() as f64);
-    (a - b).abs() <= tol * (1.0 + b.abs())
+/// The bits of `x` widened to `f64` (exact and one-to-one for `f32` and `f64`).
+fn bits<T: Real>(x: T) -> u64 {
+    let any: &dyn std::any::Any = &x;
+    match (any.downcast_ref::<f64>(), any.downcast_ref::<f32>()) {
+        (Some(x), _) => x.to_bits(),
+        (_, Some(x)) => f64::from(*x).to_bits(),
+        _ => unreachable!("the scalars are f32 and f64"),
+    }
+}
+
+/// The same value, bit for bit.
+fn same<T: Real>(a: T, b: T) -> bool {
+    bits(a) == bits(b)
 }
 
 /// Counts of (nominal, safe) steps compared.
-fn compare<T: Real>(f: &Formation, q0: &[Vec2<f64>], seed: u64, tol: f64) -> (usize, usize) {
+fn compare<T: Real>(f: &Formation, q0: &[Vec2<f64>], seed: u64) -> (usize, usize) {
     let mut r = rng(seed);
     let cv = |x: Vec2<f64>| Vec2::new(T::lit(x.x), T::lit(x.y));
     // Sometimes a short neighbour timeout, so that a long `dt` makes neighbours stale.
@@ -117,7 +128,7 @@ fn compare<T: Real>(f: &Formation, q0: &[Vec2<f64>], seed: u64, tol: f64) -> (us
                 let (force, saturated) = law::saturate(&ev.force, limit);
                 assert_eq!(out.saturated, saturated);
                 assert!(
-                    close(out.force.x, force.x, tol) && close(out.force.y, force.y, tol),
+                    same(out.force.x, force.x) && same(out.force.y, force.y),
                     "agent {i} seed {seed}: step {:?} vs evaluate {:?}",
                     out.force,
                     force
@@ -128,7 +139,7 @@ fn compare<T: Real>(f: &Formation, q0: &[Vec2<f64>], seed: u64, tol: f64) -> (us
                     let rate = ev.estimate_rates[e.triangle][e.angle][e.edge];
                     let want = law::estimator_step(e.value, rate, m.dt, r_min);
                     assert!(
-                        close(a.value, want, tol),
+                        same(a.value, want),
                         "agent {i} seed {seed} estimate {e:?}: {:?} vs {:?}",
                         a.value,
                         want
@@ -143,8 +154,7 @@ fn compare<T: Real>(f: &Formation, q0: &[Vec2<f64>], seed: u64, tol: f64) -> (us
                 assert_eq!(after, before, "estimates hold still on a safe step");
             }
         }
-        // The same broadcast next (bearings, rates, estimates): here the two paths even
-        // agree to the bit.
+        // The same broadcast next.
         let (mut a, mut b) = (Vec::new(), Vec::new());
         fast.frames(|x| a.push(x.to_vec()));
         reference.frames(|x| b.push(x.to_vec()));
@@ -153,7 +163,7 @@ fn compare<T: Real>(f: &Formation, q0: &[Vec2<f64>], seed: u64, tol: f64) -> (us
     (nominal, safe)
 }
 
-fn run<T: Real>(tol: f64) {
+fn run<T: Real>() {
     let (mut nominal, mut safe) = (0, 0);
     for seed in 0..150u64 {
         let mut r = rng(seed ^ 0xfa57);
@@ -174,7 +184,7 @@ fn run<T: Real>(tol: f64) {
         if seed % 7 == 0 {
             f.leader = None;
         }
-        let (n, s) = compare::<T>(&f, &q0, seed, tol);
+        let (n, s) = compare::<T>(&f, &q0, seed);
         nominal += n;
         safe += s;
     }
@@ -186,10 +196,10 @@ fn run<T: Real>(tol: f64) {
 
 #[test]
 fn step_agrees_with_evaluate_f64() {
-    run::<f64>(1e-12);
+    run::<f64>();
 }
 
 #[test]
 fn step_agrees_with_evaluate_f32() {
-    run::<f32>(1e-5);
+    run::<f32>();
 }

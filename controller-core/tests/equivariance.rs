@@ -1,11 +1,11 @@
 //! Equivariance of the force under rotation and scaling, and f32/f64 agreement.
 
+mod testkit;
+
 use controller_core::Vec2;
 use nalgebra::Rotation2;
-use ph_formation_tests::{
-    rng, sense_and_exchange, strip, strip_positions, Formation, HostAgent, State,
-};
 use rand::Rng;
+use testkit::{rng, sense_and_exchange, strip, strip_positions, Formation, HostAgent, State};
 
 fn forces<T: controller_core::Real>(
     f: &Formation,

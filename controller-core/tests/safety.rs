@@ -1,13 +1,15 @@
 //! Bad input never panics and never produces NaN: typed errors or the documented safe
 //! output `U = −safe_damping · v`.
 
+mod testkit;
+
 use controller_core::{
     BearingMeasurement, EstimatorMode, Fault, MeasurementError, Measurements, Status, Vec2,
 };
-use ph_formation_tests::{
+use proptest::prelude::*;
+use testkit::{
     bearings, rng, sense_and_exchange, strip, strip_positions, Formation, HostAgent, State,
 };
-use proptest::prelude::*;
 
 fn setup() -> (Formation, State, Vec<HostAgent<f64>>) {
     let mut r = rng(3);

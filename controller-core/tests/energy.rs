@@ -3,11 +3,13 @@
 //! agents' forces and estimator flows equals S14 and is never positive. This checks S8 and
 //! S9 together, independently of how they are coded (V̇ is built from the true geometry).
 
+mod testkit;
+
 use controller_core::{energy, geometry, EstimatorMode, Vec2};
-use ph_formation_tests::{
+use rand::Rng;
+use testkit::{
     fan, fan_positions, rng, sense_and_exchange, strip, strip_positions, Formation, State,
 };
-use rand::Rng;
 
 struct Check {
     v_dot: f64,
@@ -100,7 +102,7 @@ fn spec_tri(f: &Formation, k: usize, i: usize) -> usize {
 trait TriangleOf {
     fn triangle_vertices(&self, f: &Formation) -> [usize; 3];
 }
-impl TriangleOf for ph_formation_tests::AngleSpec {
+impl TriangleOf for testkit::AngleSpec {
     fn triangle_vertices(&self, f: &Formation) -> [usize; 3] {
         f.triangles[self.triangle]
     }

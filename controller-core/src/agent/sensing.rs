@@ -1,0 +1,259 @@
+//! Sensing: the agent's own measurements of one tick (bearings, rates, ranges, velocity,
+//! partner offset), the finite-difference bearing rates of SPEC §2, and the kernels of
+//! the angles this agent is the apex of (S4–S8), which depend on nothing else.
+
+use super::state::{AngleState, ApexPart, Neighbour, Role};
+use super::{Agent, BearingMeasurement, Fault, MeasurementError, Measurements};
+use crate::config::{AgentId, EstimatorMode};
+use crate::{law, Real, Vec2};
+
+/// Neither NaN nor infinite, in two float operations: `x − x` is 0 exactly for finite `x`
+/// and NaN otherwise.
+#[inline(always)]
+#[allow(clippy::eq_op)] // `x − x` on purpose: NaN for NaN and ±∞.
+fn finite<T: Real>(x: T) -> bool {
+    x - x == T::zero()
+}
+
+impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
+    /// Ages the neighbour table by `dt` (when `dt` is finite and ≥ 0, even if the rest is
+    /// refused), checks and stores the own measurements (bearings, rates, velocity, time),
+    /// and computes the angles this agent is the apex of from them (S4–S8, with the
+    /// current estimates). Nothing else changes if they are refused, except that no
+    /// angle is sent until the next accepted measurements.
+    ///
+    /// [`Agent::step`] calls it; simulators that drive [`Agent::evaluate`] themselves
+    /// call it first (after [`Agent::set_estimate`], before exchanging frames).
+    pub fn sense(&mut self, m: &Measurements<'_, T>) -> Result<(), Fault> {
+        let dt = m.dt;
+        if !(finite(dt) && dt >= T::zero()) {
+            return Err(Fault::Measurement(MeasurementError::NonFinite));
+        }
+        // The checks read nothing that aging changes: age after them.
+        let checked = self.check_measurements(m);
+        for a in self.angles.as_mut_slice().as_flattened_mut() {
+            a.remote_age += dt;
+        }
+        let in_order = match checked {
+            Ok(in_order) => in_order,
+            Err(e) => {
+                for n in self.neighbours.iter_mut() {
+                    n.age += dt;
+                    n.bearing_age += dt;
+                }
+                let fault = Fault::Measurement(e);
+                for a in self.angles.as_mut_slice().as_flattened_mut() {
+                    a.fault = Some(fault);
+                }
+                return Err(fault);
+            }
+        };
+        let v_prev = self.velocity;
+        self.time = m.time;
+        self.velocity = m.velocity;
+        self.partner_offset = m.partner_offset;
+        if in_order {
+            // Bearing i is to slot i: one pass.
+            let mut bearings = m.bearings.iter();
+            for n in self.neighbours.iter_mut() {
+                n.age += dt;
+                match bearings.next() {
+                    Some(b) => take_bearing(n, b, dt),
+                    None => no_bearing(n, dt),
+                }
+            }
+        } else {
+            for n in self.neighbours.iter_mut() {
+                n.age += dt;
+                match bearing_to(m.bearings, n.id) {
+                    Some(b) => take_bearing(n, b, dt),
+                    None => no_bearing(n, dt),
+                }
+            }
+        }
+        let (mode, v) = (self.config.estimator, self.velocity);
+        let nbs = self.neighbours.as_slice();
+        for a in self.angles.as_mut_slice().as_flattened_mut() {
+            if a.role == Role::Apex {
+                match apex_part(nbs, mode, a, &v) {
+                    Ok(p) => {
+                        a.part = p;
+                        a.fault = None;
+                    }
+                    Err(f) => a.fault = Some(f),
+                }
+            } else if let Some(Some(v_apex)) = nbs.get(a.slots[0]).map(|n| n.velocity) {
+                // Own motion relative to the apex since it measured, taken as the previous
+                // tick (the apex's velocity is the one it sent with it).
+                let r = &mut a.remote;
+                r.delta += (v_prev - v_apex) * dt;
+                if r.v_ref.is_none() {
+                    r.v_ref = Some(v_prev);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks the own measurements. Returns whether bearing `i` is to neighbour slot `i`
+    /// for every `i` (the usual case, what the firmware sends).
+    fn check_measurements(&self, m: &Measurements<'_, T>) -> Result<bool, MeasurementError> {
+        let v = &m.velocity;
+        if !(finite(m.time) && finite(v.x) && finite(v.y)) {
+            return Err(MeasurementError::NonFinite);
+        }
+        if let Some(p) = &m.partner_offset {
+            if !(finite(p.x) && finite(p.y)) {
+                return Err(MeasurementError::NonFinite);
+            }
+        }
+        let tol = self.config.limits.bearing_tolerance;
+        // Bearing i to slot i: known and distinct without searching (neighbour ids are
+        // unique), and all valid.
+        if m.bearings.len() <= self.neighbours.len()
+            && m.bearings
+                .iter()
+                .zip(&self.neighbours)
+                .all(|(b, n)| b.neighbour == n.id && bearing_error(b, tol).is_none())
+        {
+            return Ok(true);
+        }
+        self.check_bearings_in_order(m.bearings, tol)
+    }
+
+    /// The bearing checks in general (any order): the first error in order, or whether
+    /// bearing `i` is to slot `i` for every `i`.
+    #[cold]
+    #[inline(never)]
+    fn check_bearings_in_order(
+        &self,
+        bearings: &[BearingMeasurement<T>],
+        tol: T,
+    ) -> Result<bool, MeasurementError> {
+        let mut in_order = true;
+        let mut slots = self.neighbours.iter();
+        for (i, b) in bearings.iter().enumerate() {
+            let id = b.neighbour;
+            in_order = in_order && slots.next().is_some_and(|n| n.id == id);
+            if !in_order {
+                if self.slot(id).is_none() {
+                    return Err(MeasurementError::UnknownNeighbour(id));
+                }
+                if bearings.iter().take(i).any(|o| o.neighbour == id) {
+                    return Err(MeasurementError::DuplicateBearing(id));
+                }
+            }
+            if let Some(e) = bearing_error(b, tol) {
+                return Err(e);
+            }
+        }
+        Ok(in_order)
+    }
+}
+
+/// The kernel of an angle this agent is the apex of (S4–S8, [`law::apex_angle`]) from its
+/// fresh bearings and rates to both far vertices and its distances to them (own estimates,
+/// or measured ranges), with the motion shares its estimators need (S9) and what the far
+/// vertices need (`γ`, `σ`, the distances).
+#[inline]
+fn apex_part<T: Real, const MT: usize>(
+    nbs: &[Neighbour<T, MT>],
+    mode: EstimatorMode,
+    a: &AngleState<T>,
+    v: &Vec2<T>,
+) -> Result<ApexPart<T>, Fault> {
+    let nv = nbs.get(a.slots[1]).ok_or(Fault::Internal)?;
+    let nw = nbs.get(a.slots[2]).ok_or(Fault::Internal)?;
+    let ((s_v, d_v), (s_w, d_w)) = (nv.bearing()?, nw.bearing()?);
+    let r = match mode {
+        EstimatorMode::Measured => [nv.range()?, nw.range()?],
+        EstimatorMode::Shared | EstimatorMode::PerAgent => a.estimate,
+    };
+    let k = law::apex_angle(
+        &[s_v, s_w],
+        &[d_v, d_w],
+        a.cos_desired,
+        a.stiffness,
+        a.damping,
+        r,
+    );
+    // γ is finite whenever the measurements are (they were checked) unless a rate
+    // overflowed; σ and the distances are finite. Only finite values are sent.
+    if !finite(k.gamma) {
+        return Err(Fault::NonFinite);
+    }
+    let share = match mode {
+        // S9 with the angle's own shares t_{α,e} (S5).
+        EstimatorMode::Shared => k.t,
+        // SPEC §6: the apex's own shares f^u_{α,e} = −g_{α,e}ᵀ v_u / r̂^u_{α,e} (unused in
+        // measured mode, which has no estimator).
+        EstimatorMode::PerAgent | EstimatorMode::Measured => [
+            law::own_share(&k.g[0], v, r[0], false),
+            law::own_share(&k.g[1], v, r[1], false),
+        ],
+    };
+    Ok(ApexPart {
+        y: k.y,
+        gamma: k.gamma,
+        share,
+        force: k.force,
+        sigma: k.sigma,
+        rho: r,
+    })
+}
+
+/// What is wrong with one bearing measurement itself, if anything (neighbour aside).
+#[inline(always)]
+fn bearing_error<T: Real>(b: &BearingMeasurement<T>, tol: T) -> Option<MeasurementError> {
+    // A unit vector within a finite tolerance is finite (NaN and ∞ fail the comparison):
+    // no separate finiteness check.
+    let s = &b.bearing;
+    let unit = (s.dot(s) - T::one()).abs() <= tol;
+    let rate_ok = b.rate.as_ref().is_none_or(|r| finite(r.x) && finite(r.y));
+    if !unit || !rate_ok {
+        return Some(MeasurementError::BadBearing(b.neighbour));
+    }
+    match b.range {
+        Some(r) if !(finite(r) && r > T::zero()) => Some(MeasurementError::BadRange(b.neighbour)),
+        _ => None,
+    }
+}
+
+/// The bearing to neighbour `id`, if any.
+#[inline(never)]
+fn bearing_to<T: Real>(
+    bearings: &[BearingMeasurement<T>],
+    id: AgentId,
+) -> Option<&BearingMeasurement<T>> {
+    bearings.iter().find(|b| b.neighbour == id)
+}
+
+/// Stores a checked bearing of this tick and its rate (`dt`: time since the last tick).
+#[inline(always)]
+fn take_bearing<T: Real, const MT: usize>(
+    n: &mut Neighbour<T, MT>,
+    b: &BearingMeasurement<T>,
+    dt: T,
+) {
+    let interval = n.bearing_age + dt;
+    n.rate = match b.rate {
+        Some(rate) => rate,
+        // Finite difference of successive bearings (SPEC §2), over the time since the
+        // previous bearing (a missed tick widens the interval). Without a previous
+        // bearing the interval is −∞: zero rate.
+        None if interval > T::zero() => (b.bearing - n.s) / interval,
+        None => Vec2::zeros(),
+    };
+    n.s = b.bearing;
+    n.bearing_age = T::zero();
+    n.range = b.range;
+    n.fresh = true;
+}
+
+/// No bearing to this neighbour this tick.
+#[inline(always)]
+fn no_bearing<T: Real, const MT: usize>(n: &mut Neighbour<T, MT>, dt: T) {
+    n.bearing_age += dt;
+    n.fresh = false;
+    n.range = None;
+}

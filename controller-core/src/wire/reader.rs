@@ -1,0 +1,215 @@
+//! Checking and reading frames in place (layout in [`super`]).
+
+use super::{
+    mode_byte, offset, quant, FrameError, FrameHeader, Integrity, ANGLE_ITEM_LEN, FIXED_LEN,
+    MAX_ANGLES_PER_FRAME, MAX_FRAME_LEN, WIRE_VERSION,
+};
+use crate::config::EstimatorMode;
+use crate::{crc16, AgentId};
+
+/// One angle item, decoded (fields: see [`super`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct AngleItem {
+    /// The far vertices `v`, `w` of the angle `(sender; v, w)`.
+    pub far: [AgentId; 2],
+    /// `γ_α` (S7).
+    pub gamma: f32,
+    /// `σ_α = s_nv × s_nw`.
+    pub sigma: f32,
+    /// `[ρ_v, ρ_w]`: the distances the apex used.
+    pub rho: [f32; 2],
+}
+
+/// One angle item's bytes: far vertices and the binary16 codes of `[γ, σ, ρ_v, ρ_w]`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct RawAngle {
+    /// The far vertices.
+    pub far: [AgentId; 2],
+    /// The codes of `[γ, σ, ρ_v, ρ_w]`.
+    pub codes: [u16; 4],
+}
+
+// The destructuring patterns below read the fields in the documented order.
+const _: () = assert!(
+    offset::MODE == 0
+        && offset::SENDER == 1
+        && offset::SEQ == 2
+        && offset::VELOCITY == 4
+        && offset::ANGLES == FIXED_LEN
+        && FIXED_LEN == 12
+        && offset::ITEM_FAR0 == 0
+        && offset::ITEM_FAR1 == 1
+        && offset::ITEM_GAMMA == 2
+        && offset::ITEM_SIGMA == 4
+        && offset::ITEM_RHO0 == 6
+        && offset::ITEM_RHO1 == 8
+        && ANGLE_ITEM_LEN == 10
+);
+
+impl RawAngle {
+    #[inline(always)]
+    fn of(b: &[u8; ANGLE_ITEM_LEN]) -> Self {
+        let [v, w, g0, g1, s0, s1, a0, a1, b0, b1] = *b;
+        let code = |lo: u8, hi: u8| u16::from_le_bytes([lo, hi]);
+        Self {
+            far: [v, w],
+            codes: [code(g0, g1), code(s0, s1), code(a0, a1), code(b0, b1)],
+        }
+    }
+}
+
+/// binary16 `1.0` (`|σ| ≤ 1`).
+const F16_ONE: u16 = 0x3C00;
+
+/// A frame whose length, trailer, version and modes are checked; its items are read in
+/// place (no copy of the frame).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameView<'a> {
+    /// The header.
+    pub header: FrameHeader,
+    /// The sender's velocity (not yet checked for finiteness: see [`FrameView::validate`]).
+    pub velocity: [f32; 2],
+    /// The angle items.
+    items: &'a [[u8; ANGLE_ITEM_LEN]],
+}
+
+impl<'a> FrameView<'a> {
+    /// Number of angle items.
+    pub fn len(&self) -> usize {
+        self.items.len()
+    }
+
+    /// No angle items.
+    pub fn is_empty(&self) -> bool {
+        self.items.is_empty()
+    }
+
+    /// The raw items.
+    #[inline(always)]
+    pub(crate) fn raw_items(&self) -> impl Iterator<Item = RawAngle> + 'a {
+        self.items.iter().map(RawAngle::of)
+    }
+
+    /// Checks every value: a finite velocity, and per item two distinct far vertices, a
+    /// finite `γ`, `|σ| ≤ 1`, and distances at least `rho_min` (a binary16 code of a
+    /// positive value: the receiver's `r_min` as rounded, or 1 for any positive value).
+    /// Reads nothing but bits (no float conversion: binary16 codes of positive values are
+    /// ordered like the values).
+    #[inline]
+    pub fn validate(&self, rho_min: u16) -> Result<(), FrameError> {
+        let [vx, vy] = self.velocity;
+        // `x·0` is ±0 for finite `x` and NaN otherwise: one comparison for both.
+        if vx * 0.0 + vy * 0.0 != 0.0 {
+            return Err(FrameError::InvalidValue);
+        }
+        let mut ok = true;
+        for it in self.raw_items() {
+            if it.far[0] == it.far[1] {
+                return Err(FrameError::Malformed);
+            }
+            let [gamma, sigma, rho0, rho1] = it.codes;
+            // Exponent all ones: ∞ or NaN. Positive finite values are 0x0001..=0x7BFF.
+            let distance = |c: u16| (c >= rho_min) & (c < 0x7C00);
+            ok &= (gamma & 0x7C00 != 0x7C00)
+                & (sigma & 0x7FFF <= F16_ONE)
+                & distance(rho0)
+                & distance(rho1);
+        }
+        if ok {
+            Ok(())
+        } else {
+            Err(FrameError::InvalidValue)
+        }
+    }
+
+    /// The decoded angle items (invalid codes read as NaN; call [`FrameView::validate`]
+    /// first).
+    pub fn angles(&self) -> impl Iterator<Item = AngleItem> + 'a {
+        self.raw_items().map(|it| {
+            let v = |c| quant::decode(c).unwrap_or(f32::NAN);
+            let [g, s, r0, r1] = it.codes;
+            AngleItem {
+                far: it.far,
+                gamma: v(g),
+                sigma: v(s),
+                rho: [v(r0), v(r1)],
+            }
+        })
+    }
+}
+
+/// Checks length, trailer, version and modes of one frame for a receiver with
+/// `integrity` and `estimator` mode, and returns a view of it. Never panics.
+#[inline]
+pub fn check_frame(
+    bytes: &[u8],
+    integrity: Integrity,
+    estimator: EstimatorMode,
+) -> Result<FrameView<'_>, FrameError> {
+    if bytes.len() > MAX_FRAME_LEN {
+        return Err(FrameError::TooLong);
+    }
+    let (body, trailer) = bytes
+        .split_at_checked(bytes.len().wrapping_sub(integrity.trailer_len()))
+        .ok_or(FrameError::TooShort)?;
+    let (head, items) = body
+        .split_first_chunk::<FIXED_LEN>()
+        .ok_or(FrameError::TooShort)?;
+    if let (Integrity::Crc16, [c0, c1]) = (integrity, trailer) {
+        if crc16::checksum(body) != u16::from_le_bytes([*c0, *c1]) {
+            return Err(FrameError::BadCrc);
+        }
+    }
+    let [mode, sender, q0, q1, v0, v1, v2, v3, w0, w1, w2, w3] = *head;
+    if mode >> 4 != WIRE_VERSION {
+        return Err(FrameError::UnknownVersion(mode >> 4));
+    }
+    if mode != mode_byte(integrity, estimator) {
+        return Err(FrameError::ModeMismatch(mode));
+    }
+    let (items, rest) = items.as_chunks::<ANGLE_ITEM_LEN>();
+    if !rest.is_empty() {
+        return Err(FrameError::Malformed);
+    }
+    Ok(FrameView {
+        header: FrameHeader {
+            mode,
+            sender,
+            seq: u16::from_le_bytes([q0, q1]),
+        },
+        velocity: [
+            f32::from_le_bytes([v0, v1, v2, v3]),
+            f32::from_le_bytes([w0, w1, w2, w3]),
+        ],
+        items,
+    })
+}
+
+/// A frame decoded completely (for tools and tests; agents read frames in place).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    /// The header.
+    pub header: FrameHeader,
+    /// The sender's velocity.
+    pub velocity: [f32; 2],
+    /// The angle items.
+    pub angles: heapless::Vec<AngleItem, MAX_ANGLES_PER_FRAME>,
+}
+
+/// Checks a frame ([`check_frame`] and [`FrameView::validate`] with any positive
+/// distance) and decodes it. Never panics.
+pub fn decode_frame(
+    bytes: &[u8],
+    integrity: Integrity,
+    estimator: EstimatorMode,
+) -> Result<Frame, FrameError> {
+    let view = check_frame(bytes, integrity, estimator)?;
+    view.validate(1)?;
+    Ok(Frame {
+        header: view.header,
+        velocity: view.velocity,
+        // At most MAX_ANGLES_PER_FRAME items fit in MAX_FRAME_LEN bytes.
+        angles: view.angles().take(MAX_ANGLES_PER_FRAME).collect(),
+    })
+}

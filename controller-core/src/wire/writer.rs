@@ -1,0 +1,93 @@
+//! Building frames (layout in [`super`]).
+
+use super::{offset, Integrity, ANGLE_ITEM_LEN, FIXED_LEN, MAX_FRAME_LEN};
+use crate::{crc16, AgentId};
+
+// The byte arrays below are built in the documented field order.
+const _: () = assert!(
+    offset::MODE == 0
+        && offset::SENDER == 1
+        && offset::SEQ == 2
+        && offset::VELOCITY == 4
+        && FIXED_LEN == 12
+        && offset::ITEM_GAMMA == 2
+        && offset::ITEM_SIGMA == 4
+        && offset::ITEM_RHO0 == 6
+        && offset::ITEM_RHO1 == 8
+        && ANGLE_ITEM_LEN == 10
+);
+
+/// Builds one frame at a time: [`FrameWriter::start`] (header and velocity), then
+/// [`FrameWriter::push_angle`] while it fits, then [`FrameWriter::finish`] (trailer).
+/// The buffer is reused from frame to frame (no zeroing).
+#[derive(Clone, Debug)]
+pub struct FrameWriter {
+    buf: [u8; MAX_FRAME_LEN],
+    len: usize,
+    integrity: Integrity,
+}
+
+impl FrameWriter {
+    /// A writer for frames with `integrity`.
+    pub const fn new(integrity: Integrity) -> Self {
+        Self {
+            buf: [0; MAX_FRAME_LEN],
+            len: 0,
+            integrity,
+        }
+    }
+
+    /// Starts a frame: the mode byte, sender, sequence number and velocity.
+    #[inline]
+    pub fn start(&mut self, mode: u8, sender: AgentId, seq: u16, velocity: [f32; 2]) {
+        let [q0, q1] = seq.to_le_bytes();
+        let [v0, v1, v2, v3] = velocity[0].to_le_bytes();
+        let [w0, w1, w2, w3] = velocity[1].to_le_bytes();
+        if let Some(head) = self.buf.first_chunk_mut::<FIXED_LEN>() {
+            *head = [mode, sender, q0, q1, v0, v1, v2, v3, w0, w1, w2, w3];
+        }
+        self.len = FIXED_LEN;
+    }
+
+    /// Appends one angle item: far vertices and the binary16 codes (see [`super::quant`])
+    /// of `[γ, σ, ρ_v, ρ_w]`; `false`, and nothing written, if the frame is full.
+    #[inline]
+    pub fn push_angle(&mut self, far: [AgentId; 2], codes: [u16; 4]) -> bool {
+        let end = self.len + ANGLE_ITEM_LEN;
+        if end + self.integrity.trailer_len() > MAX_FRAME_LEN {
+            return false;
+        }
+        let [g0, g1] = codes[0].to_le_bytes();
+        let [s0, s1] = codes[1].to_le_bytes();
+        let [a0, a1] = codes[2].to_le_bytes();
+        let [b0, b1] = codes[3].to_le_bytes();
+        let item = [far[0], far[1], g0, g1, s0, s1, a0, a1, b0, b1];
+        match self.buf.get_mut(self.len..end) {
+            Some(d) => {
+                d.copy_from_slice(&item);
+                self.len = end;
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Angle items in the current frame.
+    pub fn angles(&self) -> usize {
+        (self.len.saturating_sub(FIXED_LEN)) / ANGLE_ITEM_LEN
+    }
+
+    /// Appends the integrity trailer and returns the finished frame.
+    #[inline]
+    pub fn finish(&mut self) -> &[u8] {
+        let body = self.len;
+        if self.integrity == Integrity::Crc16 {
+            let crc = crc16::checksum(self.buf.get(..body).unwrap_or(&[]));
+            if let Some(t) = self.buf.get_mut(body..body + 2) {
+                t.copy_from_slice(&crc.to_le_bytes());
+            }
+        }
+        let end = body + self.integrity.trailer_len();
+        self.buf.get(..end).unwrap_or(&[])
+    }
+}
