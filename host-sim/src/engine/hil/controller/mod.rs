@@ -13,7 +13,7 @@ pub use tick::step_output;
 use super::link::{Link, LinkCounters, RecvError, TARGET_MT};
 use super::{HilError, LinkStats, When};
 use controller_core::link::{HostMsg, LinkError, TargetMsg, LINK_VERSION};
-use controller_core::{AgentConfig, OwnedEstimate};
+use controller_core::{AgentConfig, EstimatorMode, Integrity, OwnedEstimate};
 use std::time::{Duration, Instant};
 
 /// Where one owned estimate of the HIL agent sits: its frame item `(far, other)` ids and
@@ -43,6 +43,8 @@ pub struct HilController {
     slots: Vec<EstimateSlot>,
     estimates: Vec<f64>,
     estimates_from_target: bool,
+    /// The frames' integrity and estimator mode (to read the agent's own frames).
+    modes: (Integrity, EstimatorMode),
     /// Ticks completed.
     ticks: u64,
     time: f64,
@@ -85,6 +87,7 @@ impl HilController {
             layout,
             slots,
             estimates_from_target: false,
+            modes: (config.integrity, config.estimator),
             ticks: 0,
             time: 0.0,
             sent_at: None,

@@ -7,6 +7,7 @@ use crate::engine::controller::AgentController;
 use crate::engine::hil::{HilError, LinkStats, When};
 use crate::engine::radio::RadioFrame;
 use controller_core::link::{HostMsg, LinkBearing, LinkError, LinkOutput, LinkStep, TargetMsg};
+use controller_core::wire::decode_frame;
 use controller_core::{Fault, FrameStats, Measurements, OwnedEstimate, Status, StepOutput, Vec2};
 use std::time::{Duration, Instant};
 
@@ -99,6 +100,9 @@ impl HilController {
             match msg {
                 TargetMsg::Radio(v) => {
                     outbox.push(RadioFrame::new(&v));
+                    if !self.estimates_from_target {
+                        self.estimates_from_frame(&v);
+                    }
                     frames += 1;
                 }
                 TargetMsg::Estimates(list) => {
@@ -152,6 +156,33 @@ impl HilController {
         self.wall += start.elapsed();
         self.ticks += 1;
         Ok(step_output(&out))
+    }
+}
+
+impl HilController {
+    /// Reads the owned estimates from one of the agent's own broadcast frames (used when
+    /// the target does not send `Estimates`): an angle item carries the distances its
+    /// apex used in S8, its estimates as they were before this step's integration (one
+    /// control period behind; the far vertices' copies of per-agent mode are not sent).
+    fn estimates_from_frame(&mut self, bytes: &[u8]) {
+        let (integrity, estimator) = self.modes;
+        let Ok(frame) = decode_frame(bytes, integrity, estimator) else {
+            return;
+        };
+        for item in &frame.angles {
+            let [v, w] = item.far;
+            for (far, other, r) in [(v, w, item.rho[0]), (w, v, item.rho[1])] {
+                if let Some(k) = self
+                    .slots
+                    .iter()
+                    .position(|s| s.far == far && s.other == other)
+                {
+                    if let Some(slot) = self.estimates.get_mut(k) {
+                        *slot = f64::from(r);
+                    }
+                }
+            }
+        }
     }
 }
 
