@@ -2,7 +2,7 @@
 //!
 //! ONE agent's angle-based port-Hamiltonian formation controller (Li, Borja, van der
 //! Schaft, Scherpen), its passive distance estimators and its wire frames, as it runs on
-//! one microcontroller. The math is `SPEC.md` (equations cited as `S<n>`).
+//! one microcontroller. The math is `docs/spec.md` (equations cited as `S<n>`).
 //!
 //! * `no_std`, no heap, fixed capacity: [`Agent<T, MT, NB>`] holds at most `MT` triangles
 //!   and `NB` neighbours.
