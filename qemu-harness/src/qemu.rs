@@ -136,6 +136,7 @@ pub struct Qemu {
     cpu: Option<usize>,
     stdout: PathBuf,
     stderr: PathBuf,
+    pipe: bool,
 }
 
 impl Qemu {
@@ -157,7 +158,16 @@ impl Qemu {
             cpu: None,
             stdout: with(".raw"),
             stderr: with(".stderr.txt"),
+            pipe: false,
         }
+    }
+
+    /// Sends the guest's output to a pipe ([`QemuProcess::take_stdout`]) instead of the
+    /// `.raw` file, for a live log. The reader must keep reading until QEMU exits (a guest
+    /// writing to a closed semihosting stdout spins forever; the time limit ends it).
+    pub fn pipe_stdout(mut self) -> Self {
+        self.pipe = true;
+        self
     }
 
     /// Another QEMU binary.
@@ -268,12 +278,16 @@ impl Qemu {
                 format!("no firmware ELF at {}", self.elf.display()),
             ));
         }
-        let out = create(&self.stdout)?;
+        let out = if self.pipe {
+            Stdio::piped()
+        } else {
+            Stdio::from(create(&self.stdout)?)
+        };
         let err = create(&self.stderr)?;
         let mut cmd = Command::new(&self.program);
         cmd.args(self.arguments())
             .stdin(Stdio::null())
-            .stdout(Stdio::from(out))
+            .stdout(out)
             .stderr(Stdio::from(err));
         before_exec(&mut cmd, self.cpu);
         let child = cmd.spawn().map_err(|e| {
@@ -318,7 +332,8 @@ fn create(path: &Path) -> io::Result<File> {
 #[derive(Debug)]
 pub struct QemuProcess {
     child: Child,
-    /// Where the guest's semihosting output goes (raw defmt frames).
+    /// Where the guest's semihosting output goes (raw defmt frames; unused with
+    /// [`Qemu::pipe_stdout`]).
     pub log: PathBuf,
     /// Where QEMU's own messages go.
     pub stderr_log: PathBuf,
@@ -326,6 +341,11 @@ pub struct QemuProcess {
 }
 
 impl QemuProcess {
+    /// The guest's output, if QEMU was started with [`Qemu::pipe_stdout`] (once).
+    pub fn take_stdout(&mut self) -> Option<std::process::ChildStdout> {
+        self.child.stdout.take()
+    }
+
     /// The process id.
     pub fn pid(&self) -> u32 {
         self.child.id()

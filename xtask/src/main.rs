@@ -7,11 +7,19 @@
 //! * `cargo xtask test`: everything `scripts/test.sh` runs after installing: rustfmt,
 //!   clippy (host and thumbv7em), builds, `cargo test`, firmware-check, host-sim's
 //!   host-in-the-loop tests; then the duration of each phase.
+//! * `cargo xtask firmware-profile [REGION] [TOP]`: where the instructions of one
+//!   measured step go (by file and function).
+//! * `cargo xtask stack-frames <elf> [N]`: the largest stack frames of an ELF.
+//! * `cargo xtask qemu-run <elf> [qemu args…]`: the cargo runner of the firmware (QEMU +
+//!   live defmt log).
 
 mod budgets;
 mod check;
 mod firmware_check;
 mod fwlog;
+mod profile;
+mod qemu_run;
+mod stack_frames;
 mod test_cmd;
 mod tools;
 
@@ -36,11 +44,43 @@ enum Task {
     FirmwareCheck(CheckArgs),
     /// Run every check of the project (what scripts/test.sh runs after installing).
     Test(CheckArgs),
+    /// Where the instructions of one measured region of `measure` go: by source file, by
+    /// innermost function and by outermost function of the inlining chain (needs binutils'
+    /// addr2line). Report also in target/firmware-check/profile-REGION.txt.
+    FirmwareProfile {
+        /// Region name printed by `measure`: tri2 (whole step), tri2-rx, tri2-step,
+        /// tri2-tx, tri2-crc, tri8, …
+        #[arg(default_value = "tri2")]
+        region: String,
+        /// Rows per table.
+        #[arg(default_value_t = 25)]
+        top: usize,
+    },
+    /// The largest stack frames of a thumbv7em ELF (from the `sub sp, #N` of the
+    /// function prologues; push/vpush not counted).
+    StackFrames {
+        /// The ELF, e.g. target/thumbv7em-none-eabihf/release/measure.
+        elf: PathBuf,
+        /// How many frames to list.
+        #[arg(default_value_t = 20)]
+        count: usize,
+    },
+    /// Run a firmware ELF under QEMU (netduinoplus2) and print its defmt log: the cargo
+    /// runner for thumbv7em-none-eabihf. Exits with the firmware's exit code (124: timed
+    /// out). Environment: QEMU_TIMEOUT, QEMU_SERIAL, QEMU_RAW_OUT, QEMU_SYSTEM_ARM,
+    /// DEFMT_PRINT.
+    QemuRun {
+        /// The firmware ELF.
+        elf: PathBuf,
+        /// Extra QEMU arguments (e.g. -d in_asm).
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        qemu_args: Vec<String>,
+    },
 }
 
 /// Options of the firmware checks (also taken from the environment, as the old script
 /// did: FIRMWARE_BUDGETS, FIRMWARE_CHECK_OUT, QEMU_TIMEOUT).
-#[derive(Args, Debug)]
+#[derive(Args, Debug, Default)]
 struct CheckArgs {
     /// Budget file [env FIRMWARE_BUDGETS; default firmware-example/budgets.toml].
     #[arg(long)]
@@ -85,6 +125,13 @@ impl CheckArgs {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
+        Task::QemuRun { elf, qemu_args } => return qemu_run::run(&elf, &qemu_args),
+        Task::StackFrames { elf, count } => {
+            stack_frames::run(&elf, count).map(|()| ExitCode::SUCCESS)
+        }
+        Task::FirmwareProfile { region, top } => CheckArgs::default().options().and_then(|o| {
+            profile::run(&region, top, &o.out, o.timeout).map(|()| ExitCode::SUCCESS)
+        }),
         Task::FirmwareCheck(a) => a.options().and_then(|o| {
             firmware_check::run(&o).map(|ok| {
                 if ok {

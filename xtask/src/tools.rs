@@ -69,13 +69,16 @@ pub fn show(cmd: &Command) -> String {
     s
 }
 
-/// `llvm-size` and `llvm-nm` of the pinned toolchain's `llvm-tools` component.
+/// `llvm-size`, `llvm-nm` and `llvm-objdump` of the pinned toolchain's `llvm-tools`
+/// component.
 #[derive(Clone, Debug)]
 pub struct Llvm {
     /// `llvm-size`.
     pub size: PathBuf,
     /// `llvm-nm`.
     pub nm: PathBuf,
+    /// `llvm-objdump`.
+    pub objdump: PathBuf,
 }
 
 impl Llvm {
@@ -99,12 +102,16 @@ impl Llvm {
         let llvm = Self {
             size: bin.join("llvm-size"),
             nm: bin.join("llvm-nm"),
+            objdump: bin.join("llvm-objdump"),
         };
-        if llvm.size.is_file() && llvm.nm.is_file() {
+        if [&llvm.size, &llvm.nm, &llvm.objdump]
+            .iter()
+            .all(|p| p.is_file())
+        {
             Ok(llvm)
         } else {
             Err(format!(
-                "llvm-size/llvm-nm missing in {}; run: rustup component add llvm-tools",
+                "llvm-size/llvm-nm/llvm-objdump missing in {}; run: rustup component add llvm-tools",
                 bin.display()
             ))
         }
