@@ -11,7 +11,7 @@
 //! same inputs (relative difference ≤ 1e-3; in practice they are
 //! bit-identical, frames included), and `Finish` → `Finished` with exit code 0.
 //! Reports the lock-step round-trip throughput (ticks per second of wall
-//! clock). No sleeps: socket read timeouts are failure guards only.
+//! clock). No pacing delays: socket timeouts are failure guards only.
 //!
 //! Ignored by default (needs `qemu-system-arm` and the release firmware):
 //!
