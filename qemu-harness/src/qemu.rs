@@ -170,6 +170,14 @@ impl Qemu {
         self
     }
 
+    /// Other files for the guest's output and QEMU's messages (e.g. host-sim's
+    /// `qemu-agent-<id>.log` and `qemu-agent-<id>.stderr.log`).
+    pub fn log_files(mut self, stdout: impl Into<PathBuf>, stderr: impl Into<PathBuf>) -> Self {
+        self.stdout = stdout.into();
+        self.stderr = stderr.into();
+        self
+    }
+
     /// Another QEMU binary.
     pub fn program(mut self, program: impl Into<PathBuf>) -> Self {
         self.program = program.into();
@@ -569,6 +577,9 @@ mod tests {
         assert_eq!(&a[a.len() - 2..], ["-kernel", "/fw/measure"]);
         assert_eq!(q.stdout_path(), Path::new("/tmp/x/measure.raw"));
         assert_eq!(q.stderr_path(), Path::new("/tmp/x/measure.stderr.txt"));
+        let q = q.log_files("/l/a.log", "/l/a.stderr.log");
+        assert_eq!(q.stdout_path(), Path::new("/l/a.log"));
+        assert_eq!(q.stderr_path(), Path::new("/l/a.stderr.log"));
     }
 
     #[test]
