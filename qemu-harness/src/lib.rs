@@ -17,6 +17,7 @@
 pub mod defmt;
 pub mod firmware;
 pub mod link;
+mod os;
 pub mod qemu;
 
 pub use qemu::{Exit, Qemu, QemuProcess, Serial};
