@@ -8,14 +8,15 @@
 //!   limit, no QEMU left behind).
 //! * [`firmware`]: the workspace, the target directory and the release firmware ELFs.
 //! * [`defmt`]: decoding the firmware's defmt log with `defmt-print`.
-//! * [`link`]: the host end of the UART link session (`controller_core::link` messages,
-//!   postcard in COBS frames).
+//! * `link` (feature `link`): the host end of the UART link session
+//!   (`controller_core::link` messages, postcard in COBS frames).
 //!
 //! Host only (std). Nothing here starts QEMU by itself: the QEMU tests are `#[ignore]`d
 //! and `cargo xtask firmware-check` runs them.
 
 pub mod defmt;
 pub mod firmware;
+#[cfg(feature = "link")]
 pub mod link;
 mod os;
 pub mod qemu;
