@@ -10,7 +10,7 @@
 #                          brought them)
 #   tools/qemu-insn        built for the installed QEMU
 #
-# Then: bash scripts/firmware-check.sh
+# Then: cargo xtask firmware-check
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -85,4 +85,4 @@ fi
 # --------------------------------------------------------------- plugin
 plugin=$(tools/qemu-insn/build.sh)
 log "plugin: $plugin"
-log "done; run: bash scripts/firmware-check.sh"
+log "done; run: cargo xtask firmware-check"

@@ -1,6 +1,6 @@
 //! # host-sim
 //!
-//! N `controller-core` agents over simulated dynamics (S1, fixed-step RK4) and simulated
+//! N `controller-core` agents over simulated dynamics (S1 of `docs/spec.md`, fixed-step RK4) and simulated
 //! radio links. Each agent is one [`controller_core::Agent`] behind the
 //! [`engine::AgentController`] trait: it sees only what its own sensors measure and the
 //! frames its radio delivers, as real postcard bytes.

@@ -17,27 +17,30 @@
 //!
 //! Both are ignored by default: they need `qemu-system-arm`, `defmt-print` and
 //! the release firmware (`cargo build -p firmware-example --target
-//! thumbv7em-none-eabihf --release --bin qemu-demo`); `scripts/test.sh` runs
-//! them with `--include-ignored`. The parsers and the comparison are checked
-//! by the plain tests at the end.
+//! thumbv7em-none-eabihf --release --bin qemu-demo`); `cargo xtask
+//! firmware-check` runs them with `--include-ignored` (the one `qemu-demo` run
+//! of a test run, shared by both tests). The parsers and the comparison are
+//! checked by the plain tests at the end.
 //!
-//! Environment: `PH_QEMU_DEMO_ELF` (the firmware ELF), `QEMU_TIMEOUT` (passed
-//! to `scripts/qemu-run.sh`, default here 120 s), `PH_HOST_SIM_SUMMARY` (use
-//! this `summary.json` instead of running the host simulator).
+//! Environment: `PH_QEMU_DEMO_ELF` (the firmware ELF), `QEMU_TIMEOUT` (time
+//! limit of the QEMU run in seconds, default here 120), `PH_QEMU_DEMO_LOG`
+//! (write the demo's decoded defmt log there; `cargo xtask firmware-check`
+//! reads its `DEMO` and stack lines), `PH_HOST_SIM_SUMMARY` (use this
+//! `summary.json` instead of running the host simulator), `QEMU_SYSTEM_ARM`,
+//! `DEFMT_PRINT`.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::Command;
 use std::sync::OnceLock;
+use std::time::Duration;
+
+use qemu_harness::{defmt, firmware, Exit, Qemu};
 
 /// Largest difference of a relative position `q_i − q_1`, in metres.
 const TOLERANCE: f64 = 1e-2;
 
 /// The paper's target square, `q_i − q_1` (SPEC §9, `z* = q1 − q2 = (10, −10)`).
 const SQUARE: [[f64; 2]; 4] = [[0.0, 0.0], [-10.0, 10.0], [10.0, 10.0], [0.0, 20.0]];
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
 
 /// Parses `DEMO final t=<t> rel=<x1>,<y1>;<x2>,<y2>;…` from the demo's output:
 /// returns `(t, [q_i − q_1])`.
@@ -110,7 +113,7 @@ fn max_difference(a: &[[f64; 2]], b: &[[f64; 2]]) -> Result<f64, String> {
 }
 
 struct DemoRun {
-    code: Option<i32>,
+    exit: Exit,
     log: String,
 }
 
@@ -118,27 +121,25 @@ struct DemoRun {
 fn demo() -> &'static DemoRun {
     static RUN: OnceLock<DemoRun> = OnceLock::new();
     RUN.get_or_init(|| {
-        let elf = std::env::var_os("PH_QEMU_DEMO_ELF")
-            .map(PathBuf::from)
-            .unwrap_or_else(|| root().join("target/thumbv7em-none-eabihf/release/qemu-demo"));
-        assert!(
-            elf.is_file(),
-            "{} not found: build it with `cargo build -p firmware-example --target thumbv7em-none-eabihf --release --bin qemu-demo`",
-            elf.display()
-        );
-        let timeout = std::env::var("QEMU_TIMEOUT").unwrap_or_else(|_| "120".into());
-        let out = Command::new("bash")
-            .arg(root().join("scripts/qemu-run.sh"))
-            .arg(&elf)
-            .env("QEMU_TIMEOUT", timeout)
-            .output()
-            .expect("run scripts/qemu-run.sh");
-        let mut log = String::from_utf8_lossy(&out.stdout).into_owned();
-        log.push_str(&String::from_utf8_lossy(&out.stderr));
-        DemoRun {
-            code: out.status.code(),
-            log,
+        let elf = firmware::elf_or_env("qemu-demo", "PH_QEMU_DEMO_ELF");
+        let elf = firmware::require_elf(&elf, "qemu-demo").unwrap_or_else(|e| panic!("{e}"));
+        let limit = match std::env::var("QEMU_TIMEOUT") {
+            Ok(v) => v.trim().parse().expect("QEMU_TIMEOUT: whole seconds"),
+            Err(_) => 120,
+        };
+        let qemu = Qemu::new(&elf, firmware::target_dir().join("qemu-tests/qemu-demo"));
+        let exit = qemu
+            .run(Duration::from_secs(limit))
+            .unwrap_or_else(|e| panic!("{e}: {}", qemu.display()));
+        let mut log = defmt::decode_or_note(&elf, qemu.stdout_path());
+        if let Some(path) = std::env::var_os("PH_QEMU_DEMO_LOG") {
+            std::fs::write(&path, &log).expect("write PH_QEMU_DEMO_LOG");
         }
+        if exit != Exit::Code(0) {
+            log.push_str(&format!("qemu-demo: {exit} (limit {limit} s)\n"));
+            log.push_str(&std::fs::read_to_string(qemu.stderr_path()).unwrap_or_default());
+        }
+        DemoRun { exit, log }
     })
 }
 
@@ -153,7 +154,7 @@ fn host_sim_final_positions() -> Vec<[f64; 2]> {
             std::fs::create_dir_all(&dir).expect("temporary directory");
             let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
             let out = Command::new(cargo)
-                .current_dir(root())
+                .current_dir(firmware::workspace_root())
                 .args([
                     "run",
                     "--release",
@@ -185,12 +186,12 @@ fn host_sim_final_positions() -> Vec<[f64; 2]> {
 }
 
 #[test]
-#[ignore = "needs qemu-system-arm and the firmware ELF; run by scripts/test.sh"]
+#[ignore = "needs qemu-system-arm and the firmware ELF; run by cargo xtask firmware-check"]
 fn demo_converges_to_the_square() {
     let run = demo();
     assert_eq!(
-        run.code,
-        Some(0),
+        run.exit,
+        Exit::Code(0),
         "qemu-demo did not exit 0 (not converged?):\n{}",
         run.log
     );
@@ -204,10 +205,15 @@ fn demo_converges_to_the_square() {
 }
 
 #[test]
-#[ignore = "needs qemu-system-arm and the firmware ELF; run by scripts/test.sh"]
+#[ignore = "needs qemu-system-arm and the firmware ELF; run by cargo xtask firmware-check"]
 fn demo_matches_host_sim() {
     let run = demo();
-    assert_eq!(run.code, Some(0), "qemu-demo did not exit 0:\n{}", run.log);
+    assert_eq!(
+        run.exit,
+        Exit::Code(0),
+        "qemu-demo did not exit 0:\n{}",
+        run.log
+    );
     let (_, firmware) = parse_demo_final(&run.log).unwrap_or_else(|e| panic!("{e}\n{}", run.log));
     let host = relative(&host_sim_final_positions());
     let d = max_difference(&firmware, &host).unwrap_or_else(|e| panic!("{e}"));

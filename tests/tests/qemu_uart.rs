@@ -11,7 +11,7 @@
 //! same inputs (relative difference ≤ 1e-3; in practice they are
 //! bit-identical, frames included), and `Finish` → `Finished` with exit code 0.
 //! Reports the lock-step round-trip throughput (ticks per second of wall
-//! clock). No sleeps: socket read timeouts are failure guards only.
+//! clock). No pacing delays: socket timeouts are failure guards only.
 //!
 //! Ignored by default (needs `qemu-system-arm` and the release firmware):
 //!
@@ -20,22 +20,23 @@
 //! cargo test -p ph-formation-tests --test qemu_uart -- --include-ignored
 //! ```
 //!
+//! `cargo xtask firmware-check` runs it (the one `qemu-uart` run of a test run).
+//! QEMU, the link and the log decoding are `qemu_harness`'s.
+//!
 //! Environment: `QEMU_SYSTEM_ARM` (QEMU binary), `PH_QEMU_UART_ELF` (firmware
 //! ELF), `PH_QEMU_UART_LOG` (write the firmware's decoded defmt log there;
-//! `scripts/firmware-check.sh` reads its stack line), `DEFMT_PRINT`.
+//! `cargo xtask firmware-check` reads its stack line), `DEFMT_PRINT`.
 
-use std::io::{Read, Write};
-use std::net::{TcpListener, TcpStream};
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::net::TcpListener;
 use std::time::{Duration, Instant};
 
 use controller_core::link::{HostMsg, LinkBearing, LinkOutput, LinkStep, TargetMsg, LINK_VERSION};
-use controller_core::wire::{cobs_encode, CobsAccumulator};
 use controller_core::{
     Agent, AgentConfig, AngleConfig, BearingMeasurement, LeaderConfig, LeaderRole, Measurements,
     Real, Schedule, TriangleConfig, Vec2,
 };
+use qemu_harness::link::Link;
+use qemu_harness::{defmt, firmware, Qemu, Serial};
 
 /// Control ticks of the session.
 const TICKS: usize = 300;
@@ -48,10 +49,6 @@ const READ_GUARD: Duration = Duration::from_secs(20);
 
 const Q0: [[f64; 2]; 4] = [[0.9, 2.2], [2.2, 2.8], [1.8, 1.1], [3.1, 1.9]];
 const FRICTION: f64 = 0.5;
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
 
 /// The paper scenario's configuration of agent index `i` (id `i + 1`), SPEC §9.
 fn paper_config<T: Real>(i: usize) -> AgentConfig<T, 4> {
@@ -126,158 +123,16 @@ fn seconds_to_us(s: f32) -> u64 {
     (s * 1_000_000.0 + 0.5) as u64
 }
 
-struct Qemu {
-    child: Child,
-    stdout_path: PathBuf,
-    elf: PathBuf,
+/// Sends one message (failure guard: the write has [`READ_GUARD`] too).
+fn send(link: &mut Link, msg: &HostMsg<4>) {
+    link.send(msg)
+        .unwrap_or_else(|e| panic!("sending {msg:?}: {e}"));
 }
 
-impl Qemu {
-    fn start(elf: &Path, port: u16, out_dir: &Path) -> Qemu {
-        let qemu = std::env::var("QEMU_SYSTEM_ARM").unwrap_or_else(|_| "qemu-system-arm".into());
-        let stdout_path = out_dir.join("qemu-uart.semihosting.bin");
-        let stdout = std::fs::File::create(&stdout_path).expect("create semihosting output file");
-        let stderr = std::fs::File::create(out_dir.join("qemu-uart.stderr.txt")).expect("stderr");
-        // `timeout` is a last-resort guard against a hung QEMU.
-        let child = Command::new("timeout")
-            .args(["-k", "5", "90", &qemu])
-            .args([
-                "-machine",
-                "netduinoplus2",
-                "-display",
-                "none",
-                "-monitor",
-                "none",
-            ])
-            .args(["-semihosting-config", "enable=on,target=native"])
-            .arg("-serial")
-            // QEMU connects to the test's listening socket (no port race).
-            .arg(format!("tcp:127.0.0.1:{port},nodelay=on"))
-            .arg("-kernel")
-            .arg(elf)
-            .stdin(Stdio::null())
-            .stdout(stdout)
-            .stderr(stderr)
-            .spawn()
-            .unwrap_or_else(|e| panic!("cannot start {qemu} under timeout: {e}"));
-        Qemu {
-            child,
-            stdout_path,
-            elf: elf.to_path_buf(),
-        }
-    }
-
-    /// The firmware's defmt log, decoded with defmt-print if available.
-    fn log(&self) -> String {
-        let raw = std::fs::read(&self.stdout_path).unwrap_or_default();
-        let print = std::env::var("DEFMT_PRINT").unwrap_or_else(|_| "defmt-print".into());
-        let decoded = Command::new(&print)
-            .arg("-e")
-            .arg(&self.elf)
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .spawn()
-            .and_then(|mut c| {
-                c.stdin.take().expect("stdin").write_all(&raw)?;
-                c.wait_with_output()
-            });
-        match decoded {
-            Ok(out) if out.status.success() => String::from_utf8_lossy(&out.stdout).into_owned(),
-            _ => format!("({} raw bytes; {print} not available)", raw.len()),
-        }
-    }
-}
-
-impl Drop for Qemu {
-    fn drop(&mut self) {
-        if let Ok(None) = self.child.try_wait() {
-            let _ = self.child.kill();
-            let _ = self.child.wait();
-        }
-    }
-}
-
-/// The host end of the link.
-struct Link {
-    stream: TcpStream,
-    acc: CobsAccumulator<1024>,
-    buf: Vec<u8>,
-    bytes_out: usize,
-    bytes_in: usize,
-}
-
-impl Link {
-    /// Accepts QEMU's connection to `listener` (QEMU connects while it
-    /// starts; the deadline only guards against a QEMU that never does).
-    fn accept(listener: &TcpListener, qemu: &mut Qemu) -> Link {
-        listener.set_nonblocking(true).expect("nonblocking");
-        let deadline = Instant::now() + Duration::from_secs(20);
-        let stream = loop {
-            match listener.accept() {
-                Ok((s, _)) => break s,
-                Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {
-                    if let Ok(Some(status)) = qemu.child.try_wait() {
-                        panic!("QEMU exited ({status}) before connecting; see target/qemu-tests/qemu-uart.stderr.txt");
-                    }
-                    assert!(
-                        Instant::now() < deadline,
-                        "QEMU did not connect to the serial socket within 20 s"
-                    );
-                    std::thread::yield_now();
-                }
-                Err(e) => panic!("accept: {e}"),
-            }
-        };
-        stream.set_nonblocking(false).expect("blocking");
-        stream.set_nodelay(true).expect("nodelay");
-        stream.set_read_timeout(Some(READ_GUARD)).expect("timeout");
-        Link {
-            stream,
-            acc: CobsAccumulator::new(),
-            buf: vec![0; 1024],
-            bytes_out: 0,
-            bytes_in: 0,
-        }
-    }
-
-    /// Waits for the target's start-up announcement (a single `0`).
-    fn wait_announce(&mut self) {
-        let mut b = [0u8; 1];
-        self.stream
-            .read_exact(&mut b)
-            .expect("no start-up byte from the firmware (read guard expired)");
-        self.bytes_in += 1;
-        assert_eq!(
-            b[0], 0,
-            "the first byte from the target must be the 0 announcement"
-        );
-    }
-
-    fn send(&mut self, msg: &HostMsg<4>) {
-        let raw = postcard::to_allocvec(msg).expect("encode");
-        let mut framed = vec![0u8; raw.len() + raw.len() / 254 + 2];
-        let n = cobs_encode(&raw, &mut framed).expect("cobs");
-        self.stream.write_all(&framed[..n]).expect("write to QEMU");
-        self.bytes_out += n;
-    }
-
-    fn recv(&mut self) -> TargetMsg {
-        let mut byte = [0u8; 1];
-        loop {
-            self.stream
-                .read_exact(&mut byte)
-                .expect("read from QEMU (read guard expired or closed)");
-            self.bytes_in += 1;
-            match self.acc.push(byte[0], &mut self.buf) {
-                None => {}
-                Some(Ok(0)) => {} // empty frame
-                Some(Ok(n)) => {
-                    return postcard::from_bytes(&self.buf[..n]).expect("decode TargetMsg")
-                }
-                Some(Err(e)) => panic!("bad COBS frame from the target: {e:?}"),
-            }
-        }
-    }
+/// The next message from the target; the deadline is a failure guard only.
+fn recv(link: &mut Link) -> TargetMsg {
+    link.recv(Instant::now() + READ_GUARD)
+        .unwrap_or_else(|e| panic!("no message from the target: {e:?}"))
 }
 
 /// What the firmware's control loop does with the same inputs, on the host.
@@ -318,30 +173,32 @@ impl Reference {
 }
 
 #[test]
-#[ignore = "needs qemu-system-arm and the firmware ELF; run by scripts/test.sh"]
+#[ignore = "needs qemu-system-arm and the firmware ELF; run by cargo xtask firmware-check"]
 fn uart_agent_in_the_loop() {
-    let elf = std::env::var_os("PH_QEMU_UART_ELF")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| root().join("target/thumbv7em-none-eabihf/release/qemu-uart"));
-    assert!(
-        elf.is_file(),
-        "{} not found: build it with `cargo build -p firmware-example --target thumbv7em-none-eabihf --release --bin qemu-uart`",
-        elf.display()
-    );
-    let out_dir = root().join("target/qemu-tests");
-    std::fs::create_dir_all(&out_dir).expect("output directory");
+    let elf = firmware::elf_or_env("qemu-uart", "PH_QEMU_UART_ELF");
+    let elf = firmware::require_elf(&elf, "qemu-uart").unwrap_or_else(|e| panic!("{e}"));
+    let out_dir = firmware::target_dir().join("qemu-tests");
 
-    // The test listens on a free loopback port; QEMU's USART1 connects to it.
+    // The test listens on a free loopback port; QEMU's USART1 connects to it (QEMU is
+    // killed when `qemu` is dropped, e.g. when an assertion fails).
     let listener = TcpListener::bind("127.0.0.1:0").expect("listen on a loopback port");
     let port = listener.local_addr().expect("local address").port();
-    let mut qemu = Qemu::start(&elf, port, &out_dir);
-    let mut link = Link::accept(&listener, &mut qemu);
-    link.wait_announce();
+    let command = Qemu::new(&elf, out_dir.join("qemu-uart")).serial(Serial::TcpClient { port });
+    let mut qemu = command
+        .spawn()
+        .unwrap_or_else(|e| panic!("{e}: {}", command.display()));
+    let stream = qemu
+        .accept(&listener, Instant::now() + Duration::from_secs(20))
+        .unwrap_or_else(|e| panic!("QEMU did not connect its USART1: {e}"));
+    let mut link = Link::new(stream).expect("configure the connection");
+    link.set_write_timeout(READ_GUARD).expect("write timeout");
+    link.wait_announcement(Instant::now() + READ_GUARD)
+        .unwrap_or_else(|e| panic!("no start-up announcement from the firmware: {e:?}"));
 
     // Handshake.
     const ME: usize = 2; // agent 3
-    link.send(&HostMsg::Configure(paper_config::<f32>(ME)));
-    match link.recv() {
+    send(&mut link, &HostMsg::Configure(paper_config::<f32>(ME)));
+    match recv(&mut link) {
         TargetMsg::Ready { id, version, .. } => {
             assert_eq!(id, 3);
             assert_eq!(version, LINK_VERSION);
@@ -432,13 +289,14 @@ fn uart_agent_in_the_loop() {
         };
         for f in &for_target {
             let frame = heapless::Vec::from_slice(f).expect("frame fits");
-            link.send(&HostMsg::Radio(frame));
+            link.queue(&HostMsg::Radio(frame))
+                .expect("queue a radio frame");
         }
-        link.send(&HostMsg::Step(step.clone()));
+        send(&mut link, &HostMsg::Step(step.clone()));
         let mut target_frames = Vec::new();
         let mut target_estimates = Vec::new();
         let output = loop {
-            match link.recv() {
+            match recv(&mut link) {
                 TargetMsg::Radio(f) => {
                     assert!(
                         target_estimates.is_empty(),
@@ -532,8 +390,8 @@ fn uart_agent_in_the_loop() {
     }
     let elapsed = started.elapsed();
 
-    link.send(&HostMsg::Finish);
-    match link.recv() {
+    send(&mut link, &HostMsg::Finish);
+    match recv(&mut link) {
         TargetMsg::Finished { accepted, rejected } => {
             assert_eq!(
                 accepted,
@@ -548,20 +406,17 @@ fn uart_agent_in_the_loop() {
         }
         other => panic!("expected Finished, got {other:?}"),
     }
-    let status = loop {
-        if let Some(s) = qemu.child.try_wait().expect("wait") {
-            break s;
-        }
-        std::thread::yield_now();
-    };
-    let log = qemu.log();
+    // The firmware exits right after `Finished`; the limit is a failure guard only.
+    let status = qemu.wait_or_kill(READ_GUARD);
+    let log = defmt::decode_or_note(&elf, &qemu.log);
     if let Some(path) = std::env::var_os("PH_QEMU_UART_LOG") {
         std::fs::write(&path, &log).expect("write PH_QEMU_UART_LOG");
     }
     assert_eq!(
-        status.code(),
+        status.and_then(|s| s.code()),
         Some(0),
-        "qemu-uart exit status; firmware log:\n{log}"
+        "qemu-uart exit status {status:?} ({}); firmware log:\n{log}",
+        qemu.stderr_tail()
     );
 
     let tps = TICKS as f64 / elapsed.as_secs_f64();
@@ -570,8 +425,8 @@ fn uart_agent_in_the_loop() {
          {} bytes to the target, {} bytes back; first nominal tick {first_nominal:?}; \
          max relative force difference {max_rel:e}; {identical}/{TICKS} ticks bit-identical (force, frames, estimates)",
         elapsed.as_secs_f64(),
-        link.bytes_out,
-        link.bytes_in,
+        link.counters.bytes_to_target,
+        link.counters.bytes_from_target,
     );
     println!("firmware log:\n{log}");
     assert_eq!(first_nominal, Some(1));

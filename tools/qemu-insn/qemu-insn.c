@@ -19,7 +19,7 @@
  *   profile=ID    also count, per instruction address, the instructions
  *                 executed inside region ID (all its occurrences), and print
  *                 `qemu-insn profile pc=0x<addr> insns=<n>` lines at exit
- *                 (scripts/firmware-profile.sh maps them to functions)
+ *                 (cargo xtask firmware-profile maps them to functions)
  *
  * Counting uses one callback per executed instruction, so the count is exact
  * and independent of how QEMU splits code into translation blocks. It

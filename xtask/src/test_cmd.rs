@@ -1,0 +1,130 @@
+//! `cargo xtask test`: every check of the project, in order, stopping at the first
+//! failure; then the duration of each phase (informational, never asserted).
+//!
+//! `scripts/test.sh` installs what this needs (rustup target and components,
+//! `scripts/firmware-deps.sh`) and then runs it. Each QEMU run happens once: the firmware
+//! checks run `firmware-example`, `measure` and the self-tests themselves and the demo
+//! and UART sessions through the QEMU tests of the `tests` crate; the host-in-the-loop
+//! runs are host-sim's QEMU tests.
+
+use crate::firmware_check;
+use crate::tools::{self, cargo};
+use qemu_harness::firmware::TARGET;
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+/// Environment variable: Unix time (s) when `scripts/test.sh` started.
+pub const STARTED_ENV: &str = "XTASK_TEST_STARTED";
+/// Environment variable: Unix time (s) when `scripts/test.sh` finished installing.
+pub const INSTALLED_ENV: &str = "XTASK_TEST_INSTALLED";
+
+/// Runs the phases; `Ok(())` if every one passed.
+pub fn run(fw: &firmware_check::Options) -> Result<(), String> {
+    let mut durations: Vec<(String, Duration)> = Vec::new();
+    // What happened before this process: scripts/test.sh's installation and the build of
+    // this xtask (both measured from the timestamps scripts/test.sh exports).
+    let now = unix_now();
+    let started = env_time(STARTED_ENV);
+    let installed = env_time(INSTALLED_ENV);
+    if let (Some(s), Some(i)) = (started, installed) {
+        durations.push(("install (scripts/test.sh)".into(), secs(i - s)));
+    }
+    if let Some(i) = installed {
+        durations.push(("build xtask".into(), secs(now - i)));
+    }
+
+    let result = phases(fw, &mut durations);
+
+    println!();
+    println!("== durations (wall clock; informational)");
+    let mut total = Duration::ZERO;
+    for (name, d) in &durations {
+        total += *d;
+        println!("   {name:<42} {:>7.1} s", d.as_secs_f64());
+    }
+    println!("   {:<42} {:>7.1} s", "total", total.as_secs_f64());
+    match &result {
+        Ok(()) => println!("xtask test: all checks passed"),
+        Err(e) => eprintln!("xtask test: FAILED: {e}"),
+    }
+    result
+}
+
+fn phases(
+    fw: &firmware_check::Options,
+    durations: &mut Vec<(String, Duration)>,
+) -> Result<(), String> {
+    let mut phase = |name: &str, f: &mut dyn FnMut() -> Result<(), String>| {
+        println!("\n==> {name}");
+        let t = Instant::now();
+        let r = f();
+        durations.push((name.to_owned(), t.elapsed()));
+        r.map_err(|e| format!("{name}: {e}"))
+    };
+    let thumb = ["--target", TARGET];
+    let deny = ["--", "-D", "warnings"];
+
+    phase("format", &mut || {
+        tools::run(cargo().args(["fmt", "--all", "--check"]))
+    })?;
+    phase("clippy (host)", &mut || {
+        tools::run(
+            cargo()
+                .args(["clippy", "--workspace", "--all-targets"])
+                .args(deny),
+        )
+    })?;
+    phase("clippy and builds (thumbv7em-none-eabihf)", &mut || {
+        let core = ["-p", "controller-core"];
+        tools::run(cargo().arg("clippy").args(core).args(thumb).args(deny))?;
+        tools::run(
+            cargo()
+                .arg("clippy")
+                .args(core)
+                .args(thumb)
+                .args(["--features", "defmt"])
+                .args(deny),
+        )?;
+        tools::run(cargo().arg("build").args(core).args(thumb).arg("--release"))?;
+        tools::run(cargo().arg("build").args(core).args(thumb).args([
+            "--release",
+            "--features",
+            "defmt",
+        ]))?;
+        tools::run(
+            cargo()
+                .args(["clippy", "-p", "firmware-example"])
+                .args(thumb)
+                .args(["--release", "--all-targets"])
+                .args(deny),
+        )
+    })?;
+    phase("host tests (cargo test)", &mut || {
+        tools::run(cargo().arg("test"))
+    })?;
+    phase(
+        "firmware-check (QEMU)",
+        &mut || match firmware_check::run(fw)? {
+            true => Ok(()),
+            false => Err("regressions (listed above)".into()),
+        },
+    )?;
+    phase("host-in-the-loop (host-sim QEMU tests)", &mut || {
+        // No `-p host-sim`: the default members' feature set, as `cargo test` built it.
+        tools::run(cargo().args(["test", "--test", "hil", "--", "--include-ignored"]))
+    })?;
+    Ok(())
+}
+
+fn unix_now() -> f64 {
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0.0, |d| d.as_secs_f64())
+}
+
+fn env_time(name: &str) -> Option<f64> {
+    std::env::var(name).ok()?.trim().parse().ok()
+}
+
+fn secs(s: f64) -> Duration {
+    Duration::try_from_secs_f64(s).unwrap_or(Duration::ZERO)
+}
