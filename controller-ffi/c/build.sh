@@ -49,7 +49,7 @@ firmware)
     "${ARM_CC:-arm-none-eabi-gcc}" "${cflags[@]}" \
         -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard \
         -ffreestanding -ffunction-sections -fdata-sections -nostdlib \
-        -T "$here/firmware/stm32f405.ld" -Wl,--gc-sections -Wl,-Map="$out/c-firmware.map" \
+        -T "$here/firmware/stm32f405.ld" -Wl,--gc-sections -Wl,-z,noexecstack -Wl,-Map="$out/c-firmware.map" \
         -o "$out/c-firmware.elf" \
         "$here/firmware/startup.c" "$here/firmware/main.c" "${demo[@]}" \
         "$lib" -lgcc

@@ -159,7 +159,7 @@ pub unsafe extern "C" fn ph_agent_init(
     config: *const ph_config,
 ) -> ph_status {
     // SAFETY: per this function's contract.
-    let config = unsafe { input(config) }.and_then(to_core);
+    let config = || unsafe { input(config) }.and_then(to_core);
     // SAFETY: per this function's contract.
     unsafe { storage::init(agent, size, config) }
 }
@@ -178,16 +178,14 @@ pub unsafe extern "C" fn ph_agent_init_blob(
     blob: *const u8,
     len: usize,
 ) -> ph_status {
-    // SAFETY: per this function's contract.
-    let config = unsafe { slice(blob, len) }
-        .and_then(|b| {
-            if b.is_empty() {
-                Err(ph_status::PH_ERR_NULL)
-            } else {
-                Ok(b)
-            }
-        })
-        .and_then(|b| decode_blob(b).map_err(ph_status::from));
+    let config = || {
+        // SAFETY: per this function's contract.
+        let bytes = unsafe { slice(blob, len) }?;
+        if bytes.is_empty() {
+            return Err(ph_status::PH_ERR_NULL);
+        }
+        decode_blob(bytes).map_err(ph_status::from)
+    };
     // SAFETY: per this function's contract.
     unsafe { storage::init(agent, size, config) }
 }

@@ -66,8 +66,9 @@ fn slot_ptr(memory: *mut ph_agent, size: usize) -> Result<*mut Slot, ph_status> 
     Ok(slot)
 }
 
-/// Builds the agent of `config` in `memory` (`size` bytes). On any error the memory no
-/// longer holds an agent.
+/// Builds the agent of the configuration `config()` returns in `memory` (`size` bytes).
+/// On any error the memory no longer holds an agent. (`config` runs inside, so that
+/// the configuration is built in the same out-of-line frame as the agent.)
 ///
 /// # Safety
 /// `memory` is NULL or valid for writes of `size` bytes, and not used by anything else
@@ -75,7 +76,7 @@ fn slot_ptr(memory: *mut ph_agent, size: usize) -> Result<*mut Slot, ph_status> 
 pub unsafe fn init(
     memory: *mut ph_agent,
     size: usize,
-    config: Result<FfiConfig, ph_status>,
+    config: impl FnOnce() -> Result<FfiConfig, ph_status>,
 ) -> ph_status {
     let slot = match slot_ptr(memory, size) {
         Ok(s) => s,
@@ -85,18 +86,38 @@ pub unsafe fn init(
     // the caller guarantees it is valid for writes. Raw writes: the memory may hold
     // anything (no reference to a `Slot` is made before it holds one).
     unsafe { addr_of_mut!((*slot).marker).write(0) };
-    let agent = match config.map(FfiAgent::new) {
-        Ok(Ok(a)) => a,
-        Ok(Err(e)) => return e.into(),
-        Err(e) => return e,
-    };
+    // SAFETY: as above.
+    if let Err(e) = unsafe { build(config, addr_of_mut!((*slot).agent)) } {
+        return e;
+    }
     // SAFETY: as above; the marker is written last, so an agent is only ever seen
     // complete.
-    unsafe {
-        addr_of_mut!((*slot).agent).write(agent);
-        addr_of_mut!((*slot).marker).write(MARKER);
-    }
+    unsafe { addr_of_mut!((*slot).marker).write(MARKER) };
     ph_status::PH_OK
+}
+
+/// `Agent::new(config)` written to `dst`, copied straight out of the `Result` (moving
+/// it out would put a second copy of the agent on the stack: init's stack is in
+/// docs/c-api.md). Out of line, so that no caller's frame holds one either.
+///
+/// # Safety
+/// `dst` is valid for writes of an agent.
+#[inline(never)]
+unsafe fn build(
+    config: impl FnOnce() -> Result<FfiConfig, ph_status>,
+    dst: *mut FfiAgent,
+) -> Result<(), ph_status> {
+    let built = FfiAgent::new(config()?);
+    match &built {
+        Ok(agent) => {
+            // SAFETY: `dst` is valid for writes (caller); this is a bitwise move of
+            // `agent`, whose original is forgotten right after (never used or dropped).
+            unsafe { core::ptr::copy_nonoverlapping(agent, dst, 1) };
+            core::mem::forget(built);
+            Ok(())
+        }
+        Err(e) => Err((*e).into()),
+    }
 }
 
 /// The agent in `memory`, if it holds one.
