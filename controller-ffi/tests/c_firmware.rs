@@ -10,8 +10,9 @@
 //!   linker drops it when nothing calls it), nor any soft-float `f64` routine: nothing
 //!   the C API reaches can panic.
 //! * `c_firmware_figures`: text size by origin (from the linker map), RAM, stack, and
-//!   instructions per whole tick through the C API (QEMU with `tools/qemu-insn`);
-//!   printed for docs/c-api.md (run with `--nocapture`).
+//!   instructions per whole tick through the C API (QEMU with `tools/qemu-insn`), with
+//!   the functions robot 3's tick spends them in; printed for docs/c-api.md (run with
+//!   `--nocapture`).
 //!
 //! Ignored by default: they need `arm-none-eabi-gcc` (scripts/firmware-deps.sh) and
 //! `qemu-system-arm`. Run them with
@@ -71,8 +72,13 @@ fn demo_run() -> &'static (Option<i32>, String) {
 }
 
 fn nm(elf: &Path) -> String {
+    nm_with(elf, &[])
+}
+
+fn nm_with(elf: &Path, args: &[&str]) -> String {
     let tool = std::env::var("ARM_NM").unwrap_or_else(|_| "arm-none-eabi-nm".into());
     let out = Command::new(&tool)
+        .args(args)
         .arg(elf)
         .output()
         .unwrap_or_else(|e| panic!("run {tool}: {e}"));
@@ -262,4 +268,63 @@ fn c_firmware_figures() {
     {
         println!("  {line}");
     }
+
+    // Where robot 3's tick goes: the plugin's per-address profile of region 3, by
+    // function (symbol sizes from nm).
+    let profile = elf.with_file_name("profile.txt");
+    let _ = std::fs::remove_file(&profile);
+    let (code, log) = run_qemu(
+        elf,
+        &[
+            "-plugin".into(),
+            format!(
+                "{plugin},marker={marker},out={},profile=3",
+                profile.display()
+            ),
+        ],
+    );
+    assert_eq!(code, Some(0), "{log}");
+    let mut symbols: Vec<(u64, u64, String)> = nm_with(elf, &["-n", "-S", "--defined-only"])
+        .lines()
+        .filter_map(|l| match l.split_whitespace().collect::<Vec<_>>()[..] {
+            [a, s, _, n] => Some((
+                u64::from_str_radix(a, 16).ok()?,
+                u64::from_str_radix(s, 16).ok()?,
+                n.to_string(),
+            )),
+            _ => None,
+        })
+        .collect();
+    symbols.sort();
+    let mut by_function: BTreeMap<String, u64> = BTreeMap::new();
+    for line in std::fs::read_to_string(&profile).expect("profile").lines() {
+        let (Some(pc), Some(n)) = (
+            line.split("pc=0x")
+                .nth(1)
+                .and_then(|x| x.split_whitespace().next()),
+            line.split("insns=").nth(1),
+        ) else {
+            continue;
+        };
+        let (Ok(pc), Ok(n)) = (u64::from_str_radix(pc, 16), n.trim().parse::<u64>()) else {
+            continue;
+        };
+        let name = symbols
+            .iter()
+            .rev()
+            .find(|(a, size, _)| *a <= pc && pc < a + (*size).max(1))
+            .map_or("?".to_string(), |(_, _, n)| n.clone());
+        *by_function.entry(name).or_default() += n;
+    }
+    let mut rows: Vec<_> = by_function.into_iter().collect();
+    rows.sort_by(|a, b| b.1.cmp(&a.1));
+    println!("robot 3's tick by function (instructions):");
+    for (name, n) in &rows {
+        println!("  {n:>5}  {name}");
+    }
+    assert_eq!(
+        rows.iter().map(|r| r.1).sum::<u64>(),
+        region(3)[0],
+        "profile total"
+    );
 }
