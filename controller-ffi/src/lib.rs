@@ -43,7 +43,9 @@ extern crate std;
 pub mod api;
 pub mod blob;
 pub mod config;
-#[cfg(all(target_os = "none", feature = "panic-handler"))]
+// Bare-metal targets: the staticlib needs a panic handler (so Rust firmware with its
+// own handler uses controller-core directly, not this crate).
+#[cfg(target_os = "none")]
 mod panic;
 pub mod status;
 pub mod storage;

@@ -1,5 +1,4 @@
-//! The panic handler of the bare-metal staticlib (feature `panic-handler`, on by
-//! default).
+//! The panic handler of the bare-metal staticlib.
 //!
 //! Nothing reachable from the C API should panic: like the core, this crate denies
 //! `unwrap`, `expect`, `panic!`, indexing and unchecked arithmetic. Should one happen

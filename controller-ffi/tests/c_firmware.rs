@@ -317,7 +317,7 @@ fn c_firmware_figures() {
         *by_function.entry(name).or_default() += n;
     }
     let mut rows: Vec<_> = by_function.into_iter().collect();
-    rows.sort_by(|a, b| b.1.cmp(&a.1));
+    rows.sort_by_key(|r| std::cmp::Reverse(r.1));
     println!("robot 3's tick by function (instructions):");
     for (name, n) in &rows {
         println!("  {n:>5}  {name}");
