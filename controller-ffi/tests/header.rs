@@ -52,3 +52,41 @@ fn header_lists_every_status_code() {
         assert_eq!(controller_ffi::ph_status::from_code(s as i32), Some(s));
     }
 }
+
+/// The header is plain C99 (`-pedantic`, warnings as errors) for the host compiler.
+#[test]
+fn header_compiles_as_pedantic_c99() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("header-c99");
+    std::fs::create_dir_all(&dir).expect("scratch directory");
+    let src = dir.join("use_header.c");
+    std::fs::write(
+        &src,
+        "#include \"ph_formation.h\"\n\
+         int main(void) { ph_config c; return ph_config_default(&c, 1) == PH_OK ? 0 : 1; }\n",
+    )
+    .expect("write the C file");
+    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
+    let out = std::process::Command::new(&cc)
+        .args([
+            "-std=c99",
+            "-pedantic",
+            "-Wall",
+            "-Wextra",
+            "-Werror",
+            "-fsyntax-only",
+        ])
+        .arg(format!(
+            "-I{}",
+            Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("include")
+                .display()
+        ))
+        .arg(&src)
+        .output()
+        .unwrap_or_else(|e| panic!("run {cc}: {e}"));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
