@@ -4,6 +4,8 @@
 #
 #   qemu-system-arm        apt (Debian bookworm: QEMU 7.2; netduinoplus2 = STM32F405)
 #   gcc, libc6-dev         apt, to build the TCG plugin tools/qemu-insn
+#   gcc-arm-none-eabi      apt, the C firmware and the Crazyflie app of controller-ffi
+#                          (bare metal, no libc: newlib is not needed)
 #   defmt-print 1.x        cargo install --locked (only if missing / not 1.x)
 #   thumbv7em-none-eabihf, llvm-tools
 #                          rustup (no-ops when rust-toolchain.toml already
@@ -23,6 +25,7 @@ need_apt=()
 command -v qemu-system-arm >/dev/null 2>&1 || need_apt+=(qemu-system-arm)
 command -v gcc >/dev/null 2>&1 || need_apt+=(gcc)
 [[ -e /usr/include/stdio.h ]] || need_apt+=(libc6-dev)
+command -v arm-none-eabi-gcc >/dev/null 2>&1 || need_apt+=(gcc-arm-none-eabi)
 command -v timeout >/dev/null 2>&1 || need_apt+=(coreutils)
 
 if ((${#need_apt[@]} > 0)); then
@@ -50,9 +53,10 @@ if ((${#need_apt[@]} > 0)); then
         DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get install -y -qq --no-install-recommends qemu-utils
     fi
 else
-    log "qemu-system-arm, gcc: present"
+    log "qemu-system-arm, gcc, arm-none-eabi-gcc: present"
 fi
 log "$(qemu-system-arm --version | head -n1)"
+log "$(arm-none-eabi-gcc --version | head -n1)"
 
 # ----------------------------------------------------------------- rust
 if ! command -v cargo >/dev/null 2>&1 && [[ -f $HOME/.cargo/env ]]; then

@@ -304,6 +304,8 @@ mod tests {
         let ready = TargetMsg::Ready {
             id: 3,
             version: LINK_VERSION,
+            max_triangles: 4,
+            max_neighbours: 8,
         };
         let mut bytes = vec![0u8];
         bytes.extend(framed(&ready));
