@@ -35,7 +35,7 @@ fn check(f: &Formation, s: &State, seed: u64) -> Check {
         *acc += x;
         scale += x.abs();
     };
-    for (i, a) in agents.iter().enumerate() {
+    for (i, a) in agents.iter_mut().enumerate() {
         let ev = a.evaluate().expect("nominal evaluation");
         // Kinetic: (v − v*)ᵀ m v̇ with m v̇ = −D^r v + U (S1).
         let fr = f.friction[i];
@@ -193,7 +193,7 @@ fn formation_forces_sum_to_zero_with_shared_estimates() {
         sense_and_exchange(&f, &s, &mut agents, 0.0, 0.0);
         let mut sum = Vec2::zeros();
         let mut scale = 0.0;
-        for (i, a) in agents.iter().enumerate() {
+        for (i, a) in agents.iter_mut().enumerate() {
             let ev = a.evaluate().expect("nominal");
             // Remove the S12 friction/damping part (zero v*, zero D^v: −D^r·0 = 0).
             let _ = i;

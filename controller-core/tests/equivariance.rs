@@ -22,7 +22,7 @@ fn forces<T: controller_core::Real>(
     }
     sense_and_exchange(f, s, &mut agents, 0.0, 0.0);
     agents
-        .iter()
+        .iter_mut()
         .map(|a| {
             let ev = a.evaluate().expect("nominal");
             let x: f64 = nalgebra::try_convert(ev.force.x).unwrap_or(f64::NAN);

@@ -2,7 +2,7 @@
 //! its neighbours' broadcasts ([`Agent::receive`], [`Agent::receive_direct`]). The frame
 //! layout is [`crate::wire`]'s.
 
-use super::state::{AngleState, Remote, Role};
+use super::state::{AngleState, Remote, Side};
 use super::{pick, Agent};
 use crate::config::AgentId;
 use crate::wire::{check_frame, mode_byte, quant, FrameError, RawAngle};
@@ -162,7 +162,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 sigma,
                 rho,
             } => {
-                let me = self.config.id;
+                let (me, velocity) = (self.config.id, self.velocity);
                 let mine = if far[0] == me {
                     0
                 } else if far[1] == me {
@@ -185,16 +185,15 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     else {
                         continue;
                     };
-                    if let Role::Far(k) = a.role {
-                        if pick(&a.far, 1 - k.min(1)) == other && pick(&a.far, k) == me {
-                            a.remote = Remote {
+                    if let Side::Far { k, remote, age } = &mut a.side {
+                        if pick(&a.far, 1 - *k) == other && pick(&a.far, *k) == me {
+                            *remote = Remote {
                                 gamma,
                                 sigma,
                                 rho: pick(&rho, mine),
-                                delta: Vec2::zeros(),
-                                v_ref: None,
+                                v_ref: velocity,
                             };
-                            a.remote_age = T::zero();
+                            *age = T::zero();
                         }
                     }
                 }
@@ -208,6 +207,8 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
 #[inline]
 #[allow(clippy::type_complexity)]
 fn sent_angle<T: Real>(a: &AngleState<T>) -> Option<(T, T, [T; 2])> {
-    let p = &a.part;
-    (a.role == Role::Apex && a.fault.is_none()).then_some((p.gamma, p.sigma, p.rho))
+    match &a.side {
+        Side::Apex { part, fault: None } => Some((part.gamma, part.sigma, part.rho)),
+        _ => None,
+    }
 }

@@ -2,7 +2,8 @@
 //! computed by [`Agent::sense`]; far vertices apply the efforts they received), the
 //! estimator flows S9/S10, saturation and the safe output.
 
-use super::state::Role;
+use super::estimates::owns;
+use super::state::{AngleState, Side};
 use super::{
     finite_vec, pick, vec2, within, Agent, Evaluation, Fault, Measurements, Status, StepOutput,
 };
@@ -11,15 +12,25 @@ use crate::{geometry, law, Real, Vec2};
 
 impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// Evaluates the control law S7–S12 and the estimator flows S9/S10 on the stored
-    /// measurements and neighbour data, without changing anything. [`Agent::step`] uses
-    /// the same law; simulators that integrate the estimators themselves (continuous
-    /// time) call [`Agent::sense`], exchange, then this.
-    pub fn evaluate(&self) -> Result<Evaluation<T, MT>, Fault> {
-        let (force, degenerate) = self.law()?;
+    /// measurements and neighbour data, without changing the state (it only overwrites
+    /// the internal scratch of the flows). [`Agent::step`] runs the same law; simulators
+    /// that integrate the estimators themselves (continuous time) call [`Agent::sense`],
+    /// exchange, then this.
+    pub fn evaluate(&mut self) -> Result<Evaluation<T, MT>, Fault> {
+        let (force, degenerate) = self.law(None)?;
+        let r_min = self.config.min_estimate;
+        // S10, continuous form: no negative flow at r_min (zero for estimates not owned).
+        let projected = |a: &AngleState<T>| {
+            let rate = |e: usize| match self.owns(a, e) {
+                true => law::projected_rate(pick(&a.estimate, e), pick(&a.flow, e), r_min),
+                false => T::zero(),
+            };
+            [rate(0), rate(1)]
+        };
         let estimate_rates = self
             .angles
             .iter()
-            .map(|[a0, a1]| [a0.rate.get(), a1.rate.get()])
+            .map(|[a0, a1]| [projected(a0), projected(a1)])
             .collect();
         Ok(Evaluation {
             force,
@@ -28,18 +39,15 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         })
     }
 
-    /// One control tick: [`Agent::sense`], the law ([`Agent::evaluate`]'s), the owned
+    /// One control tick: [`Agent::sense`], the law ([`Agent::evaluate`]'s) with the owned
     /// estimates integrated over `dt` (sampled S10), saturation. On any fault the output
     /// is the documented safe command `U = −safe_damping · v` (no formation force) and the
     /// estimates hold still.
     pub fn step(&mut self, m: &Measurements<'_, T>) -> StepOutput<T> {
-        let result = self.sense(m).and_then(|()| self.law());
-        if result.is_ok() {
-            // The law's flows, over dt (sampled S10: `r̂ ← max(r_min, r̂ + Δt·S9)`; the
-            // continuous projection the law applies first changes nothing here: it acts
-            // only when r̂ ≤ r_min and S9 < 0, and then both give r_min).
-            self.integrate(m.dt);
-        }
+        let result = match self.sense(m) {
+            Ok(()) => self.law(Some(m.dt)),
+            Err(fault) => Err(fault),
+        };
         self.comm_due = self.comm_countdown == 0;
         self.comm_countdown = match self.comm_countdown.checked_sub(1) {
             Some(c) => c,
@@ -73,12 +81,42 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         }
     }
 
-    /// The law S7–S12: the sum of the angles' S8 forces, S11 and S12, and the S9 flow
-    /// with the S10 projection of every owned estimate (left in each angle's `rate`).
-    /// Returns the unsaturated force and whether a current angle (of which this agent is
-    /// the apex) is degenerate. The first fault in angle order wins (after staleness).
+    /// The law S7–S12: the sum of the angles' S8 forces, S11 and S12, and the S9 flow of
+    /// every owned estimate. With `integrate = Some(dt)` the owned estimates take the
+    /// sampled S10 step `r̂ ← max(r_min, r̂ + Δt·S9)` (the continuous projection changes
+    /// nothing there: it acts only when r̂ ≤ r_min and S9 < 0, and then both give r_min),
+    /// and are put back as they were if the law ends in a fault; with `None` the flows are
+    /// left in each angle's `flow`. Returns the unsaturated force and whether a current
+    /// angle (of which this agent is the apex) is degenerate. The first fault in angle
+    /// order wins (after staleness).
+    fn law(&mut self, integrate: Option<T>) -> Result<(Vec2<T>, bool), Fault> {
+        let mut done = 0;
+        let result = self.law_pass(integrate, &mut done);
+        if result.is_err() && integrate.is_some() {
+            // Roll back the angles the pass integrated (their `flow` holds the estimates
+            // from before; the others are untouched).
+            let mode = self.config.estimator;
+            for a in self.angles.as_mut_slice().as_flattened_mut().iter_mut().take(done) {
+                for e in 0..2 {
+                    if owns(mode, a, e) {
+                        if let (Some(est), Some(before)) = (a.estimate.get_mut(e), a.flow.get(e)) {
+                            *est = *before;
+                        }
+                    }
+                }
+            }
+        }
+        result
+    }
+
+    /// [`Agent::law`] without the roll-back: with `integrate`, `flow` keeps the estimates
+    /// from before the step of the `done` angles it went through.
     #[inline]
-    fn law(&self) -> Result<(Vec2<T>, bool), Fault> {
+    fn law_pass(
+        &mut self,
+        integrate: Option<T>,
+        done: &mut usize,
+    ) -> Result<(Vec2<T>, bool), Fault> {
         self.check_fresh()?;
         let c = &self.config;
         let v = self.velocity;
@@ -86,56 +124,71 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         let (mode, r_min) = (c.estimator, c.min_estimate);
         let timeout = c.limits.neighbour_timeout;
         let zero = T::zero();
+        let nbs = self.neighbours.as_slice();
+        let nb = |slot: usize| nbs.get(slot).ok_or(Fault::Internal);
+        // S9 with S3 for ṙ, then (stepping) S10 on the estimate, or (evaluating) the flow
+        // kept in `flow`.
+        let settle = |a: &mut AngleState<T>, e: usize, flow: T| {
+            if let (Some(est), Some(f)) = (a.estimate.get_mut(e), a.flow.get_mut(e)) {
+                match integrate {
+                    Some(dt) => {
+                        *f = *est;
+                        *est = law::estimator_step(*est, flow, dt, r_min);
+                    }
+                    None => *f = flow,
+                }
+            }
+        };
         // S12.
         let mut force = law::velocity_force(&c.friction, &c.velocity_damping, &v, &v_star);
         // Largest |y| (NaN ignored): degenerate iff above the margin.
         let mut y_max = zero;
-        for a in self.angles.as_slice().as_flattened() {
-            let rate = match a.role {
-                Role::Apex => {
-                    if let Some(fault) = a.fault {
+        for a in self.angles.as_mut_slice().as_flattened_mut() {
+            match a.side {
+                Side::Apex { part: p, fault } => {
+                    if let Some(fault) = fault {
                         return Err(fault);
                     }
-                    let p = &a.part;
                     let y_abs = p.y.abs();
                     if y_abs > y_max {
                         y_max = y_abs;
                     }
                     // S8 on the apex (computed when sensing).
                     force += p.force;
-                    if mode == EstimatorMode::Measured {
-                        [zero; 2]
-                    } else {
-                        // S9 with S3 for ṙ_e (own bearing, the far vertex's velocity), S10.
-                        let flow = |slot: usize, e: usize| -> Result<T, Fault> {
-                            let n = self.neighbour(slot)?;
-                            let rr = geometry::range_rate(&n.s, &(n.velocity()? - v));
-                            let r_hat = pick(&a.estimate, e);
-                            let share = pick(&p.share, e);
-                            let f =
-                                law::estimator_rate(rr, p.gamma, share, a.estimator_gain, r_hat);
-                            Ok(law::projected_rate(r_hat, f, r_min))
-                        };
-                        [flow(a.slots[1], 0)?, flow(a.slots[2], 1)?]
+                    if mode != EstimatorMode::Measured {
+                        let (nv, nw) = (nb(a.slots[1])?, nb(a.slots[2])?);
+                        let (vv, vw) = (nv.velocity()?, nw.velocity()?);
+                        let gain = a.estimator_gain;
+                        // S3 with the own bearings s_uv, s_uw and the far vertices' velocities.
+                        let rr = [
+                            geometry::range_rate(&nv.s, &(vv - v)),
+                            geometry::range_rate(&nw.s, &(vw - v)),
+                        ];
+                        let [r0, r1] = a.estimate;
+                        let f0 = law::estimator_rate(rr[0], p.gamma, p.share[0], gain, r0);
+                        let f1 = law::estimator_rate(rr[1], p.gamma, p.share[1], gain, r1);
+                        settle(a, 0, f0);
+                        settle(a, 1, f1);
                     }
                 }
-                Role::Far(k) => {
-                    let n = self.neighbour(a.slots[0])?;
+                Side::Far { k, remote, age } => {
+                    let n = nb(a.slots[0])?;
                     let (s_ku, _) = n.bearing()?;
-                    if !within(a.remote_age, timeout) {
+                    if !within(age, timeout) {
                         return Err(Fault::MissingData(a.apex));
                     }
-                    let remote = &a.remote;
                     // SPEC §6: the apex's shared estimate, the own copy, or the range.
                     let r = match mode {
                         EstimatorMode::Shared => remote.rho,
                         EstimatorMode::PerAgent => pick(&a.estimate, k),
                         EstimatorMode::Measured => n.range()?,
                     };
-                    let dv = match remote.v_ref {
-                        Some(v_ref) => v - v_ref,
-                        None => Vec2::zeros(),
-                    };
+                    // Own motion relative to the apex since it measured (taken as the tick
+                    // before the frame arrived): displacement at the current relative
+                    // velocity, change of own velocity since the frame arrived.
+                    let v_apex = n.velocity()?;
+                    let delta = (v - v_apex) * age;
+                    let dv = v - remote.v_ref;
                     // S6–S8 on this far vertex.
                     let (gamma_k, g_k, f) = law::far_angle(
                         remote.gamma,
@@ -145,27 +198,22 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                         &s_ku,
                         a.stiffness,
                         a.damping,
-                        &remote.delta,
+                        &delta,
                         &dv,
                     );
                     force += f;
                     if mode == EstimatorMode::PerAgent {
                         // S9 on the own copy r̂^k (SPEC §6): ṙ_uk = s_ukᵀ(v_k − v_u) with
                         // s_uk = −s_ku (S3), and the share f^k = +g_kᵀ v_k / r̂^k.
-                        let rr = geometry::range_rate(&-s_ku, &(v - n.velocity()?));
+                        let rr = geometry::range_rate(&-s_ku, &(v - v_apex));
                         let share = law::own_share(&g_k, &v, r, true);
                         let flow = law::estimator_rate(rr, gamma_k, share, a.estimator_gain, r);
-                        let mut rate = [zero; 2];
-                        if let Some(x) = rate.get_mut(k) {
-                            *x = law::projected_rate(r, flow, r_min);
-                        }
-                        rate
-                    } else {
-                        [zero; 2]
+                        settle(a, k, flow);
                     }
                 }
-            };
-            a.rate.set(rate);
+            }
+            // Every fault of an angle comes before its estimates are settled.
+            *done += 1;
         }
         if let Some(l) = &c.leader {
             // S11 with z = q_a − q_b; the partner offset p = q_partner − q_self.
@@ -233,7 +281,9 @@ mod tests {
             partner_offset: None,
         };
         a.sense(&m).unwrap();
-        a.angles[0][0].remote_age = 0.0;
+        if let crate::agent::state::Side::Far { age, .. } = &mut a.angles[0][0].side {
+            *age = 0.0;
+        }
         a.angles[0][0].slots[0] = 7;
         assert_eq!(a.evaluate().err(), Some(Fault::Internal));
     }

@@ -1,22 +1,16 @@
 //! The distance estimates an agent owns (SPEC §6): which they are, reading and setting
 //! them, and the sampled integration of S9 with the S10 projection.
 
-use super::state::{AngleState, Role};
+use super::state::{AngleState, Side};
 use super::{pick, Agent, OwnedEstimate};
 use crate::config::EstimatorMode;
-use crate::{law, Real};
+use crate::Real;
 
 impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
-    /// Whether this agent owns (integrates) the estimate of `edge` of angle `a`: the apex
-    /// owns both in shared and per-agent mode, a far vertex its own edge's copy in
-    /// per-agent mode; nobody in measured mode.
+    /// Whether this agent owns (integrates) the estimate of `edge` of angle `a` (see
+    /// [`owns`]).
     pub(super) fn owns(&self, a: &AngleState<T>, edge: usize) -> bool {
-        match (self.config.estimator, a.role) {
-            (EstimatorMode::Measured, _) => false,
-            (_, Role::Apex) => true,
-            (EstimatorMode::PerAgent, Role::Far(k)) => k == edge,
-            (EstimatorMode::Shared, Role::Far(_)) => false,
-        }
+        owns(self.config.estimator, a, edge)
     }
 
     /// The estimates this agent owns and integrates, with where they belong.
@@ -60,17 +54,16 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             _ => false,
         }
     }
+}
 
-    /// One sampled step of every estimate with the flows the law left in `rate`:
-    /// `r̂ ← max(r_min, r̂ + Δt·rate)` (S10). Estimates not owned have rate zero and stay as
-    /// they are (they are never below `r_min`).
-    pub(super) fn integrate(&mut self, dt: T) {
-        let r_min = self.config.min_estimate;
-        for a in self.angles.as_mut_slice().as_flattened_mut() {
-            let rate = a.rate.get();
-            for (est, rate) in a.estimate.iter_mut().zip(rate) {
-                *est = law::estimator_step(*est, rate, dt, r_min);
-            }
-        }
+/// Whether an agent in `mode` owns (integrates) the estimate of `edge` of angle `a`: the
+/// apex owns both in shared and per-agent mode, a far vertex its own edge's copy in
+/// per-agent mode; nobody in measured mode.
+pub(super) fn owns<T: Real>(mode: EstimatorMode, a: &AngleState<T>, edge: usize) -> bool {
+    match (mode, &a.side) {
+        (EstimatorMode::Measured, _) => false,
+        (_, Side::Apex { .. }) => true,
+        (EstimatorMode::PerAgent, Side::Far { k, .. }) => *k == edge,
+        (EstimatorMode::Shared, Side::Far { .. }) => false,
     }
 }

@@ -2,7 +2,7 @@
 //! partner offset), the finite-difference bearing rates of SPEC §2, and the kernels of
 //! the angles this agent is the apex of (S4–S8), which depend on nothing else.
 
-use super::state::{AngleState, ApexPart, Neighbour, Role};
+use super::state::{AngleState, ApexPart, Neighbour, Side};
 use super::{Agent, BearingMeasurement, Fault, MeasurementError, Measurements};
 use crate::config::{AgentId, EstimatorMode};
 use crate::{law, Real, Vec2};
@@ -30,11 +30,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             return Err(Fault::Measurement(MeasurementError::NonFinite));
         }
         // The checks read nothing that aging changes: age after them.
-        let checked = self.check_measurements(m);
-        for a in self.angles.as_mut_slice().as_flattened_mut() {
-            a.remote_age += dt;
-        }
-        let in_order = match checked {
+        let in_order = match self.check_measurements(m) {
             Ok(in_order) => in_order,
             Err(e) => {
                 for n in self.neighbours.iter_mut() {
@@ -43,12 +39,14 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 }
                 let fault = Fault::Measurement(e);
                 for a in self.angles.as_mut_slice().as_flattened_mut() {
-                    a.fault = Some(fault);
+                    match &mut a.side {
+                        Side::Apex { fault: f, .. } => *f = Some(fault),
+                        Side::Far { age, .. } => *age += dt,
+                    }
                 }
                 return Err(fault);
             }
         };
-        let v_prev = self.velocity;
         self.time = m.time;
         self.velocity = m.velocity;
         self.partner_offset = m.partner_offset;
@@ -74,22 +72,20 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         let (mode, v) = (self.config.estimator, self.velocity);
         let nbs = self.neighbours.as_slice();
         for a in self.angles.as_mut_slice().as_flattened_mut() {
-            if a.role == Role::Apex {
-                match apex_part(nbs, mode, a, &v) {
+            let computed = match a.side {
+                Side::Apex { .. } => Some(apex_part(nbs, mode, a, &v)),
+                Side::Far { .. } => None,
+            };
+            match (&mut a.side, computed) {
+                (Side::Apex { part, fault }, Some(result)) => match result {
                     Ok(p) => {
-                        a.part = p;
-                        a.fault = None;
+                        *part = p;
+                        *fault = None;
                     }
-                    Err(f) => a.fault = Some(f),
-                }
-            } else if let Some(Some(v_apex)) = nbs.get(a.slots[0]).map(|n| n.velocity) {
-                // Own motion relative to the apex since it measured, taken as the previous
-                // tick (the apex's velocity is the one it sent with it).
-                let r = &mut a.remote;
-                r.delta += (v_prev - v_apex) * dt;
-                if r.v_ref.is_none() {
-                    r.v_ref = Some(v_prev);
-                }
+                    Err(f) => *fault = Some(f),
+                },
+                (Side::Far { age, .. }, _) => *age += dt,
+                (Side::Apex { .. }, None) => {}
             }
         }
         Ok(())
@@ -99,13 +95,12 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// for every `i` (the usual case, what the firmware sends).
     fn check_measurements(&self, m: &Measurements<'_, T>) -> Result<bool, MeasurementError> {
         let v = &m.velocity;
-        if !(finite(m.time) && finite(v.x) && finite(v.y)) {
+        // `x − x` is 0 for finite `x`, NaN otherwise: one comparison for the sum.
+        let p = m.partner_offset.unwrap_or_default();
+        #[allow(clippy::eq_op)]
+        let all = (m.time - m.time) + (v.x - v.x) + (v.y - v.y) + (p.x - p.x) + (p.y - p.y);
+        if all != T::zero() {
             return Err(MeasurementError::NonFinite);
-        }
-        if let Some(p) = &m.partner_offset {
-            if !(finite(p.x) && finite(p.y)) {
-                return Err(MeasurementError::NonFinite);
-            }
         }
         let tol = self.config.limits.bearing_tolerance;
         // Bearing i to slot i: known and distinct without searching (neighbour ids are
@@ -162,13 +157,20 @@ fn apex_part<T: Real, const MT: usize>(
     a: &AngleState<T>,
     v: &Vec2<T>,
 ) -> Result<ApexPart<T>, Fault> {
-    let nv = nbs.get(a.slots[1]).ok_or(Fault::Internal)?;
-    let nw = nbs.get(a.slots[2]).ok_or(Fault::Internal)?;
-    let ((s_v, d_v), (s_w, d_w)) = (nv.bearing()?, nw.bearing()?);
-    let r = match mode {
-        EstimatorMode::Measured => [nv.range()?, nw.range()?],
-        EstimatorMode::Shared | EstimatorMode::PerAgent => a.estimate,
+    let (Some(nv), Some(nw)) = (nbs.get(a.slots[1]), nbs.get(a.slots[2])) else {
+        return Err(Fault::Internal);
     };
+    if !(nv.fresh && nw.fresh) {
+        let missing = if nv.fresh { nw.id } else { nv.id };
+        return Err(Fault::MissingBearing(missing));
+    }
+    let r = match (mode, nv.range, nw.range) {
+        (EstimatorMode::Measured, Some(rv), Some(rw)) => [rv, rw],
+        (EstimatorMode::Measured, None, _) => return Err(Fault::MissingRange(nv.id)),
+        (EstimatorMode::Measured, _, None) => return Err(Fault::MissingRange(nw.id)),
+        (EstimatorMode::Shared | EstimatorMode::PerAgent, ..) => a.estimate,
+    };
+    let (s_v, d_v, s_w, d_w) = (nv.s, nv.rate, nw.s, nw.rate);
     let k = law::apex_angle(
         &[s_v, s_w],
         &[d_v, d_w],
@@ -209,7 +211,11 @@ fn bearing_error<T: Real>(b: &BearingMeasurement<T>, tol: T) -> Option<Measureme
     // no separate finiteness check.
     let s = &b.bearing;
     let unit = (s.dot(s) - T::one()).abs() <= tol;
-    let rate_ok = b.rate.as_ref().is_none_or(|r| finite(r.x) && finite(r.y));
+    #[allow(clippy::eq_op)]
+    let rate_ok = b
+        .rate
+        .as_ref()
+        .is_none_or(|r| (r.x - r.x) + (r.y - r.y) == T::zero());
     if !unit || !rate_ok {
         return Some(MeasurementError::BadBearing(b.neighbour));
     }

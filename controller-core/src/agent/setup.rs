@@ -1,12 +1,11 @@
 //! Building an [`Agent`] from its configuration: the checks of SPEC §3 and of every
 //! parameter, the angle states and the neighbour table.
 
-use super::state::{AngleState, ApexPart, Neighbour, Remote, Role, SELF_SLOT};
+use super::state::{AngleState, ApexPart, Neighbour, Remote, Side, SELF_SLOT};
 use super::{Agent, Fault};
 use crate::config::{AgentConfig, AgentId, ConfigError, EstimatorMode, Limits, TriangleConfig};
 use crate::wire::{quant, FrameWriter};
 use crate::{FrameStats, Real, Vec2};
-use core::cell::Cell;
 
 fn finite_pair<T: Real>(v: &[T; 2], min: T) -> bool {
     v[0].finite() && v[1].finite() && v[0] >= min && v[1] >= min
@@ -34,12 +33,17 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                         k += 1;
                     }
                 }
-                let role = if a.apex == me {
-                    Role::Apex
-                } else if far[0] == me {
-                    Role::Far(0)
+                let side = if a.apex == me {
+                    Side::Apex {
+                        part: ApexPart::default(),
+                        fault: Some(Fault::MissingBearing(far[0])),
+                    }
                 } else {
-                    Role::Far(1)
+                    Side::Far {
+                        k: usize::from(far[0] != me),
+                        remote: Remote::default(),
+                        age: T::lit(f64::INFINITY),
+                    }
                 };
                 let mut slots = [SELF_SLOT; 3];
                 for (slot, id) in slots.iter_mut().zip([a.apex, far[0], far[1]]) {
@@ -48,7 +52,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     }
                 }
                 // A far vertex takes this angle's items from its apex (`comm::receive`).
-                if let (Role::Far(_), Some(n)) = (role, neighbours.get_mut(slots[0])) {
+                if let (Side::Far { .. }, Some(n)) = (&side, neighbours.get_mut(slots[0])) {
                     let flat =
                         u16::try_from(2 * ti + ai).map_err(|_| ConfigError::TooManyTriangles)?;
                     // At most one controlled angle per triangle has this apex: ≤ MT entries.
@@ -59,18 +63,14 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 *out = Some(AngleState {
                     apex: a.apex,
                     far,
-                    role,
+                    side,
                     slots,
                     cos_desired: a.cos_desired,
                     stiffness: a.stiffness,
                     damping: a.damping,
                     estimator_gain: a.estimator_gain,
                     estimate: [config.initial_estimate; 2],
-                    rate: Cell::new([T::zero(); 2]),
-                    part: ApexPart::default(),
-                    fault: Some(Fault::MissingBearing(far[0])),
-                    remote: Remote::default(),
-                    remote_age: T::lit(f64::INFINITY),
+                    flow: [T::zero(); 2],
                 });
             }
             if let [Some(a0), Some(a1)] = pair {

@@ -4,18 +4,30 @@
 use super::Fault;
 use crate::config::AgentId;
 use crate::{Real, Vec2};
-use core::cell::Cell;
 
 /// No neighbour slot (the vertex is this agent itself).
 pub(super) const SELF_SLOT: usize = usize::MAX;
 
-/// This agent's place in a controlled angle.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Role {
-    /// The apex `u`: measures both bearings, computes the angle (S4–S8), owns the estimates.
-    Apex,
-    /// Far vertex `far[k]`: receives the apex's effort for its edge.
-    Far(usize),
+/// This agent's place in a controlled angle, with what it keeps for that place.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Side<T: Real> {
+    /// The apex `u`: measures both bearings, computes the angle (S4–S8), owns the
+    /// estimates.
+    Apex {
+        /// The result of the last sense (valid when `fault` is `None`).
+        part: ApexPart<T>,
+        /// Why the last sense could not compute the angle.
+        fault: Option<Fault>,
+    },
+    /// Far vertex `far[k]`: receives what the apex sends of the angle.
+    Far {
+        /// Which far vertex (0 or 1).
+        k: usize,
+        /// What the apex last sent.
+        remote: Remote<T>,
+        /// Seconds since it arrived (`∞` before the first).
+        age: T,
+    },
 }
 
 /// What the apex of an angle computed from its own measurements at the last sense
@@ -37,7 +49,7 @@ pub(super) struct ApexPart<T: Real> {
     pub rho: [T; 2],
 }
 
-/// What a far vertex last received of an angle from its apex, and its own motion since.
+/// What a far vertex last received of an angle from its apex.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Remote<T: Real> {
     /// `γ_α` (S7) as the apex computed it.
@@ -46,19 +58,17 @@ pub(super) struct Remote<T: Real> {
     pub sigma: T,
     /// The apex's distance to this agent (`ρ_k`).
     pub rho: T,
-    /// Own displacement relative to the apex since the apex measured.
-    pub delta: Vec2<T>,
-    /// Own velocity when the apex measured (`None` until the first sense after receipt:
-    /// then no correction).
-    pub v_ref: Option<Vec2<T>>,
+    /// Own velocity when it arrived (the last one sensed before: about when the apex
+    /// measured).
+    pub v_ref: Vec2<T>,
 }
 
 /// One controlled angle `α = (apex; far[0], far[1])` this agent belongs to.
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug)]
 pub(super) struct AngleState<T: Real> {
     pub apex: AgentId,
     pub far: [AgentId; 2],
-    pub role: Role,
+    pub side: Side<T>,
     /// Neighbour slots of `[apex, far0, far1]` (`SELF_SLOT` for this agent).
     pub slots: [usize; 3],
     pub cos_desired: T,
@@ -67,18 +77,9 @@ pub(super) struct AngleState<T: Real> {
     pub estimator_gain: T,
     /// Own estimates for edges `[apex–far0, apex–far1]` (only the owned ones are used).
     pub estimate: [T; 2],
-    /// The S9 flows (with the S10 projection) of `estimate` found by the last evaluation
-    /// of the law (zero where not owned): written by the read-only law, read by the
-    /// integration that follows it.
-    pub rate: Cell<[T; 2]>,
-    /// Apex: the result of the last sense (valid when `fault` is `None`).
-    pub part: ApexPart<T>,
-    /// Apex: why the last sense could not compute the angle.
-    pub fault: Option<Fault>,
-    /// Far vertex: what the apex last sent of this angle.
-    pub remote: Remote<T>,
-    /// Far vertex: seconds since it arrived (`∞` before the first).
-    pub remote_age: T,
+    /// Scratch of the law: the S9 flows of `estimate` ([`crate::Agent::evaluate`]), or the
+    /// estimates before the step's integration ([`crate::Agent::step`], to roll back).
+    pub flow: [T; 2],
 }
 
 /// One neighbour: a triangle neighbour or the leader partner.
