@@ -102,8 +102,10 @@ impl<T: Real> Schedule<T> {
     /// The value at time `t`.
     pub fn at(&self, t: T) -> [T; 2] {
         // The last step (in order) that has started, else the first.
-        let Some((first, rest)) = self.steps.split_first() else {
-            return [T::zero(); 2];
+        let (first, rest) = match self.steps.as_slice() {
+            [] => return [T::zero(); 2],
+            [only] => return only.value,
+            [first, rest @ ..] => (first, rest),
         };
         let mut value = first.value;
         for s in rest {

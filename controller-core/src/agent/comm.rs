@@ -98,6 +98,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             n.last_seq = Some(seq);
             n.age = T::zero();
         }
+        self.oldest = None;
         let [vx, vy] = frame.velocity;
         self.apply(
             slot,
@@ -129,6 +130,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         if let Some(n) = self.neighbours.get_mut(slot) {
             n.age = T::zero();
         }
+        self.oldest = None;
         self.apply(slot, Item::Velocity(from.velocity));
         for a in from.angles.iter().flatten() {
             if let Some((gamma, sigma, rho)) = sent_angle(a) {

@@ -157,7 +157,10 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     force += p.force;
                     if mode != EstimatorMode::Measured {
                         let (nv, nw) = (nb(a.slots[1])?, nb(a.slots[2])?);
-                        let (vv, vw) = (nv.velocity()?, nw.velocity()?);
+                        let (Some(vv), Some(vw)) = (nv.velocity, nw.velocity) else {
+                            let missing = if nv.velocity.is_none() { nv.id } else { nw.id };
+                            return Err(Fault::MissingData(missing));
+                        };
                         let gain = a.estimator_gain;
                         // S3 with the own bearings s_uv, s_uw and the far vertices' velocities.
                         let rr = [

@@ -52,6 +52,9 @@ pub struct Agent<T: Real, const MT: usize, const NB: usize> {
     velocity: Vec2<T>,
     partner_offset: Option<Vec2<T>>,
     seq: u16,
+    /// The largest neighbour age when last sensed (`None` after a frame arrived since, or
+    /// when it is NaN): lets [`Agent::check_fresh`] skip its loop.
+    oldest: Option<T>,
     /// Steps until the next broadcast (0: the last step broadcasts).
     comm_countdown: u16,
     /// [`Agent::frames`] broadcasts after the last step.
@@ -105,6 +108,12 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// Checks that every neighbour has been heard recently (or reports the stale one).
     fn check_fresh(&self) -> Result<(), Fault> {
         let timeout = self.config.limits.neighbour_timeout;
+        // The oldest age found when sensing, if no frame arrived since: one comparison.
+        if let Some(oldest) = self.oldest {
+            if within(oldest, timeout) {
+                return Ok(());
+            }
+        }
         for n in &self.neighbours {
             // Never heard: `age` is ∞.
             if !within(n.age, timeout) {

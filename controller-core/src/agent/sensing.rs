@@ -50,11 +50,16 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         self.time = m.time;
         self.velocity = m.velocity;
         self.partner_offset = m.partner_offset;
+        // The oldest neighbour (ages are never NaN: ∞ + a finite dt ≥ 0, or 0 when heard).
+        let mut oldest = T::zero();
         if in_order {
             // Bearing i is to slot i: one pass.
             let mut bearings = m.bearings.iter();
             for n in self.neighbours.iter_mut() {
                 n.age += dt;
+                if n.age > oldest {
+                    oldest = n.age;
+                }
                 match bearings.next() {
                     Some(b) => take_bearing(n, b, dt),
                     None => no_bearing(n, dt),
@@ -63,12 +68,16 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         } else {
             for n in self.neighbours.iter_mut() {
                 n.age += dt;
+                if n.age > oldest {
+                    oldest = n.age;
+                }
                 match bearing_to(m.bearings, n.id) {
                     Some(b) => take_bearing(n, b, dt),
                     None => no_bearing(n, dt),
                 }
             }
         }
+        self.oldest = Some(oldest);
         let (mode, v) = (self.config.estimator, self.velocity);
         let nbs = self.neighbours.as_slice();
         for a in self.angles.as_mut_slice().as_flattened_mut() {

@@ -100,6 +100,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             velocity: Vec2::zeros(),
             partner_offset: None,
             seq: 0,
+            oldest: None,
             comm_countdown,
             comm_due: true,
             writer,
