@@ -3,9 +3,9 @@
 //! layout is [`crate::wire`]'s.
 
 use super::state::{AngleState, Remote, Side};
-use super::{pick, Agent};
+use super::Agent;
 use crate::config::AgentId;
-use crate::wire::{check_frame, mode_byte, quant, FrameError, RawAngle};
+use crate::wire::{check_mode, quant, FrameError, RawAngle};
 use crate::{Real, Vec2};
 
 /// A broadcast item at full precision (the wire rounds the angle's values to binary16).
@@ -33,10 +33,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         if !self.comm_due {
             return 0;
         }
-        let (id, mode) = (
-            self.config.id,
-            mode_byte(self.config.integrity, self.config.estimator),
-        );
+        let (id, mode) = (self.config.id, self.mode);
         let velocity = [self.velocity.x.as_f32(), self.velocity.y.as_f32()];
         let mut seq = self.seq;
         let mut count = 0;
@@ -66,12 +63,15 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// counters. A neighbour that was stale may restart its sequence numbers.
     pub fn receive(&mut self, bytes: &[u8]) -> Result<(), FrameError> {
         let result = self.receive_inner(bytes);
-        self.stats.record(&result);
+        match result {
+            Ok(()) => self.stats.accepted = self.stats.accepted.saturating_add(1),
+            Err(_) => self.stats.record(&result),
+        }
         result
     }
 
     fn receive_inner(&mut self, bytes: &[u8]) -> Result<(), FrameError> {
-        let frame = check_frame(bytes, self.config.integrity, self.config.estimator)?;
+        let frame = check_mode(bytes, self.config.integrity, self.mode)?;
         let sender = frame.header.sender;
         if sender == self.config.id {
             return Err(FrameError::OwnFrame);
@@ -106,17 +106,14 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         );
         let me = self.config.id;
         for RawAngle { far, codes } in frame.raw_items() {
-            // Only the items for angles of which this agent is a far vertex (`apply`
-            // checks it again; this saves decoding the others). Validated: finite.
-            if far.contains(&me) {
-                let v = |c: u16| T::of_f32(quant::from_code(c));
-                let item = Item::Angle {
-                    far,
-                    gamma: v(codes[0]),
-                    sigma: v(codes[1]),
-                    rho: [v(codes[2]), v(codes[3])],
-                };
-                self.apply(slot, item);
+            // Only the items for angles of which this agent is a far vertex. Validated:
+            // finite.
+            let v = |c: u16| T::of_f32(quant::from_code(c));
+            let [g, s, r0, r1] = codes;
+            if far[0] == me {
+                self.apply_angle(slot, far[1], v(g), v(s), v(r0));
+            } else if far[1] == me {
+                self.apply_angle(slot, far[0], v(g), v(s), v(r1));
             }
         }
         Ok(())
@@ -164,41 +161,44 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 sigma,
                 rho,
             } => {
-                let (me, velocity) = (self.config.id, self.velocity);
-                let mine = if far[0] == me {
-                    0
+                let me = self.config.id;
+                if far[0] == me {
+                    self.apply_angle(slot, far[1], gamma, sigma, rho[0]);
                 } else if far[1] == me {
-                    1
-                } else {
-                    return;
-                };
-                let other = pick(&far, 1 - mine);
-                let Some(n) = self.neighbours.get(slot) else {
-                    return;
-                };
-                // The angles whose apex is the sender and of which this agent is a far
-                // vertex (at most one per triangle), matched by the other far vertex.
-                for &flat in &n.apex_of {
-                    let flat = usize::from(flat);
-                    let Some(a) = self
-                        .angles
-                        .get_mut(flat / 2)
-                        .and_then(|t| t.get_mut(flat % 2))
-                    else {
-                        continue;
-                    };
-                    if let Side::Far { k, remote, age } = &mut a.side {
-                        if pick(&a.far, 1 - *k) == other && pick(&a.far, *k) == me {
-                            *remote = Remote {
-                                gamma,
-                                sigma,
-                                rho: pick(&rho, mine),
-                                v_ref: velocity,
-                            };
-                            *age = T::zero();
-                        }
-                    }
+                    self.apply_angle(slot, far[0], gamma, sigma, rho[1]);
                 }
+            }
+        }
+    }
+
+    /// Stores what the apex in neighbour `slot` sent of its angle `(apex; me, other)`:
+    /// `γ`, `σ` and its distance to this agent `ρ`.
+    #[inline]
+    fn apply_angle(&mut self, slot: usize, other: AgentId, gamma: T, sigma: T, rho: T) {
+        let Some(n) = self.neighbours.get(slot) else {
+            return;
+        };
+        let v_ref = self.velocity;
+        // At most one angle per triangle has this apex and this agent as a far vertex;
+        // the other far vertex tells them apart.
+        for e in n.apex_of.iter().filter(|e| e.other == other) {
+            let flat = usize::from(e.flat);
+            let a = self
+                .angles
+                .get_mut(flat / 2)
+                .and_then(|t| t.get_mut(flat % 2));
+            if let Some(AngleState {
+                side: Side::Far { remote, age, .. },
+                ..
+            }) = a
+            {
+                *remote = Remote {
+                    gamma,
+                    sigma,
+                    rho,
+                    v_ref,
+                };
+                *age = T::zero();
             }
         }
     }

@@ -64,6 +64,8 @@ pub struct Agent<T: Real, const MT: usize, const NB: usize> {
     /// Smallest binary16 code of a received distance: `r_min` as rounded (estimator
     /// modes), or the smallest positive value (measured ranges).
     rho_min_code: u16,
+    /// The mode byte of this agent's frames (and of the frames it accepts).
+    mode: u8,
     stats: FrameStats,
 }
 

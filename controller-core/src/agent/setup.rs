@@ -1,10 +1,10 @@
 //! Building an [`Agent`] from its configuration: the checks of SPEC §3 and of every
 //! parameter, the angle states and the neighbour table.
 
-use super::state::{AngleState, ApexPart, Neighbour, Remote, Side, SELF_SLOT};
+use super::state::{AngleState, ApexOf, ApexPart, Neighbour, Remote, Side, SELF_SLOT};
 use super::{Agent, Fault};
 use crate::config::{AgentConfig, AgentId, ConfigError, EstimatorMode, Limits, TriangleConfig};
-use crate::wire::{quant, FrameWriter};
+use crate::wire::{mode_byte, quant, FrameWriter};
 use crate::{FrameStats, Real, Vec2};
 
 fn finite_pair<T: Real>(v: &[T; 2], min: T) -> bool {
@@ -52,12 +52,13 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     }
                 }
                 // A far vertex takes this angle's items from its apex (`comm::receive`).
-                if let (Side::Far { .. }, Some(n)) = (&side, neighbours.get_mut(slots[0])) {
+                if let (Side::Far { k, .. }, Some(n)) = (&side, neighbours.get_mut(slots[0])) {
                     let flat =
                         u16::try_from(2 * ti + ai).map_err(|_| ConfigError::TooManyTriangles)?;
+                    let other = if *k == 0 { far[1] } else { far[0] };
                     // At most one controlled angle per triangle has this apex: ≤ MT entries.
                     n.apex_of
-                        .push(flat)
+                        .push(ApexOf { other, flat })
                         .map_err(|_| ConfigError::TooManyTriangles)?;
                 }
                 *out = Some(AngleState {
@@ -84,6 +85,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             None => SELF_SLOT,
         };
         let writer = FrameWriter::new(config.integrity);
+        let mode = mode_byte(config.integrity, config.estimator);
         let rho_min_code = match config.estimator {
             EstimatorMode::Measured => 1,
             EstimatorMode::Shared | EstimatorMode::PerAgent => {
@@ -105,6 +107,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             comm_due: true,
             writer,
             rho_min_code,
+            mode,
             stats: FrameStats::default(),
         })
     }

@@ -82,13 +82,22 @@ pub(super) struct AngleState<T: Real> {
     pub flow: [T; 2],
 }
 
+/// An angle of which a neighbour is the apex and this agent a far vertex.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct ApexOf {
+    /// The angle's other far vertex (how the neighbour's items name it, with this agent).
+    pub other: AgentId,
+    /// Flat index `2·triangle + angle` of the angle.
+    pub flat: u16,
+}
+
 /// One neighbour: a triangle neighbour or the leader partner.
 #[derive(Clone, Debug)]
 pub(super) struct Neighbour<T: Real, const MT: usize> {
     pub id: AgentId,
-    /// Angles (flat index `2·triangle + angle`) whose apex is this neighbour and of which
-    /// this agent is a far vertex: where its angle items go.
-    pub apex_of: heapless::Vec<u16, MT>,
+    /// The angles whose apex is this neighbour and of which this agent is a far vertex:
+    /// where its angle items go.
+    pub apex_of: heapless::Vec<ApexOf, MT>,
     /// Seconds since a frame was last accepted from it (`∞` before the first).
     pub age: T,
     pub last_seq: Option<u16>,

@@ -45,7 +45,7 @@ mod reader;
 mod writer;
 
 pub use cobs::{cobs_decode, cobs_encode, CobsAccumulator, MAX_COBS_LEN};
-pub(crate) use reader::RawAngle;
+pub(crate) use reader::{check_mode, RawAngle};
 pub use reader::{check_frame, decode_frame, AngleItem, Frame, FrameView};
 pub use writer::FrameWriter;
 

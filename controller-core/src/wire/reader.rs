@@ -147,6 +147,16 @@ pub fn check_frame(
     integrity: Integrity,
     estimator: EstimatorMode,
 ) -> Result<FrameView<'_>, FrameError> {
+    check_mode(bytes, integrity, mode_byte(integrity, estimator))
+}
+
+/// [`check_frame`] against the receiver's mode byte (see [`super::mode_byte`]).
+#[inline]
+pub(crate) fn check_mode(
+    bytes: &[u8],
+    integrity: Integrity,
+    expected_mode: u8,
+) -> Result<FrameView<'_>, FrameError> {
     if bytes.len() > MAX_FRAME_LEN {
         return Err(FrameError::TooLong);
     }
@@ -165,7 +175,7 @@ pub fn check_frame(
     if mode >> 4 != WIRE_VERSION {
         return Err(FrameError::UnknownVersion(mode >> 4));
     }
-    if mode != mode_byte(integrity, estimator) {
+    if mode != expected_mode {
         return Err(FrameError::ModeMismatch(mode));
     }
     let (items, rest) = items.as_chunks::<ANGLE_ITEM_LEN>();
