@@ -55,18 +55,20 @@ fn the_worst_case_rounding_error_is_the_documented_bound() {
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(20_000))]
 
-    /// Any finite `f32`: saturates beyond ±65504 (flagged, never ∞, never wrapped:
-    /// the sign is kept), otherwise within the documented error.
+    /// Any finite `f32`: saturates when it does not round into ±65504 (|x| ≥ 65520;
+    /// flagged, never ∞, never wrapped: the sign is kept), otherwise within the
+    /// documented error.
     #[test]
     fn any_value_rounds_within_the_bound_or_saturates(x in any::<f32>().prop_filter("not NaN", |x| !x.is_nan())) {
         let (code, saturated) = encode(x);
         let y = decode(code).expect("never infinity or NaN");
-        if x.abs() > MAX {
+        if x.abs() >= 65520.0 {
             prop_assert!(saturated);
             prop_assert_eq!(y, MAX.copysign(x));
         } else {
             prop_assert!(!saturated);
             let err = f64::from((y - x).abs());
+            prop_assert!(y.abs() <= MAX);
             let bound = if x.abs() >= MIN_NORMAL {
                 f64::from(REL_ERROR) * f64::from(x.abs())
             } else {
@@ -83,4 +85,15 @@ proptest! {
         let y = decode(encode(x).0).expect("finite");
         prop_assert!(f64::from((y - x).abs()) <= f64::from(REL_ERROR) * f64::from(x.abs()) + f64::from(ABS_ERROR));
     }
+}
+
+/// The edges of the saturation: 65504 is exact; up to 65519.99 rounds down to it; from
+/// 65520 (the midpoint to the next power of two) it saturates.
+#[test]
+fn saturation_edges() {
+    assert_eq!(encode(65504.0), (0x7BFF, false));
+    assert_eq!(encode(65519.99), (0x7BFF, false));
+    assert_eq!(encode(65520.0), (0x7BFF, true));
+    assert_eq!(encode(-1.0e30), (0xFBFF, true));
+    assert_eq!(encode(f32::INFINITY), (0x7BFF, true));
 }

@@ -39,7 +39,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         let mut count = 0;
         let (writer, angles) = (&mut self.writer, &self.angles);
         writer.start(mode, id, seq, velocity);
-        for a in angles.iter().flatten() {
+        for a in angles.as_slice().as_flattened() {
             let Some((gamma, sigma, rho)) = sent_angle(a) else {
                 continue;
             };

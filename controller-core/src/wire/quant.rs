@@ -2,9 +2,10 @@
 //!
 //! Range and worst-case error (checked over every one of the 65,536 codes and on random
 //! `f32` inputs in `tests/wire_quant.rs`):
-//! - finite codes cover `[−65504, 65504]`; an input beyond that range saturates to
-//!   `±65504` (never to infinity, never wraps), and [`encode`] says so;
-//! - rounding is to nearest (ties to even): for `2⁻¹⁴ ≤ |x| ≤ 65504` the error is at most
+//! - finite codes cover `[−65504, 65504]`; an input that does not round into that range
+//!   (`|x| ≥ 65520`) saturates to `±65504` (never to infinity, never wraps), and
+//!   [`encode`] says so;
+//! - rounding is to nearest (ties to even): for `2⁻¹⁴ ≤ |x| < 65520` the error is at most
 //!   `2⁻¹¹ |x|` (relative `4.9·10⁻⁴`); below `2⁻¹⁴` (subnormals) at most `2⁻²⁵` absolute
 //!   (`3.0·10⁻⁸`);
 //! - zero, the sign and every code round-trip exactly (`decode(encode(decode(c))) = c`);
@@ -28,15 +29,22 @@ pub const ABS_ERROR: f32 = 1.0 / 33_554_432.0;
 /// Smallest positive normal binary16 value (`2⁻¹⁴`).
 pub const MIN_NORMAL: f32 = 1.0 / 16384.0;
 
-/// The binary16 code of `x`, saturated to `±MAX`, and whether it saturated. `x` must not
-/// be NaN (the caller sends only finite values; a NaN would give a NaN code, which
-/// receivers refuse).
+/// The binary16 code of `x` (rounded to nearest), saturated to `±MAX` when it does not
+/// round to a finite binary16 value (`|x| ≥ 65520`), and whether it saturated. `x` must
+/// not be NaN (the caller sends only finite values; a NaN would saturate).
 #[inline]
 pub fn encode(x: f32) -> (u16, bool) {
-    let saturated = x.abs() > MAX;
-    let clamped = if saturated { MAX.copysign(x) } else { x };
-    (to_code(clamped), saturated)
+    let code = to_code(x);
+    // Exponent all ones: the rounding overflowed to ±∞. Keep the sign, take ±MAX.
+    if code & 0x7C00 == 0x7C00 {
+        ((code & 0x8000) | MAX_CODE, true)
+    } else {
+        (code, false)
+    }
 }
+
+/// The code of [`MAX`].
+const MAX_CODE: u16 = 0x7BFF;
 
 /// The value of a binary16 code; `None` for infinity and NaN.
 #[inline]

@@ -61,10 +61,13 @@ impl FrameWriter {
         let [s0, s1] = codes[1].to_le_bytes();
         let [a0, a1] = codes[2].to_le_bytes();
         let [b0, b1] = codes[3].to_le_bytes();
-        let item = [far[0], far[1], g0, g1, s0, s1, a0, a1, b0, b1];
-        match self.buf.get_mut(self.len..end) {
+        let slot = self
+            .buf
+            .get_mut(self.len..)
+            .and_then(|b| b.first_chunk_mut::<ANGLE_ITEM_LEN>());
+        match slot {
             Some(d) => {
-                d.copy_from_slice(&item);
+                *d = [far[0], far[1], g0, g1, s0, s1, a0, a1, b0, b1];
                 self.len = end;
                 true
             }
