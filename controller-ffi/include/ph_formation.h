@@ -76,14 +76,14 @@
 /**
  * Bytes of agent memory (`sizeof` the agent, for 32-bit targets such as Cortex-M).
  */
-#define PH_AGENT_SIZE 3752
+#define PH_AGENT_SIZE 3248
 #endif
 
 #if defined(PH_PTR64)
 /**
  * Bytes of agent memory (`sizeof` the agent, for 64-bit hosts).
  */
-#define PH_AGENT_SIZE 4208
+#define PH_AGENT_SIZE 3640
 #endif
 
 #if defined(PH_PTR32)

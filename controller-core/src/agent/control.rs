@@ -96,7 +96,13 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             // Roll back the angles the pass integrated (their `flow` holds the estimates
             // from before; the others are untouched).
             let mode = self.config.estimator;
-            for a in self.angles.as_mut_slice().as_flattened_mut().iter_mut().take(done) {
+            for a in self
+                .angles
+                .as_mut_slice()
+                .as_flattened_mut()
+                .iter_mut()
+                .take(done)
+            {
                 for e in 0..2 {
                     if owns(mode, a, e) {
                         if let (Some(est), Some(before)) = (a.estimate.get_mut(e), a.flow.get(e)) {

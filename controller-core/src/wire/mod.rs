@@ -45,8 +45,8 @@ mod reader;
 mod writer;
 
 pub use cobs::{cobs_decode, cobs_encode, CobsAccumulator, MAX_COBS_LEN};
-pub(crate) use reader::{check_mode, RawAngle};
 pub use reader::{check_frame, decode_frame, AngleItem, Frame, FrameView};
+pub(crate) use reader::{check_mode, RawAngle};
 pub use writer::FrameWriter;
 
 use crate::config::EstimatorMode;
