@@ -50,10 +50,10 @@
 #define PH_MAX_FRAME_LEN 60
 
 /**
- * Most frames one `ph_frames` call produces: the velocity frame plus one per
- * controlled angle this agent is the apex of (at most two per triangle).
+ * Most frames one `ph_frames` call produces: an agent is the apex of at most one
+ * controlled angle per triangle, and a frame holds four (wire v3, every integrity mode).
  */
-#define PH_MAX_FRAMES_PER_TICK (1 + (2 * PH_MAX_TRIANGLES))
+#define PH_MAX_FRAMES_PER_TICK ((PH_MAX_TRIANGLES + 3) / 4)
 
 /**
  * Most estimates one agent owns (two edges of two angles per triangle).

@@ -66,9 +66,9 @@ pub const PH_MAX_SCHEDULE_STEPS: usize = 8;
 /// Largest frame, in bytes (the Crazyflie P2P payload); also the stride of the frame
 /// buffer of `ph_frames`.
 pub const PH_MAX_FRAME_LEN: usize = 60;
-/// Most frames one `ph_frames` call produces: the velocity frame plus one per
-/// controlled angle this agent is the apex of (at most two per triangle).
-pub const PH_MAX_FRAMES_PER_TICK: usize = 1 + 2 * PH_MAX_TRIANGLES;
+/// Most frames one `ph_frames` call produces: an agent is the apex of at most one
+/// controlled angle per triangle, and a frame holds four (wire v3, every integrity mode).
+pub const PH_MAX_FRAMES_PER_TICK: usize = (PH_MAX_TRIANGLES + 3) / 4;
 /// Most estimates one agent owns (two edges of two angles per triangle).
 pub const PH_MAX_OWNED_ESTIMATES: usize = 4 * PH_MAX_TRIANGLES;
 /// Version of this C ABI (the header's structs and functions). Compare the header's
@@ -80,7 +80,13 @@ pub type FfiAgent = controller_core::Agent<f32, PH_MAX_TRIANGLES, PH_MAX_NEIGHBO
 /// Its configuration.
 pub type FfiConfig = controller_core::AgentConfig<f32, PH_MAX_TRIANGLES>;
 
-// The header's constants must be the core's.
+// The header's constants must be the core's (cbindgen needs literals).
+const _: () = assert!(PH_MAX_TRIANGLES == controller_core::MAX_TRIANGLES);
+const _: () = assert!(PH_MAX_NEIGHBOURS == controller_core::MAX_NEIGHBOURS);
+const _: () = assert!(
+    PH_MAX_FRAMES_PER_TICK
+        == PH_MAX_TRIANGLES.div_ceil(controller_core::wire::Integrity::Crc16.max_angles())
+);
 const _: () = assert!(PH_MAX_SCHEDULE_STEPS == controller_core::MAX_SCHEDULE_STEPS);
 const _: () = assert!(PH_MAX_FRAME_LEN == controller_core::MAX_FRAME_LEN);
 const _: () = assert!(PH_MAX_NEIGHBOURS <= u8::MAX as usize + 1);
