@@ -1,14 +1,19 @@
-//! Feeds arbitrary bytes to an agent as radio frames and as measurements, interleaved.
-//! Invariants: no panic; the force is always finite and within `max_force`; every
-//! outgoing frame is at most 60 bytes.
+//! Feeds arbitrary bytes to agents as radio frames and as measurements, interleaved: one
+//! agent with `crc16` integrity (the frame's CRC is sometimes made valid, so that the
+//! fuzzer reaches past it) and one with `link` integrity (no CRC: every byte reaches the
+//! decoder). Invariants: no panic; a frame the agent accepts is one `decode_frame`
+//! accepts; the force is always finite and within `max_force`; every outgoing frame is at
+//! most 60 bytes and decodes.
 #![no_main]
 
+use controller_core::wire::{decode_frame, Integrity};
 use controller_core::{
-    Agent, AgentConfig, AngleConfig, BearingMeasurement, Measurements, TriangleConfig, Vec2,
+    Agent, AgentConfig, AngleConfig, BearingMeasurement, EstimatorMode, Measurements,
+    TriangleConfig, Vec2,
 };
 use libfuzzer_sys::fuzz_target;
 
-fn agent() -> Agent<f32, 2, 4> {
+fn agent(integrity: Integrity) -> Agent<f32, 2, 4> {
     let angle = |apex, cos| AngleConfig {
         apex,
         cos_desired: cos,
@@ -17,6 +22,7 @@ fn agent() -> Agent<f32, 2, 4> {
         estimator_gain: 10.0,
     };
     let mut c = AgentConfig::<f32, 2>::new(3);
+    c.integrity = integrity;
     let _ = c.triangles.push(TriangleConfig {
         vertices: [1, 2, 3],
         angles: [angle(1, 0.0), angle(3, 0.707)],
@@ -39,16 +45,19 @@ fn f32_at(data: &[u8], i: usize) -> f32 {
     f32::from_le_bytes(b)
 }
 
+fn crc16(body: &[u8]) -> [u8; 2] {
+    controller_core::crc16::checksum(body).to_le_bytes()
+}
+
 fuzz_target!(|data: &[u8]| {
-    let mut a = agent();
-    let limit = a.config().limits.max_force;
-    // Chunks: first byte = length L (≤ 63) of a frame that follows, then 40 bytes of
-    // measurement floats.
+    let mut agents = [(agent(Integrity::Crc16), Integrity::Crc16), (agent(Integrity::Link), Integrity::Link)];
+    let limit = agents[0].0.config().limits.max_force;
+    // Chunks: one byte (bits 0–5: frame length L ≤ 63; bit 6: make the CRC valid), the
+    // frame's L bytes, then 40 bytes of measurement floats.
     let mut rest = data;
-    while let Some((&len, tail)) = rest.split_first() {
-        let len = usize::from(len & 63).min(tail.len());
+    while let Some((&head, tail)) = rest.split_first() {
+        let len = usize::from(head & 63).min(tail.len());
         let (frame, tail) = tail.split_at(len);
-        let _ = a.receive(frame);
         let m = tail.get(..40).unwrap_or(tail);
         let bearings: [BearingMeasurement<f32>; 3] = core::array::from_fn(|k| BearingMeasurement {
             neighbour: [1, 2, 4][k],
@@ -56,16 +65,32 @@ fuzz_target!(|data: &[u8]| {
             rate: None,
             range: None,
         });
-        let out = a.step(&Measurements {
+        let meas = Measurements {
             time: f32_at(m, 24),
             dt: f32_at(m, 28),
             velocity: Vec2::new(f32_at(m, 32), f32_at(m, 36)),
             bearings: &bearings,
             partner_offset: None,
-        });
-        assert!(out.force.x.is_finite() && out.force.y.is_finite());
-        assert!(out.force.norm() <= limit * 1.0001);
-        a.frames(|f| assert!(f.len() <= 60));
+        };
+        for (a, integrity) in agents.iter_mut() {
+            let mut bytes = frame.to_vec();
+            if *integrity == Integrity::Crc16 && head & 64 != 0 && bytes.len() >= 2 {
+                let n = bytes.len() - 2;
+                let crc = crc16(&bytes[..n]);
+                bytes[n..].copy_from_slice(&crc);
+            }
+            if a.receive(&bytes).is_ok() {
+                assert!(decode_frame(&bytes, *integrity, EstimatorMode::Shared).is_ok());
+            }
+            let out = a.step(&meas);
+            assert!(out.force.x.is_finite() && out.force.y.is_finite());
+            assert!(out.force.norm() <= limit * 1.0001);
+            let integrity = *integrity;
+            a.frames(|f| {
+                assert!(f.len() <= 60);
+                assert!(decode_frame(f, integrity, EstimatorMode::Shared).is_ok());
+            });
+        }
         rest = tail.get(40..).unwrap_or(&[]);
     }
 });
