@@ -23,6 +23,7 @@
 pub mod cli;
 pub mod continuous;
 pub mod controller;
+pub mod design;
 pub mod diagnostics;
 pub mod error;
 pub mod graph;
