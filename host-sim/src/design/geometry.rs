@@ -116,15 +116,35 @@ mod tests {
     fn overlap_tests() {
         let t = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
         // Glued on the hypotenuse, on the other side: touching only.
-        assert!(!interiors_overlap(&t, &[[1.0, 0.0], [0.0, 1.0], [1.0, 1.0]], 1e-12));
+        assert!(!interiors_overlap(
+            &t,
+            &[[1.0, 0.0], [0.0, 1.0], [1.0, 1.0]],
+            1e-12
+        ));
         // Folded back over it.
-        assert!(interiors_overlap(&t, &[[1.0, 0.0], [0.0, 1.0], [0.2, 0.2]], 1e-12));
+        assert!(interiors_overlap(
+            &t,
+            &[[1.0, 0.0], [0.0, 1.0], [0.2, 0.2]],
+            1e-12
+        ));
         // Sharing a vertex only.
-        assert!(!interiors_overlap(&t, &[[0.0, 0.0], [-1.0, 0.0], [0.0, -1.0]], 1e-12));
+        assert!(!interiors_overlap(
+            &t,
+            &[[0.0, 0.0], [-1.0, 0.0], [0.0, -1.0]],
+            1e-12
+        ));
         // Far away.
-        assert!(!interiors_overlap(&t, &[[5.0, 5.0], [6.0, 5.0], [5.0, 6.0]], 1e-12));
+        assert!(!interiors_overlap(
+            &t,
+            &[[5.0, 5.0], [6.0, 5.0], [5.0, 6.0]],
+            1e-12
+        ));
         // Crossing without a shared vertex.
-        assert!(interiors_overlap(&t, &[[0.5, -0.5], [0.6, 2.0], [0.7, -0.5]], 1e-12));
+        assert!(interiors_overlap(
+            &t,
+            &[[0.5, -0.5], [0.6, 2.0], [0.7, -0.5]],
+            1e-12
+        ));
         assert!(covers(&t, [0.2, 0.2], 1e-12));
         assert!(covers(&t, [0.5, 0.0], 1e-12));
         assert!(!covers(&t, [0.6, 0.6], 1e-12));

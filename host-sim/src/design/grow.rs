@@ -34,6 +34,9 @@ use rstar::{RTree, AABB};
 use std::cmp::Ordering;
 use std::collections::{BinaryHeap, HashSet};
 
+mod repair;
+mod search;
+
 /// Smallest angle beyond which a triangle counts as good (rad, 35°): above it only edge
 /// length and load decide.
 pub(crate) const THETA_GOOD: f64 = 35.0 * std::f64::consts::PI / 180.0;
@@ -42,8 +45,11 @@ pub(crate) const THETA_GOOD: f64 = 35.0 * std::f64::consts::PI / 180.0;
 pub(crate) const LAMBDA: f64 = 0.25;
 /// Weight of the load of the edge's two agents.
 pub(crate) const MU: f64 = 0.25;
-/// Attached points tried per left-over point in a fallback round.
-const FALLBACK: usize = 32;
+/// Attached points whose edges are tried when a point is widened.
+const WIDEN: usize = 32;
+/// A point whose best candidate has a smallest angle below this (rad, 25°) is widened
+/// before that candidate is taken.
+const WIDEN_BELOW: f64 = 25.0 * std::f64::consts::PI / 180.0;
 /// Start vertices (nearest the centroid) examined before taking the best start triangle.
 const START_BATCH: usize = 32;
 
@@ -124,12 +130,22 @@ struct State<'a> {
     adj: Vec<Vec<u32>>,
     watch: Vec<Vec<u32>>,
     watched: HashSet<(u32, u32)>,
+    widened: Vec<bool>,
+    placed_tree: RTree<GeomWithData<Point, usize>>,
     tris: Vec<[usize; 3]>,
     overlapping: Vec<bool>,
+    /// Triangles taken out by the repair (indices into `tris`).
+    removed: Vec<bool>,
+    /// Each point's own triangle (the one it joined with; 0 for the first three).
+    own: Vec<usize>,
     tri_tree: RTree<GeomWithData<Rectangle<Point>, u32>>,
     heap: BinaryHeap<Entry>,
     mark: Vec<u32>,
     epoch: u32,
+}
+
+fn min_angle(t: [Point; 3]) -> f64 {
+    angles(t).into_iter().fold(f64::INFINITY, f64::min)
 }
 
 fn bbox(t: &[Point; 3]) -> AABB<Point> {
@@ -144,7 +160,7 @@ impl State<'_> {
     /// Angle and length part of the score, or `None` when an angle is within the margin.
     fn static_score(&self, v: usize, a: usize, b: usize) -> Option<f64> {
         let t = self.tri(a, b, v);
-        let theta = angles(t).into_iter().fold(f64::INFINITY, f64::min);
+        let theta = min_angle(t);
         if !(theta > self.p.margin) {
             return None;
         }
@@ -198,6 +214,7 @@ impl State<'_> {
         ));
         self.tris.push(t);
         self.overlapping.push(overlapping);
+        self.removed.push(false);
         for &x in &t {
             self.tri_count[x] += 1;
         }
@@ -232,6 +249,7 @@ impl State<'_> {
     fn start(&mut self, t: [usize; 3]) {
         for &x in &t {
             self.placed[x] = true;
+            self.placed_tree.insert(GeomWithData::new(self.pts[x], x));
         }
         self.n_placed = 3;
         let [a, b, c] = t;
@@ -244,141 +262,51 @@ impl State<'_> {
         self.edge_added(b, c);
     }
 
+    /// Attaches `v` to edge `ab` and pushes the candidates of its two new edges.
     fn attach(&mut self, v: usize, a: usize, b: usize, overlapping: bool) {
-        self.placed[v] = true;
-        self.n_placed += 1;
-        self.adj[a].push(v as u32);
-        self.adj[b].push(v as u32);
-        self.adj[v] = vec![a as u32, b as u32];
-        self.add_triangle([a, b, v], overlapping);
+        self.link(v, a, b, overlapping);
         self.watch[v].clear();
         self.edge_added(a, v);
         self.edge_added(b, v);
     }
 
-    /// One fallback round; `Err` when no point left can be attached.
-    fn fallback(&mut self) -> Result<(), DesignError> {
-        let placed_tree: RTree<GeomWithData<Point, usize>> = RTree::bulk_load(
-            (0..self.pts.len())
-                .filter(|&i| self.placed[i])
-                .map(|i| GeomWithData::new(self.pts[i], i))
-                .collect(),
-        );
-        let (mut pushed, mut angle, mut capacity) = (0usize, 0usize, 0usize);
-        for v in 0..self.pts.len() {
-            if self.placed[v] {
-                continue;
-            }
-            let near: Vec<usize> = placed_tree
-                .nearest_neighbor_iter(self.pts[v])
-                .take(FALLBACK)
-                .map(|q| q.data)
-                .collect();
-            for a in near {
-                if self.watched.insert((a as u32, v as u32)) {
-                    self.watch[a].push(v as u32);
-                }
-                for k in 0..self.adj[a].len() {
-                    let b = self.adj[a][k] as usize;
-                    match self.evaluate(v, a, b) {
-                        Ok(score) => {
-                            pushed += 1;
-                            self.heap.push(Entry {
-                                clear: true,
-                                score,
-                                v: v as u32,
-                                a: a as u32,
-                                b: b as u32,
-                            });
-                        }
-                        Err(Reject::Angle) => angle += 1,
-                        Err(Reject::Capacity) => capacity += 1,
-                    }
-                }
-            }
-        }
-        if pushed > 0 {
-            return Ok(());
-        }
-        Err(DesignError::NoConstruction {
-            placed: self.n_placed,
-            stuck: (0..self.pts.len()).filter(|&i| !self.placed[i]).collect(),
-            margin_deg: self.p.margin.to_degrees(),
-            angle_rejects: angle,
-            capacity_rejects: capacity,
-            max_triangles: self.p.max_triangles,
-            max_neighbours: self.p.max_neighbours,
-        })
+    /// Attaches `v` to edge `ab` (no candidates pushed).
+    fn link(&mut self, v: usize, a: usize, b: usize, overlapping: bool) {
+        self.placed[v] = true;
+        self.placed_tree.insert(GeomWithData::new(self.pts[v], v));
+        self.n_placed += 1;
+        self.adj[a].push(v as u32);
+        self.adj[b].push(v as u32);
+        self.adj[v] = vec![a as u32, b as u32];
+        self.own[v] = self.tris.len();
+        self.add_triangle([a, b, v], overlapping);
     }
 
-    /// The best first triangle `[a, b, c]` (`ab` the start edge).
-    fn first_triangle(&self) -> Result<[usize; 3], DesignError> {
-        let n = self.pts.len();
-        let mut best: Option<(Entry, [usize; 3])> = None;
-        let consider = |t: [usize; 3], best: &mut Option<(Entry, [usize; 3])>| {
-            let [a, b, c] = t;
-            if let Some(score) = self.static_score(c, a, b) {
-                let e = Entry {
-                    clear: !self.overlaps(&self.tri(a, b, c), t),
-                    score,
-                    v: c as u32,
-                    a: a as u32,
-                    b: b as u32,
-                };
-                if best.as_ref().is_none_or(|(old, _)| e > *old) {
-                    *best = Some((e, t));
-                }
-            }
-        };
-        if let Some([i, j]) = self.p.leader {
-            let refuse = |reason: String| DesignError::LeaderEdge {
-                pair: [i, j],
-                reason,
-            };
-            if i >= n || j >= n {
-                return Err(refuse(format!("there are only {n} points (0..{n})")));
-            }
-            if i == j {
-                return Err(refuse("the two leaders must be different points".to_owned()));
-            }
-            for k in (0..n).filter(|&k| k != i && k != j) {
-                consider([i, j, k], &mut best);
-            }
-            return best.map(|(_, t)| t).ok_or_else(|| {
-                refuse(format!(
-                    "no third point makes a triangle with every angle above the {}° margin",
-                    self.p.margin.to_degrees()
-                ))
-            });
+    /// Whether `v` can be detached: it is not in the first triangle and no triangle is
+    /// glued to one of its edges.
+    fn is_leaf(&self, v: usize) -> bool {
+        self.placed[v] && self.tri_count[v] == 1 && self.own[v] != 0
+    }
+
+    /// Undoes [`Self::link`] of a leaf.
+    fn detach(&mut self, v: usize) {
+        let k = self.own[v];
+        let [a, b, _] = self.tris[k];
+        let env = bbox(&self.tri(a, b, v));
+        self.tri_tree.remove(&GeomWithData::new(
+            Rectangle::from_corners(env.lower(), env.upper()),
+            k as u32,
+        ));
+        self.removed[k] = true;
+        for x in [a, b, v] {
+            self.tri_count[x] -= 1;
         }
-        let c = self.pts.iter().fold([0.0, 0.0], |s, p| [s[0] + p[0], s[1] + p[1]]);
-        let centroid = [c[0] / n as f64, c[1] / n as f64];
-        for (k, q) in self.all.nearest_neighbor_iter(centroid).enumerate() {
-            if k % START_BATCH == 0 && best.is_some() {
-                break;
-            }
-            let v = q.data;
-            let list = self.nb.of(v);
-            for (x, &a) in list.iter().enumerate() {
-                for &b in &list[x + 1..] {
-                    // The start edge is the triangle's shortest edge.
-                    let mut t = [v, a as usize, b as usize];
-                    let e = |k: usize| dist(self.pts[t[k]], self.pts[t[(k + 1) % 3]]);
-                    let shortest = (0..3).min_by(|&x, &y| e(x).total_cmp(&e(y))).unwrap_or(0);
-                    t.rotate_left(shortest);
-                    consider(t, &mut best);
-                }
-            }
-        }
-        best.map(|(_, t)| t).ok_or(DesignError::NoConstruction {
-            placed: 0,
-            stuck: (0..n).collect(),
-            margin_deg: self.p.margin.to_degrees(),
-            angle_rejects: 0,
-            capacity_rejects: 0,
-            max_triangles: self.p.max_triangles,
-            max_neighbours: self.p.max_neighbours,
-        })
+        self.adj[a].retain(|&w| w as usize != v);
+        self.adj[b].retain(|&w| w as usize != v);
+        self.adj[v].clear();
+        self.placed[v] = false;
+        self.n_placed -= 1;
+        self.placed_tree.remove(&GeomWithData::new(self.pts[v], v));
     }
 }
 
@@ -405,8 +333,12 @@ pub(crate) fn grow(
         adj: vec![Vec::new(); n],
         watch: vec![Vec::new(); n],
         watched: HashSet::new(),
+        widened: vec![false; n],
+        placed_tree: RTree::new(),
         tris: Vec::with_capacity(n.saturating_sub(2)),
         overlapping: Vec::with_capacity(n.saturating_sub(2)),
+        removed: Vec::with_capacity(n.saturating_sub(2)),
+        own: vec![0; n],
         tri_tree: RTree::new(),
         heap: BinaryHeap::new(),
         mark: vec![0; n],
@@ -426,6 +358,11 @@ pub(crate) fn grow(
         let Ok(score) = s.evaluate(v, a, b) else {
             continue;
         };
+        if !s.widened[v] && min_angle(s.tri(a, b, v)) < WIDEN_BELOW {
+            s.widen(v);
+            s.heap.push(e);
+            continue;
+        }
         let clear = e.clear && !s.overlaps(&s.tri(a, b, v), [a, b, v]);
         let now = Entry { clear, score, ..e };
         if now.key() != e.key() {
@@ -434,8 +371,13 @@ pub(crate) fn grow(
         }
         s.attach(v, a, b, !clear);
     }
+    s.repair();
+    let keep = |k: &usize| !s.removed[*k];
     Ok(Grown {
-        triangles: s.tris,
-        overlapping: s.overlapping,
+        triangles: (0..s.tris.len()).filter(keep).map(|k| s.tris[k]).collect(),
+        overlapping: (0..s.tris.len())
+            .filter(keep)
+            .map(|k| s.overlapping[k])
+            .collect(),
     })
 }

@@ -263,17 +263,26 @@ pub fn verify(points: &[Point], c: &Construction, opts: &DesignOptions) -> Resul
     for (k, t) in c.triangles.iter().enumerate() {
         let [a, b, v] = t.vertices;
         if t.vertices.iter().any(|&x| x >= n) || a == b || b == v || a == v {
-            return Err(format!("triangle {k} {:?} is not three distinct points", t.vertices));
+            return Err(format!(
+                "triangle {k} {:?} is not three distinct points",
+                t.vertices
+            ));
         }
         if k == 0 {
             placed[a] = true;
             placed[b] = true;
             edges.insert(key(a, b));
         } else if !(placed[a] && placed[b] && edges.contains(&key(a, b))) {
-            return Err(format!("triangle {k} {:?}: ({a}, {b}) is not an edge yet", t.vertices));
+            return Err(format!(
+                "triangle {k} {:?}: ({a}, {b}) is not an edge yet",
+                t.vertices
+            ));
         }
         if placed[v] {
-            return Err(format!("triangle {k} {:?}: point {v} is already placed", t.vertices));
+            return Err(format!(
+                "triangle {k} {:?}: point {v} is already placed",
+                t.vertices
+            ));
         }
         placed[v] = true;
         edges.insert(key(a, v));
@@ -292,10 +301,18 @@ pub fn verify(points: &[Point], c: &Construction, opts: &DesignOptions) -> Resul
         }
         let [x, y] = t.angles;
         if x.apex == y.apex || !t.vertices.contains(&x.apex) || !t.vertices.contains(&y.apex) {
-            return Err(format!("triangle {k}: apexes {} and {} are not two of its vertices", x.apex, y.apex));
+            return Err(format!(
+                "triangle {k}: apexes {} and {} are not two of its vertices",
+                x.apex, y.apex
+            ));
         }
         for ca in t.angles {
-            let far: Vec<Point> = t.vertices.iter().filter(|&&q| q != ca.apex).map(|&q| points[q]).collect();
+            let far: Vec<Point> = t
+                .vertices
+                .iter()
+                .filter(|&&q| q != ca.apex)
+                .map(|&q| points[q])
+                .collect();
             let actual = angle_at(points[ca.apex], far[0], far[1]);
             if (actual - ca.desired).abs() > 1e-9 || !(margin(ca.desired) > margin_rad) {
                 return Err(format!(
@@ -307,7 +324,9 @@ pub fn verify(points: &[Point], c: &Construction, opts: &DesignOptions) -> Resul
             }
         }
         if !(PI - x.desired - y.desired > margin_rad) {
-            return Err(format!("triangle {k}: controlled angles leave no third angle beyond the margin"));
+            return Err(format!(
+                "triangle {k}: controlled angles leave no third angle beyond the margin"
+            ));
         }
     }
     if let Some(i) = placed.iter().position(|p| !p) {
@@ -318,7 +337,9 @@ pub fn verify(points: &[Point], c: &Construction, opts: &DesignOptions) -> Resul
         nbrs[x] += 1;
         nbrs[y] += 1;
     }
-    if let Some(i) = (0..n).find(|&i| tri_count[i] > opts.max_triangles || nbrs[i] > opts.max_neighbours) {
+    if let Some(i) =
+        (0..n).find(|&i| tri_count[i] > opts.max_triangles || nbrs[i] > opts.max_neighbours)
+    {
         return Err(format!(
             "point {i} has {} triangles and {} neighbours (capacity {} and {})",
             tri_count[i], nbrs[i], opts.max_triangles, opts.max_neighbours

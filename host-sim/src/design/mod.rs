@@ -17,5 +17,7 @@ mod neighbours;
 pub mod points;
 
 pub use error::DesignError;
-pub use laman::{construct, verify, Construction, ControlledAngle, DesignOptions, DesignTriangle, Figures};
+pub use laman::{
+    construct, verify, Construction, ControlledAngle, DesignOptions, DesignTriangle, Figures,
+};
 pub use points::{Generator, Point};

@@ -125,12 +125,11 @@ pub(crate) fn delaunay_neighbours(points: &[Point], cap: usize) -> Result<Neighb
         .enumerate()
         .map(|(i, &p)| Indexed { p, i })
         .collect();
-    let dt = DelaunayTriangulation::<Indexed>::bulk_load(vertices).map_err(|e| {
-        DesignError::Points {
+    let dt =
+        DelaunayTriangulation::<Indexed>::bulk_load(vertices).map_err(|e| DesignError::Points {
             file: "<points>".to_owned(),
             reason: format!("cannot triangulate the points: {e:?}"),
-        }
-    })?;
+        })?;
     let n = points.len();
     let mut adj: Vec<Vec<u32>> = vec![Vec::new(); n];
     for e in dt.undirected_edges() {

@@ -100,10 +100,16 @@ impl Generator {
             3
         };
         if !(min_n..=MAX_GENERATED).contains(&n) {
-            return Err(option("n", format!("must be in {min_n}..={MAX_GENERATED}, got {n}")));
+            return Err(option(
+                "n",
+                format!("must be in {min_n}..={MAX_GENERATED}, got {n}"),
+            ));
         }
         if !(spacing.is_finite() && spacing > 0.0) {
-            return Err(option("spacing", format!("must be a finite length > 0, got {spacing}")));
+            return Err(option(
+                "spacing",
+                format!("must be a finite length > 0, got {spacing}"),
+            ));
         }
         let h = 3f64.sqrt() / 2.0;
         let width = (n as f64).sqrt().ceil() as usize;
@@ -215,8 +221,9 @@ pub fn read_points(path: &Path) -> Result<Vec<Point>, DesignError> {
         Some(e) if e.eq_ignore_ascii_case("toml") => parse_toml(&text, &label),
         _ => Err(DesignError::Points {
             file: label,
-            reason: "unknown kind of file: give a .csv (columns x, y) or a .toml (points = [[x, y], …])"
-                .to_owned(),
+            reason:
+                "unknown kind of file: give a .csv (columns x, y) or a .toml (points = [[x, y], …])"
+                    .to_owned(),
         }),
     }
 }
@@ -272,7 +279,11 @@ pub fn parse_csv(text: &str, file: &str) -> Result<Vec<Point>, DesignError> {
                 .parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite())
-                .ok_or_else(|| err(format!("line {line}: `{name}` = `{raw}` is not a finite number")))?;
+                .ok_or_else(|| {
+                    err(format!(
+                        "line {line}: `{name}` = `{raw}` is not a finite number"
+                    ))
+                })?;
         }
         out.push(p);
     }
@@ -338,12 +349,24 @@ mod tests {
     fn generators_give_n_points_with_the_spacing() {
         for n in [10, 50, 200] {
             let gens = [
-                Generator::Polygon { n, spacing: 1.0, centre: false },
-                Generator::Polygon { n, spacing: 1.0, centre: true },
+                Generator::Polygon {
+                    n,
+                    spacing: 1.0,
+                    centre: false,
+                },
+                Generator::Polygon {
+                    n,
+                    spacing: 1.0,
+                    centre: true,
+                },
                 Generator::RectangularLattice { n, spacing: 1.0 },
                 Generator::TriangularLattice { n, spacing: 1.0 },
                 Generator::Strip { n, spacing: 1.0 },
-                Generator::RandomDisc { n, spacing: 1.0, seed: 3 },
+                Generator::RandomDisc {
+                    n,
+                    spacing: 1.0,
+                    seed: 3,
+                },
             ];
             for g in gens {
                 let p = g.points().unwrap();
@@ -355,7 +378,10 @@ mod tests {
                     }
                 }
                 assert!(nearest >= 1.0 - 1e-9, "{}: {nearest}", g.describe());
-                if !matches!(g, Generator::RandomDisc { .. } | Generator::Polygon { centre: true, .. }) {
+                if !matches!(
+                    g,
+                    Generator::RandomDisc { .. } | Generator::Polygon { centre: true, .. }
+                ) {
                     assert!((nearest - 1.0).abs() < 1e-9, "{}: {nearest}", g.describe());
                 }
             }
@@ -364,16 +390,31 @@ mod tests {
 
     #[test]
     fn random_disc_is_reproducible() {
-        let g = |seed| Generator::RandomDisc { n: 100, spacing: 0.5, seed }.points().unwrap();
+        let g = |seed| {
+            Generator::RandomDisc {
+                n: 100,
+                spacing: 0.5,
+                seed,
+            }
+            .points()
+            .unwrap()
+        };
         assert_eq!(g(7), g(7));
         assert_ne!(g(7), g(8));
     }
 
     #[test]
     fn bad_generator_options() {
-        let e = Generator::Strip { n: 2, spacing: 1.0 }.points().unwrap_err();
+        let e = Generator::Strip { n: 2, spacing: 1.0 }
+            .points()
+            .unwrap_err();
         assert!(e.to_string().contains("option `n`"), "{e}");
-        let e = Generator::Strip { n: 5, spacing: -1.0 }.points().unwrap_err();
+        let e = Generator::Strip {
+            n: 5,
+            spacing: -1.0,
+        }
+        .points()
+        .unwrap_err();
         assert!(e.to_string().contains("option `spacing`"), "{e}");
     }
 
@@ -383,8 +424,13 @@ mod tests {
         assert_eq!(p, vec![[0.5, 1.0], [2.0, 3.0]]);
         let p = parse_csv("0,0\n1,0\n0,1\n", "b.csv").unwrap();
         assert_eq!(p.len(), 3);
-        let e = parse_csv("x,y\n1,2\n3,abc\n", "c.csv").unwrap_err().to_string();
-        assert!(e.contains("c.csv") && e.contains("line 3") && e.contains("`y` = `abc`"), "{e}");
+        let e = parse_csv("x,y\n1,2\n3,abc\n", "c.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("c.csv") && e.contains("line 3") && e.contains("`y` = `abc`"),
+            "{e}"
+        );
         let e = parse_csv("a,b\n1,2\n", "d.csv").unwrap_err().to_string();
         assert!(e.contains("no column `x`"), "{e}");
     }
@@ -393,9 +439,15 @@ mod tests {
     fn toml_points_and_target() {
         let p = parse_toml("points = [[0, 0], [1.5, 0], [0, 2]]", "a.toml").unwrap();
         assert_eq!(p[1], [1.5, 0.0]);
-        let p = parse_toml("name = \"x\"\n[target]\npositions = [[1, 2], [3, 4]]\n", "b.toml").unwrap();
+        let p = parse_toml(
+            "name = \"x\"\n[target]\npositions = [[1, 2], [3, 4]]\n",
+            "b.toml",
+        )
+        .unwrap();
         assert_eq!(p, vec![[1.0, 2.0], [3.0, 4.0]]);
-        let e = parse_toml("points = [[0, 0], [1]]", "c.toml").unwrap_err().to_string();
+        let e = parse_toml("points = [[0, 0], [1]]", "c.toml")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("c.toml") && e.contains("`points[1]`"), "{e}");
     }
 }
