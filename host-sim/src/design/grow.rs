@@ -161,7 +161,7 @@ impl State<'_> {
     fn static_score(&self, v: usize, a: usize, b: usize) -> Option<f64> {
         let t = self.tri(a, b, v);
         let theta = min_angle(t);
-        if !(theta > self.p.margin) {
+        if theta.is_nan() || theta <= self.p.margin {
             return None;
         }
         let len = dist(t[2], t[0]).max(dist(t[2], t[1]));

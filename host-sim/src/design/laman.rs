@@ -291,7 +291,10 @@ pub fn verify(points: &[Point], c: &Construction, opts: &DesignOptions) -> Resul
             tri_count[x] += 1;
         }
         let p = t.vertices.map(|x| points[x]);
-        if let Some(th) = angles(p).into_iter().find(|&th| !(th > margin_rad)) {
+        if let Some(th) = angles(p)
+            .into_iter()
+            .find(|&th| th.is_nan() || th <= margin_rad)
+        {
             return Err(format!(
                 "triangle {k} {:?} has an angle of {}° (margin {}°)",
                 t.vertices,
@@ -314,7 +317,10 @@ pub fn verify(points: &[Point], c: &Construction, opts: &DesignOptions) -> Resul
                 .map(|&q| points[q])
                 .collect();
             let actual = angle_at(points[ca.apex], far[0], far[1]);
-            if (actual - ca.desired).abs() > 1e-9 || !(margin(ca.desired) > margin_rad) {
+            if (actual - ca.desired).abs() > 1e-9
+                || margin(ca.desired).is_nan()
+                || margin(ca.desired) <= margin_rad
+            {
                 return Err(format!(
                     "triangle {k}: angle at {} is {}° in the points, desired {}°",
                     ca.apex,
@@ -323,7 +329,7 @@ pub fn verify(points: &[Point], c: &Construction, opts: &DesignOptions) -> Resul
                 ));
             }
         }
-        if !(PI - x.desired - y.desired > margin_rad) {
+        if PI - x.desired - y.desired <= margin_rad {
             return Err(format!(
                 "triangle {k}: controlled angles leave no third angle beyond the margin"
             ));
