@@ -195,7 +195,9 @@ pub fn folded_triangles(
         let [a, b, c] = *t;
         let want = cross(target[a], target[b], target[c]).signum();
         let got = flip * cross(formation[a], formation[b], formation[c]);
-        if cross(target[a], target[b], target[c]) != 0.0 && !(got * want > 0.0) {
+        if cross(target[a], target[b], target[c]) != 0.0
+            && (got * want).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+        {
             out.push(index);
         }
     }
