@@ -289,32 +289,56 @@ fn a_hundred_thousand_points() {
 
 #[test]
 fn wire_ids_on_large_lattices_and_strips() {
-    for g in [
-        Generator::RectangularLattice {
-            n: 100_000,
-            spacing: 1.0,
-        },
-        Generator::TriangularLattice {
-            n: 100_000,
-            spacing: 1.0,
-        },
-        Generator::Strip {
-            n: 100_000,
-            spacing: 1.0,
-        },
-    ] {
-        let p = g.points().unwrap();
-        let c = construct(&p, &DesignOptions::default()).unwrap();
-        let tris: Vec<[usize; 3]> = c.triangles.iter().map(|t| t.vertices).collect();
-        let adj = adjacency_from_triangles(p.len(), &tris);
-        // Extra conflicts: each agent with the agent 3 places further in point order.
-        let extra: Vec<[usize; 2]> = (0..p.len() - 3).map(|i| [i, i + 3]).collect();
+    let n = 100_000;
+    let lattice = Generator::TriangularLattice { n, spacing: 1.0 }
+        .points()
+        .unwrap();
+    let c = construct(&lattice, &DesignOptions::default()).unwrap();
+    let graphs = [
+        (
+            "constructed triangular lattice",
+            c.triangles.iter().map(|t| t.vertices).collect::<Vec<_>>(),
+        ),
+        // The strip's construction is (i, i+1, i+2) (see `lattices_and_strips_…`).
+        ("strip", (0..n - 2).map(|i| [i, i + 1, i + 2]).collect()),
+        // A square lattice split along alternating diagonals.
+        ("square lattice", square_lattice(316)),
+    ];
+    for (what, tris) in graphs {
+        let m = tris.iter().flatten().max().unwrap() + 1;
+        let adj = adjacency_from_triangles(m, &tris);
+        let plain = distance2_colouring(&adj, &[]).unwrap();
+        check_distance2(&adj, &[], &plain).unwrap();
+        // Extra conflicts: each agent with the agent 3 places further in index order.
+        let extra: Vec<[usize; 2]> = (0..m - 3).map(|i| [i, i + 3]).collect();
         let ids = distance2_colouring(&adj, &extra).unwrap();
         check_distance2(&adj, &extra, &ids).unwrap();
-        let used = ids.iter().copied().max().unwrap_or(0) as usize + 1;
-        println!("{}: {used} wire ids", g.describe());
-        assert!(used <= 64, "{}: {used}", g.describe());
+        let used = |c: &[u8]| c.iter().copied().max().unwrap_or(0) as usize + 1;
+        println!(
+            "{what} ({m} agents): {} wire ids, {} with extra pairs",
+            used(&plain),
+            used(&ids)
+        );
+        assert!(used(&ids) <= 64, "{what}: {}", used(&ids));
     }
+}
+
+/// Triangles of a `k × k` square lattice, each cell cut by a diagonal.
+fn square_lattice(k: usize) -> Vec<[usize; 3]> {
+    let id = |r: usize, c: usize| r * k + c;
+    let mut t = Vec::new();
+    for r in 0..k - 1 {
+        for c in 0..k - 1 {
+            if (r + c) % 2 == 0 {
+                t.push([id(r, c), id(r, c + 1), id(r + 1, c + 1)]);
+                t.push([id(r, c), id(r + 1, c + 1), id(r + 1, c)]);
+            } else {
+                t.push([id(r, c), id(r, c + 1), id(r + 1, c)]);
+                t.push([id(r, c + 1), id(r + 1, c + 1), id(r + 1, c)]);
+            }
+        }
+    }
+    t
 }
 
 /// The rendered scenario without `[target]` (the loader does not know it yet), through

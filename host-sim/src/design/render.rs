@@ -125,6 +125,18 @@ impl Default for ScenarioOptions {
     }
 }
 
+/// An angle in degrees with 10 decimals, trailing zeros dropped (`60.0`, not
+/// `60.00000000000001`); 1e-10° is far below any tolerance of the controller.
+fn deg(rad: f64) -> String {
+    let s = format!("{:.10}", rad.to_degrees());
+    let s = s.trim_end_matches('0');
+    if s.ends_with('.') {
+        format!("{s}0")
+    } else {
+        s.to_owned()
+    }
+}
+
 /// A TOML string literal.
 fn quoted(s: &str) -> String {
     toml::Value::String(s.to_owned()).to_string()
@@ -188,7 +200,20 @@ pub fn render_scenario(
         "#   longest edge {:.4} m, mean edge {:.4} m, {} overlapping triangles",
         f.longest_edge, f.mean_edge, f.overlapping
     );
-    let _ = writeln!(w, "# Initial positions: target rotated by {:.3}° about its centroid, plus a displacement of at most {:.4} m ({} of the size, seed {}; {} agents' displacements shortened to keep every triangle valid and unfolded)", init.rotation.to_degrees(), init.max_displacement, o.perturbation.fraction, o.perturbation.seed, init.shortened);
+    let _ = writeln!(
+        w,
+        "# Initial positions: the target rotated by {:.3}° about its centroid, plus random",
+        init.rotation.to_degrees()
+    );
+    let _ = writeln!(
+        w,
+        "#   displacements of at most {:.4} m ({} % of its size, seed {}); {} of them shortened",
+        init.max_displacement,
+        100.0 * o.perturbation.fraction,
+        o.perturbation.seed,
+        init.shortened
+    );
+    let _ = writeln!(w, "#   so that every triangle starts valid and unfolded");
     let _ = writeln!(
         w,
         "# Schema: docs/scenarios.md. Agent i is point i − 1 of the target."
@@ -236,9 +261,9 @@ pub fn render_scenario(
         for ca in t.angles {
             let _ = writeln!(
                 w,
-                "  {{ apex = {}, desired_deg = {:?} }},",
+                "  {{ apex = {}, desired_deg = {} }},",
                 ca.apex + 1,
-                ca.desired.to_degrees()
+                deg(ca.desired)
             );
         }
         let _ = writeln!(w, "]");
