@@ -17,13 +17,21 @@
 //! are never candidates.
 //!
 //! Candidates come from the Delaunay neighbours of the new edge's ends (`neighbours.rs`).
-//! When the queue runs dry with points left (slivers on the hull, points on a circle), a
-//! *fallback round* tries, for every point left, the edges at its 32 nearest attached
-//! points, and registers it to hear of later edges there. When that finds nothing, the
-//! construction is refused with the points that could not be attached.
+//! Before a point takes a thin triangle (smallest angle below 25°) it is *widened*: the
+//! edges at its 32 nearest attached points become candidates too, and it is registered to
+//! hear of later edges there. When the queue runs dry with points left (slivers on the
+//! hull, points on a circle), a *fallback round* widens every point left; when that finds
+//! nothing, the construction is refused with the points that could not be attached.
+//! Finally the worst triangles are repaired locally (`grow/repair.rs`).
 //!
-//! Cost: O(N·d·log N) for N points with Delaunay degree d (plus the fallback rounds, which
-//! on spread-out point sets touch only a few hull points).
+//! Why not simply demand a higher angle everywhere: on random points a growth with a
+//! floor of 25–30° does complete, but only by taking overlapping triangles where a clear
+//! thin one existed (measured: 2–17 overlaps among 298 triangles); the order above keeps
+//! triangles clear wherever possible and the angle as high as that allows.
+//!
+//! Cost: O(N·d·log N) for N points with Delaunay degree d, plus the fallback rounds, which
+//! on spread-out point sets touch only a few hull points. Measured (release build, one
+//! core): 100,000 random points in a disc 1.5 s, a 100,000-point lattice 0.7 s.
 
 use super::error::DesignError;
 use super::geometry::{angles, covers, dist, interiors_overlap};

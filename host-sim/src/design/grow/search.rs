@@ -99,15 +99,24 @@ impl State<'_> {
                     "the two leaders must be different points".to_owned(),
                 ));
             }
-            for k in (0..n).filter(|&k| k != i && k != j) {
-                consider([i, j, k], &mut best);
-            }
-            return best.map(|(_, t)| t).ok_or_else(|| {
-                refuse(format!(
-                    "no third point makes a triangle with every angle above the {}° margin",
-                    self.p.margin.to_degrees()
-                ))
-            });
+            // Scores first, the overlap test (a range query) only from the best down.
+            let mut scored: Vec<(f64, usize)> = (0..n)
+                .filter(|&k| k != i && k != j)
+                .filter_map(|k| Some((self.static_score(k, i, j)?, k)))
+                .collect();
+            scored.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
+            let clear = scored
+                .iter()
+                .find(|&&(_, k)| !self.overlaps(&self.tri(i, j, k), [i, j, k]));
+            return clear
+                .or(scored.first())
+                .map(|&(_, k)| [i, j, k])
+                .ok_or_else(|| {
+                    refuse(format!(
+                        "no third point makes a triangle with every angle above the {}° margin",
+                        self.p.margin.to_degrees()
+                    ))
+                });
         }
         let c = self
             .pts
