@@ -39,6 +39,7 @@ pub use scenario::{ScenarioErrors, BUILTINS};
 pub mod analysis;
 mod api;
 pub mod cli;
+pub mod design;
 pub mod engine;
 pub mod exit_code;
 pub mod model;

@@ -1,0 +1,46 @@
+//! `host-sim design`: from a target shape to a scenario (pure functions; the only I/O is
+//! [`points::read_points`]).
+//!
+//! * [`points`]: target point sets (CSV, TOML, or generators: polygon, lattices, strip,
+//!   random disc);
+//! * [`laman`]: the triangulated Laman graph (SPEC §3) with two controlled angles per
+//!   triangle, built to keep every angle far from 0 and π ([`laman::construct`]);
+//! * [`initial`] and [`render`]: initial positions and the scenario TOML, with the target
+//!   in a `[target]` section;
+//! * [`colouring`]: one-byte wire ids unique within two hops;
+//! * [`shape`]: a formation compared with its target up to similarity and mirror, and
+//!   which triangles are folded.
+//!
+//! ```
+//! use host_sim::design::{construct, render_scenario, DesignOptions, Generator, ScenarioOptions};
+//! let points = Generator::TriangularLattice { n: 10, spacing: 1.0 }.points().unwrap();
+//! let c = construct(&points, &DesignOptions::default()).unwrap();
+//! assert_eq!(c.triangles.len(), 8);
+//! let toml = render_scenario(&points, &c, &DesignOptions::default(), &ScenarioOptions::default()).unwrap();
+//! assert!(toml.contains("[target]"));
+//! ```
+
+pub mod colouring;
+pub mod error;
+mod geometry;
+mod grow;
+pub mod initial;
+pub mod laman;
+mod neighbours;
+pub mod points;
+pub mod render;
+pub mod shape;
+
+pub use colouring::{
+    adjacency_from_triangles, check_distance2, distance2_colouring, ColouringError,
+};
+pub use error::DesignError;
+pub use initial::{initial_positions, Initial, Perturbation};
+pub use laman::{
+    construct, verify, Construction, ControlledAngle, DesignOptions, DesignTriangle, Figures,
+};
+pub use points::{read_points, Generator, Point};
+pub use render::{render_scenario, ScenarioOptions, Template};
+pub use shape::{
+    compare, fit_similarity, folded_triangles, ShapeComparison, ShapeError, SimilarityFit,
+};
