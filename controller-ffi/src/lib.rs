@@ -68,7 +68,9 @@ pub const PH_MAX_SCHEDULE_STEPS: usize = 8;
 pub const PH_MAX_FRAME_LEN: usize = 60;
 /// Most frames one `ph_frames` call produces: an agent is the apex of at most one
 /// controlled angle per triangle, and a frame holds four (wire v3, every integrity mode).
-pub const PH_MAX_FRAMES_PER_TICK: usize = PH_MAX_TRIANGLES.div_ceil(4);
+// Written out (not `.div_ceil(4)`) so that cbindgen can translate it into the C header.
+#[allow(clippy::manual_div_ceil)]
+pub const PH_MAX_FRAMES_PER_TICK: usize = (PH_MAX_TRIANGLES + 3) / 4;
 /// Most estimates one agent owns (two edges of two angles per triangle).
 pub const PH_MAX_OWNED_ESTIMATES: usize = 4 * PH_MAX_TRIANGLES;
 /// Version of this C ABI (the header's structs and functions). Compare the header's
