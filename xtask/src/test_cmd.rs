@@ -108,18 +108,27 @@ fn phases(
             false => Err("regressions (listed above)".into()),
         },
     )?;
-    phase("C ABI on target (controller-ffi: C firmware under QEMU, Crazyflie app)", &mut || {
-        // The tests that need arm-none-eabi-gcc and QEMU (ignored by plain `cargo test`):
-        // the C firmware converges, links no panic path, and prints its figures (text of
-        // the staticlib's code, RAM per agent, instructions per tick through the C API);
-        // the Crazyflie app compiles against the header stub.
-        tools::run(
-            cargo()
-                .args(["test", "-p", "controller-ffi", "--release"])
-                .args(["--test", "c_firmware", "--test", "crazyflie_app"])
-                .args(["--", "--include-ignored", "--nocapture", "--test-threads", "1"]),
-        )
-    })?;
+    phase(
+        "C ABI on target (controller-ffi: C firmware under QEMU, Crazyflie app)",
+        &mut || {
+            // The tests that need arm-none-eabi-gcc and QEMU (ignored by plain `cargo test`):
+            // the C firmware converges, links no panic path, and prints its figures (text of
+            // the staticlib's code, RAM per agent, instructions per tick through the C API);
+            // the Crazyflie app compiles against the header stub.
+            tools::run(
+                cargo()
+                    .args(["test", "-p", "controller-ffi", "--release"])
+                    .args(["--test", "c_firmware", "--test", "crazyflie_app"])
+                    .args([
+                        "--",
+                        "--include-ignored",
+                        "--nocapture",
+                        "--test-threads",
+                        "1",
+                    ]),
+            )
+        },
+    )?;
     phase("host-in-the-loop (host-sim QEMU tests)", &mut || {
         // No `-p host-sim`: the default members' feature set, as `cargo test` built it.
         tools::run(cargo().args(["test", "--test", "hil", "--", "--include-ignored"]))

@@ -1,7 +1,8 @@
-//! The command line: `host-sim [run|validate|list|plot]` (exit codes in
+//! The command line: `host-sim [run|validate|list|plot|export]` (exit codes in
 //! [`crate::exit_code`] and `docs/outputs.md`): a thin client of the library API
 //! ([`crate::Simulation`]).
 
+mod export;
 mod run;
 
 use crate::engine::hil;
@@ -45,6 +46,27 @@ pub enum Command {
         /// The run's output directory.
         dir: PathBuf,
     },
+    /// Write one agent's configuration as the C API's checked blob (docs/c-api.md).
+    Export(ExportArgs),
+}
+
+/// Arguments of `host-sim export`.
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    /// Scenario file or built-in name.
+    pub scenario: String,
+    /// The agent's id in the scenario.
+    #[arg(long, value_name = "ID")]
+    pub agent: String,
+    /// Override a field first, e.g. `--set integrity=link`.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// Output file (default: standard output).
+    #[arg(short, long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Write C source (`const uint8_t ph_blob[]`) instead of the raw bytes.
+    #[arg(long)]
+    pub c_array: bool,
 }
 
 /// Arguments of `host-sim run`.
@@ -124,6 +146,7 @@ pub fn execute(cli: Cli) -> u8 {
             quiet,
         ),
         Some(Command::Run(args)) => run_command(&args, quiet),
+        Some(Command::Export(args)) => export::export_command(&args, quiet),
         Some(Command::Validate { scenario, set }) => validate_command(&scenario, &set, quiet),
         Some(Command::List) => {
             for b in BUILTINS {

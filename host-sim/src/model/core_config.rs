@@ -3,7 +3,8 @@
 
 use super::{AngleModel, Estimator, Model};
 use controller_core::{
-    AgentConfig, AngleConfig, EstimatorMode, LeaderConfig, LeaderRole, TriangleConfig,
+    AgentConfig, AngleConfig, EstimatorMode, LeaderConfig, LeaderRole, Limits, Schedule,
+    ScheduleStep, TriangleConfig,
 };
 
 /// Triangle capacity of one host agent (`MT` of `controller_core::Agent`).
@@ -76,9 +77,79 @@ impl Model {
         Ok(c)
     }
 
+    /// Agent `i`'s configuration as an `f32` agent with triangle capacity `M` (what a
+    /// microcontroller runs: the firmware of `--hil`, the C API's blob of `host-sim
+    /// export`): [`Model::agent_config`] with every number rounded to `f32`. Fails when
+    /// the agent belongs to more than `M` triangles, naming the agent.
+    pub fn agent_config_f32<const M: usize>(
+        &self,
+        i: usize,
+    ) -> Result<AgentConfig<f32, M>, String> {
+        let c = self.agent_config(i)?;
+        let f = |x: f64| x as f32;
+        let mut t = AgentConfig::<f32, M>::new(c.id);
+        for tri in &c.triangles {
+            let ang = |a: &AngleConfig<f64>| AngleConfig {
+                apex: a.apex,
+                cos_desired: f(a.cos_desired),
+                stiffness: f(a.stiffness),
+                damping: f(a.damping),
+                estimator_gain: f(a.estimator_gain),
+            };
+            t.triangles
+                .push(TriangleConfig {
+                    vertices: tri.vertices,
+                    angles: [ang(&tri.angles[0]), ang(&tri.angles[1])],
+                })
+                .map_err(|_| {
+                    format!(
+                        "agent {} belongs to {} triangles; an f32 agent of this build holds at most {M}",
+                        c.id,
+                        c.triangles.len()
+                    )
+                })?;
+        }
+        t.estimator = c.estimator;
+        t.initial_estimate = f(c.initial_estimate);
+        t.min_estimate = f(c.min_estimate);
+        t.friction = c.friction.map(f);
+        t.velocity_damping = c.velocity_damping.map(f);
+        t.velocity_reference = schedule_f32(&c.velocity_reference);
+        t.leader = c.leader.as_ref().map(|l| LeaderConfig {
+            role: l.role,
+            partner: l.partner,
+            stiffness: f(l.stiffness),
+            damping: l.damping.map(f),
+            displacement: schedule_f32(&l.displacement),
+        });
+        t.limits = Limits {
+            max_force: f(c.limits.max_force),
+            neighbour_timeout: f(c.limits.neighbour_timeout),
+            safe_damping: f(c.limits.safe_damping),
+            bearing_tolerance: f(c.limits.bearing_tolerance),
+            margin_cos: f(c.limits.margin_cos),
+        };
+        t.integrity = c.integrity;
+        t.comm_every = c.comm_every;
+        t.comm_phase = c.comm_phase;
+        Ok(t)
+    }
+
     /// Builds agent `i`'s controller-core agent.
     pub fn core_agent(&self, i: usize) -> Result<CoreAgent, String> {
         let c = self.agent_config(i)?;
         CoreAgent::new(c).map_err(|e| format!("controller-core refused agent index {i}: {e:?}"))
     }
+}
+
+/// A schedule rounded to `f32` (same capacity on both sides: never truncated).
+fn schedule_f32(s: &Schedule<f64>) -> Schedule<f32> {
+    let mut out = Schedule::default();
+    for st in &s.steps {
+        let _ = out.steps.push(ScheduleStep {
+            from: st.from as f32,
+            value: st.value.map(|x| x as f32),
+        });
+    }
+    out
 }
