@@ -17,10 +17,14 @@ mod config;
 pub mod controller;
 mod error;
 pub mod fake;
-pub mod link;
 mod options;
-pub mod qemu;
 mod stats;
+
+use link::Link;
+/// The host end of the UART link (one implementation: `qemu-harness`'s).
+pub use qemu_harness::link;
+/// The QEMU launcher (one implementation: `qemu-harness`'s).
+pub use qemu_harness::qemu;
 
 pub use config::target_config;
 pub use error::{HilError, When};
@@ -34,8 +38,7 @@ use crate::engine::controller::{AgentController, LocalCore};
 use crate::engine::{drive, Recorder, RunError, RunResult, SampledSim};
 use crate::model::{resolve_estimates, Model};
 use controller::{EstimateSlot, HilController, TargetHandle};
-use link::Link;
-use qemu::QemuProcess;
+use qemu_harness::{Qemu, Serial};
 use std::net::TcpListener;
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -62,8 +65,16 @@ fn launch(
             firmware, log_dir, ..
         } => {
             let qemu = qemu_path.ok_or_else(|| start_err("no QEMU binary".to_owned()))?;
-            let mut p =
-                QemuProcess::spawn(qemu, firmware, port, agent, log_dir, cpu).map_err(|e| {
+            let mut p = Qemu::new(firmware, log_dir.join(format!("qemu-agent-{agent}")))
+                .program(qemu)
+                .log_files(
+                    log_dir.join(format!("qemu-agent-{agent}.log")),
+                    log_dir.join(format!("qemu-agent-{agent}.stderr.log")),
+                )
+                .serial(Serial::TcpClient { port })
+                .pin(cpu)
+                .spawn()
+                .map_err(|e| {
                     start_err(format!(
                         "cannot run {} (logs in {}): {e}",
                         qemu.display(),
