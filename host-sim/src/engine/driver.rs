@@ -2,6 +2,7 @@
 //! the diagnostics cadence (every control instant and every log instant), logging, and
 //! early stopping on a terminal failure found by [`crate::analysis::Monitor`].
 
+use super::channel::ChannelStats;
 use super::continuous::ContinuousSim;
 use super::error::RunError;
 use super::hil::HilError;
@@ -28,6 +29,10 @@ pub trait Engine {
     fn frame_counts(&self) -> FrameCounts;
     /// Controller counters so far.
     fn control_stats(&self) -> ControlStats;
+    /// The shared channel's counters, if the radio has one.
+    fn channel_stats(&self) -> Option<ChannelStats> {
+        None
+    }
     /// A controller failure that ends the run (a host-in-the-loop target that stopped
     /// answering or sent a corrupt frame), taken once; checked after every
     /// [`Self::control`].
@@ -65,6 +70,11 @@ pub fn run(
             if model.radio.is_faulty() {
                 warnings
                     .push("continuous mode: the radio settings are ignored (no radio)".to_owned());
+            }
+            if model.comm_every != 1 {
+                warnings.push(
+                    "continuous mode: controller.comm_rate_hz is ignored (no radio)".to_owned(),
+                );
             }
             let mut e = ContinuousSim::new(model)?;
             drive(model, &mut e, recorder, progress, warnings)
@@ -171,6 +181,7 @@ pub fn drive(
             .collect(),
         frames: engine.frame_counts(),
         control: engine.control_stats(),
+        channel: engine.channel_stats(),
         warnings,
         steps,
         wall_seconds: started.elapsed().as_secs_f64(),

@@ -9,9 +9,16 @@
 //!
 //! Nothing here allocates after construction unless the preallocated capacity of the
 //! in-flight queue is exceeded (it is sized from the scenario's rates and delays).
+//!
+//! With a shared medium ([`crate::model::ChannelModel`], [`Radio::attach_channel`]) a
+//! broadcast goes on the air through [`super::channel`] instead of the per-sender
+//! bandwidth limit; the copies that survive collisions and range then suffer the
+//! per-link faults above, from the end of their transmission.
 
+use super::channel::{Channel, ChannelStats};
+use crate::model::graph::Adjacency;
 use crate::model::RadioModel;
-use controller_core::MAX_FRAME_LEN;
+use controller_core::{Vec2, MAX_FRAME_LEN};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::cmp::Ordering;
@@ -79,12 +86,14 @@ pub struct RadioStats {
     pub reordered: u64,
     /// Copies handed to a receiver.
     pub delivered: u64,
+    /// Copies the shared channel lost (collisions, out of range).
+    pub channel_lost: u64,
 }
 
 impl RadioStats {
     /// Copies that never arrived (lost or dropped by the queue).
     pub fn dropped(&self) -> u64 {
-        self.lost + self.queue_dropped
+        self.lost + self.queue_dropped + self.channel_lost
     }
 }
 
@@ -93,6 +102,9 @@ struct InFlight {
     at: f64,
     order: u64,
     to: u32,
+    from: u32,
+    /// When the sender produced it (s).
+    born: f64,
     frame: RadioFrame,
 }
 
@@ -124,8 +136,10 @@ pub struct Radio {
     rng: ChaCha8Rng,
     queue: BinaryHeap<InFlight>,
     order: u64,
+    seed: u64,
     busy_until: Vec<f64>,
     stats: RadioStats,
+    channel: Option<Channel>,
 }
 
 impl Radio {
@@ -138,8 +152,32 @@ impl Radio {
             rng,
             queue: BinaryHeap::with_capacity(capacity),
             order: 0,
+            seed,
             busy_until: vec![0.0; n],
             stats: RadioStats::default(),
+            channel: None,
+        }
+    }
+
+    /// Puts the agents on the model's shared medium, if it has one: `neighbours` is the
+    /// radio graph, `period` the control period (s).
+    pub fn attach_channel(&mut self, neighbours: &Adjacency, period: f64) {
+        self.channel = self
+            .model
+            .channel
+            .as_ref()
+            .map(|c| Channel::new(c, neighbours, self.seed, period));
+    }
+
+    /// The shared channel's counters, if there is one.
+    pub fn channel_stats(&self) -> Option<ChannelStats> {
+        self.channel.as_ref().map(Channel::stats)
+    }
+
+    /// The agents' positions (for the channel's radio range; ignored without one).
+    pub fn observe(&mut self, q: &[Vec2<f64>]) {
+        if let Some(c) = &mut self.channel {
+            c.set_positions(q);
         }
     }
 
@@ -165,12 +203,14 @@ impl Radio {
         }
     }
 
-    fn push(&mut self, at: f64, to: usize, frame: RadioFrame) {
+    fn push(&mut self, at: f64, to: usize, from: usize, born: f64, frame: RadioFrame) {
         self.order += 1;
         self.queue.push(InFlight {
             at,
             order: self.order,
             to: to as u32,
+            from: from as u32,
+            born,
             frame,
         });
     }
@@ -181,6 +221,12 @@ impl Radio {
         self.stats.broadcasts += 1;
         let copies = receivers.len() as u64;
         self.stats.sent += copies;
+        if let Some(c) = &mut self.channel {
+            if !c.transmit(now, from, bytes, self.model.queue_limit) {
+                self.stats.queue_dropped += copies;
+            }
+            return;
+        }
         // Air time: the sender transmits one frame at a time.
         let mut on_air = now;
         if self.model.bandwidth > 0.0 {
@@ -196,32 +242,45 @@ impl Radio {
             }
         }
         for &to in receivers {
-            if self.chance(self.model.loss) {
-                self.stats.lost += 1;
-                continue;
-            }
-            let mut copy = frame;
-            if self.chance(self.model.corruption) {
-                let bit = self.rng.random_range(0..usize::from(copy.len).max(1) * 8);
-                copy.flip(bit);
-                self.stats.corrupted += 1;
-            }
-            let mut at = on_air + self.model.latency + self.jitter();
-            if self.chance(self.model.reordering) {
-                at += self.model.reorder_delay * (1.0 - self.rng.random::<f64>());
-                self.stats.reordered += 1;
-            }
-            self.push(at, to, copy);
-            if self.chance(self.model.duplication) {
-                let again = on_air + self.model.latency + self.jitter();
-                self.push(again, to, copy);
-                self.stats.duplicated += 1;
-            }
+            self.link_copy(on_air, now, from, to, frame);
+        }
+    }
+
+    /// One link copy of a frame produced at `born` by `from`, off the air at `on_air`:
+    /// loss, corruption, latency + jitter, reordering, duplication.
+    fn link_copy(&mut self, on_air: f64, born: f64, from: usize, to: usize, frame: RadioFrame) {
+        if self.chance(self.model.loss) {
+            self.stats.lost += 1;
+            return;
+        }
+        let mut copy = frame;
+        if self.chance(self.model.corruption) {
+            let bit = self.rng.random_range(0..usize::from(copy.len).max(1) * 8);
+            copy.flip(bit);
+            self.stats.corrupted += 1;
+        }
+        let mut at = on_air + self.model.latency + self.jitter();
+        if self.chance(self.model.reordering) {
+            at += self.model.reorder_delay * (1.0 - self.rng.random::<f64>());
+            self.stats.reordered += 1;
+        }
+        self.push(at, to, from, born, copy);
+        if self.chance(self.model.duplication) {
+            let again = on_air + self.model.latency + self.jitter();
+            self.push(again, to, from, born, copy);
+            self.stats.duplicated += 1;
         }
     }
 
     /// Hands every copy due by `now` to its receiver's inbox, in arrival order.
     pub fn deliver(&mut self, now: f64, inboxes: &mut [Vec<RadioFrame>]) {
+        if let Some(mut c) = self.channel.take() {
+            c.resolve(now, |end, born, from, to, frame| {
+                self.link_copy(end, born, from, to, frame);
+            });
+            self.stats.channel_lost = c.lost_copies();
+            self.channel = Some(c);
+        }
         while let Some(top) = self.queue.peek() {
             if top.at > now + TIME_EPS {
                 break;
@@ -230,8 +289,14 @@ impl Radio {
                 if let Some(inbox) = inboxes.get_mut(f.to as usize) {
                     inbox.push(f.frame);
                     self.stats.delivered += 1;
+                    if let Some(c) = &mut self.channel {
+                        c.heard(f.to as usize, f.from as usize, f.born);
+                    }
                 }
             }
+        }
+        if let Some(c) = &mut self.channel {
+            c.sample_ages(now);
         }
     }
 }

@@ -1,5 +1,6 @@
 //! Everything a run found, as the engine hands it to the reports.
 
+use super::channel::ChannelStats;
 use super::hil::LinkStats;
 use super::stats::{ControlStats, FrameCounts};
 use crate::analysis::{Event, Outcome};
@@ -48,6 +49,8 @@ pub struct RunResult {
     pub frames: FrameCounts,
     /// Controller counters.
     pub control: ControlStats,
+    /// The shared channel's counters (`None` without `[radio.channel]`).
+    pub channel: Option<ChannelStats>,
     /// Things the user should know (ignored settings, …).
     pub warnings: Vec<String>,
     /// RK4 steps taken.

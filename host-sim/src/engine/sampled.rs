@@ -1,6 +1,7 @@
 //! The sampled simulator: controllers at their rate with zero-order hold, frames over the
 //! radio model, the plant integrated by RK4 between ticks.
 
+use super::channel::ChannelStats;
 use super::controller::{AgentController, LocalCore};
 use super::driver::Engine;
 use super::hil::{HilError, LinkStats};
@@ -86,12 +87,14 @@ impl<'m> SampledSim<'m> {
             .map(|i| Vec::with_capacity(model.graph.radio.of(i).len() * FRAMES_PER_TICK * 4 + 8))
             .collect();
         let partner = model.partners();
+        let mut radio = Radio::new(&model.radio, n, model.seed, capacity);
+        radio.attach_channel(&model.graph.radio, period);
         Ok(Self {
             model,
             controllers,
             plant: Plant::new(model),
             sensors: Sensors::new(&model.sensors, model.seed),
-            radio: Radio::new(&model.radio, n, model.seed, capacity),
+            radio,
             inboxes,
             outboxes: (0..n)
                 .map(|_| Vec::with_capacity(4 * FRAMES_PER_TICK))
@@ -151,6 +154,7 @@ impl Engine for SampledSim<'_> {
             return;
         }
         let model = self.model;
+        self.radio.observe(&self.plant.q);
         self.radio.deliver(t, &mut self.inboxes);
         let dt = self.last_tick.map_or(0.0, |p| t - p);
         let exact = model.sensors.bearing_rate == BearingRate::Exact;
@@ -257,6 +261,10 @@ impl Engine for SampledSim<'_> {
 
     fn control_stats(&self) -> ControlStats {
         self.stats
+    }
+
+    fn channel_stats(&self) -> Option<ChannelStats> {
+        self.radio.channel_stats()
     }
 
     fn take_error(&mut self) -> Option<HilError> {

@@ -1,6 +1,6 @@
 //! What the agents' sensors and radios get wrong, in SI units.
 
-use super::BearingRate;
+use super::{BearingRate, ChannelModel};
 
 /// Sensor imperfections, in SI units.
 #[derive(Clone, Debug, PartialEq)]
@@ -67,6 +67,8 @@ pub struct RadioModel {
     pub bandwidth: f64,
     /// Longest transmit-queue wait before a drop (s).
     pub queue_limit: f64,
+    /// The shared medium, if modelled (`None`: every link is independent).
+    pub channel: Option<ChannelModel>,
 }
 
 impl RadioModel {
@@ -82,6 +84,7 @@ impl RadioModel {
             corruption: 0.0,
             bandwidth: 0.0,
             queue_limit: 0.05,
+            channel: None,
         }
     }
 
@@ -94,5 +97,6 @@ impl RadioModel {
             || self.reordering != 0.0
             || self.corruption != 0.0
             || self.bandwidth != 0.0
+            || self.channel.is_some()
     }
 }

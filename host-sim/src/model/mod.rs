@@ -5,6 +5,7 @@
 //! Agents are referred to by index (their position in the scenario's `[[agents]]` list);
 //! `AgentModel::id` is the controller-core id used on the wire.
 
+pub mod channel;
 mod core_config;
 mod criteria;
 mod devices;
@@ -13,6 +14,7 @@ mod formation;
 pub mod graph;
 mod options;
 
+pub use channel::{Access, ChannelModel, IntegrityMode};
 pub use core_config::{CoreAgent, MT, NB};
 pub use criteria::Criteria;
 pub use devices::{RadioModel, SensorModel};
@@ -44,6 +46,10 @@ pub struct Model {
     pub log_every: usize,
     /// RK4 steps per control tick (the control period is `steps_per_tick · dt`).
     pub steps_per_tick: usize,
+    /// Control ticks per broadcast (`rate_hz / comm_rate_hz`, ≥ 1).
+    pub comm_every: usize,
+    /// How frames are protected (the same for every agent).
+    pub integrity: IntegrityMode,
     /// Estimator as named in the file.
     pub estimator: Estimator,
     /// `r̂(0)`.
@@ -83,6 +89,17 @@ impl Model {
                 })
             })
             .collect()
+    }
+
+    /// Communication period (s): `comm_every` control periods.
+    pub fn comm_period(&self) -> f64 {
+        self.control_period() * self.comm_every as f64
+    }
+
+    /// Agent `i`'s broadcast phase: agents take turns round-robin, so that with
+    /// `comm_every = k` about `n / k` agents broadcast on each control tick.
+    pub fn comm_phase(&self, i: usize) -> usize {
+        i % self.comm_every.max(1)
     }
 
     /// Number of agents.

@@ -100,6 +100,9 @@ pub fn summary_json(model: &Model, r: &RunResult, estimates: &[EstimateInfo]) ->
         "warnings": r.warnings,
         "steps": r.steps,
     });
+    if let Some(obj) = v.as_object_mut() {
+        super::channel::add_json(obj, model, r);
+    }
     // Host-in-the-loop runs only (wall-clock figures would make summaries of the same
     // seed differ).
     if let (false, Some(obj)) = (r.hil.is_empty(), v.as_object_mut()) {

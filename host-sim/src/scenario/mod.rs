@@ -20,7 +20,7 @@ pub use schema::{
     AgentDefaults, AgentSpec, AngleSpec, Diagonal, GainsSpec, LeaderSpec, ScenarioFile,
     ScheduleSpec, StepSpec, TriangleSpec,
 };
-pub use settings::{ControllerSpec, Integration, RadioSpec, SensorSpec};
+pub use settings::{ChannelSpec, ControllerSpec, Integration, RadioSpec, SensorSpec};
 pub use source::Source;
 pub use strip::strip_model;
 pub use validate::validate;

@@ -1,7 +1,7 @@
 //! The run-wide sections of a scenario file: `[integration]`, `[controller]`,
 //! `[sensors]` and `[radio]`, with their defaults (`docs/scenarios.md`).
 
-use crate::model::{BearingRate, Estimator};
+use crate::model::{Access, BearingRate, Estimator, IntegrityMode};
 use serde::{Deserialize, Serialize};
 
 /// `[integration]`: the plant integrator and the log.
@@ -43,6 +43,11 @@ pub struct ControllerSpec {
     pub safe_damping: f64,
     /// Margin (degrees) that desired and current angles must keep from 0 and 180°.
     pub angle_margin_deg: f64,
+    /// Broadcast rate (Hz): `≤ rate_hz`, and `rate_hz` a whole multiple of it; default
+    /// `rate_hz` (broadcast every tick).
+    pub comm_rate_hz: Option<f64>,
+    /// Frame integrity of the swarm: `crc16` or `link`.
+    pub integrity: IntegrityMode,
 }
 
 impl Default for ControllerSpec {
@@ -56,6 +61,8 @@ impl Default for ControllerSpec {
             neighbour_timeout: 0.1,
             safe_damping: 1.0,
             angle_margin_deg: 5.0,
+            comm_rate_hz: None,
+            integrity: IntegrityMode::Crc16,
         }
     }
 }
@@ -116,6 +123,33 @@ pub struct RadioSpec {
     pub bandwidth: f64,
     /// Longest wait in a sender's transmit queue before a frame is dropped (s).
     pub queue_limit: f64,
+    /// `[radio.channel]`: one shared medium (optional; `docs/radio.md`).
+    pub channel: Option<ChannelSpec>,
+}
+
+/// `[radio.channel]`: a shared medium. A `preset` fills the radio's figures; fields
+/// given here override it.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ChannelSpec {
+    /// `crazyflie` (2 Mbit/s nRF24-class Enhanced ShockBurst), or none.
+    pub preset: Option<String>,
+    /// `aloha` or `tdma`.
+    pub access: Access,
+    /// Bit rate on the air (bit/s); required without a preset.
+    pub bit_rate: Option<f64>,
+    /// Per-frame overhead on the air besides the payload (bytes, may be fractional).
+    pub overhead_bytes: Option<f64>,
+    /// Transmitter settling time before each frame (s).
+    pub turnaround: Option<f64>,
+    /// Radio range (m); default: everyone hears everyone.
+    pub range: Option<f64>,
+    /// ALOHA: each broadcast starts at a uniform random instant this long after its
+    /// tick (s); default one control period.
+    pub aloha_window: Option<f64>,
+    /// TDMA: slot length (s); default the turnaround plus the air time of a
+    /// largest frame.
+    pub slot: Option<f64>,
 }
 
 impl Default for RadioSpec {
@@ -130,6 +164,7 @@ impl Default for RadioSpec {
             corruption: 0.0,
             bandwidth: 0.0,
             queue_limit: 0.05,
+            channel: None,
         }
     }
 }

@@ -8,7 +8,7 @@
 
 use crate::model::graph::{strip_triangles, Graph};
 use crate::model::{AgentModel, AngleModel, Model, RadioModel, SensorModel, TriangleModel};
-use crate::model::{BearingRate, Criteria, Estimator, Mode};
+use crate::model::{BearingRate, Criteria, Estimator, IntegrityMode, Mode};
 use controller_core::{Limits, Schedule};
 
 /// A strip of `n ≥ 3` agents, printed-paper gains (c = 10, d = 1, c_e = 10), desired
@@ -59,6 +59,8 @@ pub fn strip_model(n: usize, duration: f64) -> Model {
         dt,
         log_every: 10,
         steps_per_tick: 10,
+        comm_every: 1,
+        integrity: IntegrityMode::Crc16,
         estimator: Estimator::Shared,
         initial_estimate: 1.0,
         min_estimate: 0.1,

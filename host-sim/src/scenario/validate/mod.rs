@@ -5,6 +5,7 @@
 
 mod agents;
 mod checker;
+mod comm;
 mod graph;
 mod references;
 mod settings;
@@ -30,6 +31,9 @@ pub fn validate(s: &ScenarioFile, file: &str, default_name: &str) -> Result<Mode
         margin,
         reorder_delay,
     } = settings::check(&mut c, s);
+    let period = dt * steps_per_tick as f64;
+    let comm_every = comm::comm_every(&mut c, s, period);
+    let channel = comm::channel(&mut c, s, period);
     let (agents, index) = agents::check(&mut c, s);
     let (triangles, ids_ok) = triangles::check(&mut c, s, &index, margin);
     graph::check(&mut c, s, &agents, &triangles, ids_ok, margin);
@@ -64,6 +68,8 @@ pub fn validate(s: &ScenarioFile, file: &str, default_name: &str) -> Result<Mode
         dt,
         log_every,
         steps_per_tick,
+        comm_every,
+        integrity: ctl.integrity,
         estimator: ctl.estimator,
         initial_estimate: ctl.initial_estimate,
         min_estimate: ctl.min_estimate,
@@ -91,6 +97,7 @@ pub fn validate(s: &ScenarioFile, file: &str, default_name: &str) -> Result<Mode
             corruption: ra.corruption,
             bandwidth: ra.bandwidth,
             queue_limit: ra.queue_limit,
+            channel,
         },
         criteria: s.criteria.clone(),
         graph,
