@@ -1,8 +1,9 @@
-//! The command line: `host-sim [run|validate|list|plot]` (exit codes in
+//! The command line: `host-sim [run|validate|list|plot|sweep]` (exit codes in
 //! [`crate::exit_code`] and `docs/outputs.md`): a thin client of the library API
 //! ([`crate::Simulation`]).
 
 mod run;
+mod sweep;
 
 use crate::engine::hil;
 use crate::exit_code;
@@ -45,6 +46,8 @@ pub enum Command {
         /// The run's output directory.
         dir: PathBuf,
     },
+    /// Run a Monte Carlo sweep (docs/sweeps.md) on every core, or merge its shards.
+    Sweep(sweep::SweepArgs),
 }
 
 /// Arguments of `host-sim run`.
@@ -131,6 +134,7 @@ pub fn execute(cli: Cli) -> u8 {
             }
             exit_code::CONVERGED
         }
+        Some(Command::Sweep(args)) => sweep::command(&args, quiet),
         Some(Command::Plot { dir }) => match crate::report::plot_run(&dir) {
             Ok(files) => {
                 if !quiet {
