@@ -9,6 +9,8 @@ pub const CONVERGED: u8 = 0;
 pub const IO: u8 = 1;
 /// Bad command line (clap's usage errors).
 pub const USAGE: u8 = 2;
+/// `host-sim sweep` was stopped by Ctrl-C (the finished runs were written).
+pub const INTERRUPTED: u8 = 130;
 /// The run ended without converging.
 pub const NOT_CONVERGED: u8 = 10;
 /// Two agents came closer than the collision distance.

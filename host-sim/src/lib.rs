@@ -21,7 +21,8 @@
 //! * [`engine`]: plant, sensors, radio, controllers (and [`engine::hil`], agents as
 //!   firmware in QEMU), the sampled and continuous simulators, the driver.
 //! * [`report`]: `timeseries.csv`, the in-memory series, `summary.json`, the table, plots.
-//! * the API (re-exported here) and [`cli`], the command line.
+//! * the API (re-exported here), [`sweep`] (Monte Carlo sweeps, a client of the API)
+//!   and [`cli`], the command line.
 //!
 //! Imports point down only (checked by `tests/layers.rs`). Schemas: `docs/scenarios.md`
 //! (input) and `docs/outputs.md` (output, exit codes: [`exit_code`]).
@@ -45,3 +46,4 @@ pub mod exit_code;
 pub mod model;
 pub mod report;
 pub mod scenario;
+pub mod sweep;

@@ -18,6 +18,16 @@ pub enum Outcome {
 }
 
 impl Outcome {
+    /// Every outcome, in the order of the sweep tables' columns (`docs/sweeps.md`). A new
+    /// variant goes here too: sweeps count and report whatever this lists.
+    pub const ALL: &'static [Outcome] = &[
+        Outcome::Converged,
+        Outcome::Collision,
+        Outcome::EstimateCollapse,
+        Outcome::Diverged,
+        Outcome::NotConverged,
+    ];
+
     /// The name in `summary.json`.
     pub fn as_str(self) -> &'static str {
         match self {
@@ -57,4 +67,31 @@ pub struct Event {
     pub kind: Outcome,
     /// A human sentence.
     pub message: String,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Outcome;
+
+    /// `ALL` lists each outcome once; the exhaustive match fails to compile when a variant
+    /// is added, pointing here, and the count below then fails until `ALL` has it.
+    #[test]
+    fn all_lists_every_outcome_once() {
+        fn ordinal(o: Outcome) -> usize {
+            match o {
+                Outcome::Converged => 0,
+                Outcome::Collision => 1,
+                Outcome::EstimateCollapse => 2,
+                Outcome::Diverged => 3,
+                Outcome::NotConverged => 4,
+            }
+        }
+        const VARIANTS: usize = 5;
+        assert_eq!(Outcome::ALL.len(), VARIANTS);
+        let mut seen = [false; VARIANTS];
+        for &o in Outcome::ALL {
+            assert!(!seen[ordinal(o)], "{o} listed twice");
+            seen[ordinal(o)] = true;
+        }
+    }
 }

@@ -1,9 +1,10 @@
-//! The command line: `host-sim [run|validate|list|plot|export]` (exit codes in
+//! The command line: `host-sim [run|validate|list|plot|export|sweep]` (exit codes in
 //! [`crate::exit_code`] and `docs/outputs.md`): a thin client of the library API
 //! ([`crate::Simulation`]).
 
 mod export;
 mod run;
+mod sweep;
 
 use crate::engine::hil;
 use crate::exit_code;
@@ -46,6 +47,8 @@ pub enum Command {
         /// The run's output directory.
         dir: PathBuf,
     },
+    /// Run a Monte Carlo sweep (docs/sweeps.md) on every core, or merge its shards.
+    Sweep(sweep::SweepArgs),
     /// Write one agent's configuration as the C API's checked blob (docs/c-api.md).
     Export(ExportArgs),
 }
@@ -154,6 +157,7 @@ pub fn execute(cli: Cli) -> u8 {
             }
             exit_code::CONVERGED
         }
+        Some(Command::Sweep(args)) => sweep::command(&args, quiet),
         Some(Command::Plot { dir }) => match crate::report::plot_run(&dir) {
             Ok(files) => {
                 if !quiet {

@@ -11,7 +11,7 @@ mod schema;
 mod settings;
 mod source;
 pub mod strip;
-mod toml_text;
+pub mod toml_text;
 mod validate;
 
 pub use builtin::{builtin, Builtin, BUILTINS};

@@ -1,7 +1,9 @@
 //! Working on TOML text: setting a dotted key (`--set`) and telling where an error is
-//! (line, column, dotted field).
+//! (line, column, dotted field). The location helpers are public: sweep files report their
+//! errors the same way.
 
-pub(super) fn one_line(s: &str) -> String {
+/// `s` on one line (TOML messages span several).
+pub fn one_line(s: &str) -> String {
     s.trim().replace('\n', " ")
 }
 
@@ -61,7 +63,7 @@ pub(super) fn set_path(
 }
 
 /// 1-based line and column of byte offset `pos`.
-pub(super) fn line_col(text: &str, pos: usize) -> (usize, usize) {
+pub fn line_col(text: &str, pos: usize) -> (usize, usize) {
     let before = text.get(..pos).unwrap_or(text);
     let line = before.matches('\n').count() + 1;
     let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
@@ -70,7 +72,7 @@ pub(super) fn line_col(text: &str, pos: usize) -> (usize, usize) {
 
 /// Best guess of the dotted key at byte offset `pos`: the last table header before it
 /// (with its index for an array of tables, `agents[2]`) and the key on its line.
-pub(super) fn field_at(text: &str, pos: usize) -> String {
+pub fn field_at(text: &str, pos: usize) -> String {
     let before = text.get(..pos).unwrap_or(text);
     let line_start = before.rfind('\n').map_or(0, |i| i + 1);
     let line_end = text

@@ -1,4 +1,4 @@
-//! Plots of one simulator run.
+//! Plots of one simulator run, and a generic x–y figure ([`plot_xy`], for sweeps).
 //!
 //! [`plot_run`] reads `timeseries.csv` and `summary.json` from a run directory
 //! and writes five figures next to them, each as PNG (1200×900) and SVG:
@@ -39,8 +39,10 @@ mod tests;
 mod text;
 mod thinning;
 mod trajectories;
+mod xy;
 
 pub use error::PlotError;
+pub use xy::{plot_xy, XyChart, XyLine, XyPoint};
 
 use input::{load_run, Run};
 use plotters::coord::Shift;

@@ -1,0 +1,170 @@
+//! A generic x–y figure for tools above the reports (sweeps): lines of points with
+//! vertical error bars, numeric or categorical x, written as PNG and SVG in the house
+//! style (title block, legend panel, fonts, strokes).
+
+use super::legend::{entry, with_legend, Key};
+use super::ranges::{lin_range, sane};
+use super::style::{chart_on, colour, desc_style, label_style, stroke};
+use super::text::{drawable, fit_text};
+use super::{ensure_font, DrawResult, PlotError, FONT, IMAGE_SIZE};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use std::path::{Path, PathBuf};
+
+/// One point: `x`, `y` and its error bar `[lo, hi]` (equal to `y` for none).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct XyPoint {
+    /// Abscissa (the category's index for a categorical axis).
+    pub x: f64,
+    /// Value.
+    pub y: f64,
+    /// Lower end of the error bar.
+    pub lo: f64,
+    /// Upper end of the error bar.
+    pub hi: f64,
+}
+
+/// One series.
+#[derive(Clone, Debug, PartialEq)]
+pub struct XyLine {
+    /// Legend label.
+    pub label: String,
+    /// Points, in x order.
+    pub points: Vec<XyPoint>,
+    /// Join the points by a line (else markers only).
+    pub join: bool,
+}
+
+/// A whole figure.
+#[derive(Clone, Debug, PartialEq)]
+pub struct XyChart {
+    /// First title line.
+    pub title: String,
+    /// Second line (grey).
+    pub subtitle: String,
+    /// X axis description.
+    pub x_label: String,
+    /// Y axis description.
+    pub y_label: String,
+    /// Names of the x categories (x = 0, 1, …), for a categorical axis.
+    pub categories: Option<Vec<String>>,
+    /// Fixed y range (else fitted to the data and error bars).
+    pub y_range: Option<(f64, f64)>,
+    /// The series (colours in order).
+    pub lines: Vec<XyLine>,
+}
+
+/// Draws `chart` into `dir/<stem>.png` and `.svg`; returns both paths.
+pub fn plot_xy(dir: &Path, stem: &str, chart: &XyChart) -> Result<Vec<PathBuf>, PlotError> {
+    ensure_font()?;
+    let draw_err = |path: &Path, e: &dyn std::fmt::Display| PlotError::Draw {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    };
+    let png = dir.join(format!("{stem}.png"));
+    {
+        let root = BitMapBackend::new(&png, IMAGE_SIZE).into_drawing_area();
+        draw(&root, chart, true).map_err(|e| draw_err(&png, &e))?;
+        root.present().map_err(|e| draw_err(&png, &e))?;
+    }
+    let svg = dir.join(format!("{stem}.svg"));
+    {
+        let root = SVGBackend::new(&svg, IMAGE_SIZE).into_drawing_area();
+        draw(&root, chart, false).map_err(|e| draw_err(&svg, &e))?;
+        root.present().map_err(|e| draw_err(&svg, &e))?;
+    }
+    Ok(vec![png, svg])
+}
+
+fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, c: &XyChart, bitmap: bool) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE)?;
+    let (w, _) = root.dim_in_pixel();
+    let centre = Pos::new(HPos::Center, VPos::Center);
+    let title_font = TextStyle::from((FONT, 24).into_font());
+    let title = fit_text(root, &drawable(&c.title, bitmap), &title_font, w - 24)?;
+    root.draw(&Text::new(
+        title,
+        (w as i32 / 2, 24),
+        title_font.color(&BLACK).pos(centre),
+    ))?;
+    let sub_font = TextStyle::from((FONT, 16).into_font());
+    let sub = fit_text(root, &drawable(&c.subtitle, bitmap), &sub_font, w - 24)?;
+    root.draw(&Text::new(
+        sub,
+        (w as i32 / 2, 56),
+        sub_font.color(&RGBColor(80, 80, 80)).pos(centre),
+    ))?;
+    let area = root.split_vertically(80).1;
+
+    let entries: Vec<_> = c
+        .lines
+        .iter()
+        .enumerate()
+        .map(|(i, l)| entry(l.label.clone(), Key::Line(colour(i), 2)))
+        .collect();
+    let plot = with_legend(&area, &entries, bitmap)?;
+    let all = || c.lines.iter().flat_map(|l| l.points.iter());
+    let (x0, x1) = match &c.categories {
+        Some(k) => (-0.5, k.len().max(1) as f64 - 0.5),
+        None => lin_range(all().map(|p| p.x)),
+    };
+    let (y0, y1) = c
+        .y_range
+        .unwrap_or_else(|| lin_range(all().flat_map(|p| [p.y, p.lo, p.hi])));
+    let mut chart = chart_on(&plot).build_cartesian_2d(x0..x1, y0..y1)?;
+    let cats = c.categories.clone().unwrap_or_default();
+    let x_fmt = |x: &f64| {
+        if c.categories.is_none() {
+            return format!("{x}");
+        }
+        let k = x.round();
+        if (x - k).abs() < 1e-6 && k >= 0.0 {
+            cats.get(k as usize).cloned().unwrap_or_default()
+        } else {
+            String::new()
+        }
+    };
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(drawable(&c.x_label, bitmap))
+        .y_desc(drawable(&c.y_label, bitmap))
+        .label_style(label_style())
+        .axis_desc_style(desc_style())
+        .bold_line_style(BLACK.mix(0.12))
+        .light_line_style(BLACK.mix(0.04))
+        .x_label_formatter(&x_fmt);
+    if let Some(k) = &c.categories {
+        mesh.x_labels(k.len() * 4 + 1);
+    }
+    mesh.draw()?;
+    // A small horizontal offset per series keeps overlapping error bars apart.
+    let span = x1 - x0;
+    let nl = c.lines.len().max(1) as f64;
+    for (i, l) in c.lines.iter().enumerate() {
+        let col = colour(i);
+        let dx = span * 0.006 * (i as f64 - (nl - 1.0) / 2.0);
+        let pts: Vec<(f64, f64)> = l
+            .points
+            .iter()
+            .filter(|p| sane(p.x) && sane(p.y))
+            .map(|p| (p.x + dx, p.y))
+            .collect();
+        if l.join {
+            stroke(chart.plotting_area(), &pts, col, 2, false, bitmap)?;
+        }
+        for p in l.points.iter().filter(|p| sane(p.x) && sane(p.y)) {
+            let x = p.x + dx;
+            if sane(p.lo) && sane(p.hi) && p.hi > p.lo {
+                chart.draw_series(std::iter::once(PathElement::new(
+                    vec![(x, p.lo), (x, p.hi)],
+                    col.stroke_width(1),
+                )))?;
+            }
+            chart.draw_series(std::iter::once(Circle::new((x, p.y), 4, col.filled())))?;
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,505 @@
+//! A checked sweep: the base scenario resolved, every axis and point validated against it,
+//! the points laid out (grid or random), and each run's seed derived.
+
+use super::error::{SweepError, INVALID, SCHEMA};
+use super::spec::{AxisSpec, PerturbationSpec, Sampling, SweepFile, SweepSource};
+use crate::api;
+use crate::model::Model;
+use crate::scenario::Source;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// The axis key that varies the initial-shape perturbation instead of a scenario field.
+pub const PERTURBATION: &str = "perturbation";
+/// Most points a sweep may have.
+pub const MAX_POINTS: u64 = 1_000_000;
+/// Most runs a sweep may have.
+pub const MAX_JOBS: u64 = 1_000_000_000;
+
+/// The scenario every run starts from.
+#[derive(Clone, Debug)]
+pub struct Base {
+    /// Where it came from (file path or `builtin:<name>`).
+    pub label: String,
+    /// Its TOML text (read once).
+    pub text: String,
+    /// Overrides applied to every run (`[base].set`).
+    pub set: Vec<String>,
+}
+
+/// The checked perturbation: fraction (unless an axis gives it), rotation, reference.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Perturb {
+    /// Largest displacement / reference size, when no axis sets it.
+    pub fraction: f64,
+    /// Random rotation about the centroid.
+    pub rotate: bool,
+    /// Reference positions (agent order); `None`: the scenario's initial positions.
+    pub shape: Option<Vec<[f64; 2]>>,
+}
+
+/// A sweep ready to run.
+#[derive(Clone, Debug)]
+pub struct Plan {
+    /// Name (output folder `out/sweeps/<name>/`).
+    pub name: String,
+    /// Free text.
+    pub description: String,
+    /// The sweep file (or `builtin:<name>`).
+    pub label: String,
+    /// Sweep seed.
+    pub seed: u64,
+    /// Runs per point.
+    pub runs: u64,
+    /// Grid or random.
+    pub sampling: Sampling,
+    /// The base scenario.
+    pub base: Base,
+    /// Initial-shape perturbation, if any.
+    pub perturbation: Option<Perturb>,
+    /// Axis keys, in file order.
+    pub axes: Vec<String>,
+    /// Each point's value on each axis.
+    pub points: Vec<Vec<toml::Value>>,
+    /// Hash of the sweep text, the base text, seed and runs (shards must agree).
+    pub fingerprint: String,
+}
+
+/// `splitmix64` (Steele, Lea & Flood 2014): a fixed, portable 64-bit mixer.
+fn mix(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// The seed of run `run` at point `point`: `mix(mix(mix(seed) ^ point) ^ run) >> 1` (below
+/// 2⁶³: TOML integers are signed). Independent of threads and shards.
+pub fn run_seed(seed: u64, point: u64, run: u64) -> u64 {
+    mix(mix(mix(seed) ^ point) ^ run) >> 1
+}
+
+/// FNV-1a, 64 bits, as 16 hex digits (identifies a sweep, not a security hash).
+fn fingerprint(parts: &[&str]) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for p in parts {
+        for b in p.bytes().chain([0u8]) {
+            h ^= u64::from(b);
+            h = h.wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    format!("{h:016x}")
+}
+
+/// An axis' values in the cells of `runs.csv` (strings without quotes).
+pub fn cell(v: &toml::Value) -> String {
+    match v {
+        toml::Value::String(s) => s.clone(),
+        other => other.to_string(),
+    }
+}
+
+impl Plan {
+    /// Reads, parses and checks a sweep (a file or a built-in name); `runs` replaces the
+    /// file's runs per point.
+    pub fn load(arg: &str, runs: Option<u64>) -> Result<Self, SweepError> {
+        let source = SweepSource::resolve(arg)?;
+        Self::from_source(&source, runs)
+    }
+
+    /// Parses and checks a sweep's text.
+    pub fn from_source(source: &SweepSource, runs: Option<u64>) -> Result<Self, SweepError> {
+        let file = source.parse()?;
+        check(source, file, runs)
+    }
+
+    /// Total number of runs.
+    pub fn jobs(&self) -> u64 {
+        self.points.len() as u64 * self.runs
+    }
+
+    /// Point and run index of job `j` (point-major order).
+    pub fn job(&self, j: u64) -> (usize, u64) {
+        ((j / self.runs) as usize, j % self.runs)
+    }
+
+    /// The perturbation fraction at point `p` (its axis, else the section's).
+    pub fn fraction(&self, p: usize) -> Option<f64> {
+        let base = self.perturbation.as_ref()?.fraction;
+        Some(
+            self.axes
+                .iter()
+                .position(|k| k == PERTURBATION)
+                .and_then(|i| number(&self.points[p][i]))
+                .unwrap_or(base),
+        )
+    }
+
+    /// The overrides of point `p` (without perturbation) and, with `seed`, the run seed.
+    pub fn overrides(&self, p: usize, seed: Option<u64>) -> Vec<String> {
+        let mut v = self.base.set.clone();
+        for (k, x) in self.axes.iter().zip(&self.points[p]) {
+            if k != PERTURBATION {
+                v.push(format!("{k}={x}"));
+            }
+        }
+        if let Some(s) = seed {
+            v.push(format!("seed={s}"));
+        }
+        v
+    }
+
+    /// Loads the base scenario with `overrides`.
+    pub fn model(&self, overrides: &[String]) -> Result<Model, crate::ScenarioErrors> {
+        api::load_toml(&self.base.text, &self.base.label, overrides)
+    }
+}
+
+fn number(v: &toml::Value) -> Option<f64> {
+    match v {
+        toml::Value::Float(x) => Some(*x),
+        toml::Value::Integer(i) => Some(*i as f64),
+        _ => None,
+    }
+}
+
+fn check(src: &SweepSource, f: SweepFile, runs: Option<u64>) -> Result<Plan, SweepError> {
+    let file = src.label.as_str();
+    let bad = |field: &str, reason: String| Err(SweepError::new(INVALID, file, field, reason));
+    let runs = runs.unwrap_or(f.runs);
+    if !(1..=MAX_JOBS).contains(&runs) {
+        return bad("runs", format!("must be 1 to {MAX_JOBS}, got {runs}"));
+    }
+    let base = resolve_base(src, &f)?;
+    let model = api::load_toml(&base.text, &base.label, &base.set).map_err(|e| {
+        let field = if base.set.is_empty() {
+            "base.scenario"
+        } else {
+            "base.set"
+        };
+        SweepError::scenario(file, field, "with [base]", &e)
+    })?;
+    let perturbation = f
+        .perturbation
+        .as_ref()
+        .map(|p| check_perturbation(file, p, &model))
+        .transpose()?;
+    let axes = check_axes(src, &f, perturbation.is_some())?;
+    let points = lay_out(file, &f, &axes)?;
+    let keys: Vec<String> = f.axes.iter().map(|a| a.key.clone()).collect();
+    let plan = Plan {
+        name: f.name.clone().unwrap_or_else(|| src.default_name.clone()),
+        description: f.description.clone().unwrap_or_default(),
+        label: src.label.clone(),
+        seed: f.seed,
+        runs,
+        sampling: f.sampling,
+        fingerprint: fingerprint(&[
+            &src.text,
+            &base.text,
+            &f.seed.to_string(),
+            &runs.to_string(),
+        ]),
+        base,
+        perturbation,
+        axes: keys,
+        points,
+    };
+    if plan.jobs() > MAX_JOBS {
+        return bad(
+            "runs",
+            format!("{} runs in all, more than {MAX_JOBS}", plan.jobs()),
+        );
+    }
+    check_points(&plan)?;
+    Ok(plan)
+}
+
+fn resolve_base(src: &SweepSource, f: &SweepFile) -> Result<Base, SweepError> {
+    let file = src.label.as_str();
+    if f.base.design.is_some() {
+        // The hook for a design generator as the base: `host_sim::design` renders a
+        // scenario's TOML from a generator; the sweep would take that text here.
+        return Err(SweepError::new(
+            SCHEMA,
+            file,
+            "base.design",
+            "a design generator as the base is not supported yet: render it with \
+             `host-sim design` and give the file as `scenario`",
+        ));
+    }
+    let Some(name) = &f.base.scenario else {
+        return Err(SweepError::new(
+            SCHEMA,
+            file,
+            "base.scenario",
+            "missing: a scenario file or built-in name",
+        ));
+    };
+    let near = src
+        .dir
+        .as_ref()
+        .map(|d| d.join(name))
+        .filter(|p| p.is_file());
+    let source = match near {
+        Some(p) => Source::from_file(&p),
+        None => Source::resolve(name),
+    }
+    .map_err(|e| SweepError::new(e.kind.exit_code(), file, "base.scenario", e.reason))?;
+    Ok(Base {
+        label: source.label,
+        text: source.text,
+        set: f.base.set.clone(),
+    })
+}
+
+fn check_perturbation(
+    file: &str,
+    p: &PerturbationSpec,
+    model: &Model,
+) -> Result<Perturb, SweepError> {
+    let bad = |field: &str, reason: String| Err(SweepError::new(INVALID, file, field, reason));
+    if !(p.fraction.is_finite() && (0.0..=1.0).contains(&p.fraction)) {
+        return bad(
+            "perturbation.fraction",
+            format!("must be in [0, 1], got {}", p.fraction),
+        );
+    }
+    if let Some(s) = &p.shape {
+        if s.len() != model.n() {
+            return bad(
+                "perturbation.shape",
+                format!(
+                    "has {} positions, the scenario {} agents",
+                    s.len(),
+                    model.n()
+                ),
+            );
+        }
+        if s.iter().flatten().any(|x| !x.is_finite()) {
+            return bad(
+                "perturbation.shape",
+                "every coordinate must be finite".to_owned(),
+            );
+        }
+    }
+    let out = Perturb {
+        fraction: p.fraction,
+        rotate: p.rotate,
+        shape: p.shape.clone(),
+    };
+    super::perturb::positions(model, &out, 0.0, 0)
+        .map_err(|reason| SweepError::new(INVALID, file, "perturbation.shape", reason))?;
+    Ok(out)
+}
+
+/// Each axis' values: a list, or a range (grid: `steps` evenly spaced values).
+enum Values {
+    List(Vec<toml::Value>),
+    Range(f64, f64),
+}
+
+fn check_axes(
+    src: &SweepSource,
+    f: &SweepFile,
+    perturbed: bool,
+) -> Result<Vec<Values>, SweepError> {
+    let file = src.label.as_str();
+    let bad = |field: String, reason: String| Err(SweepError::new(INVALID, file, &field, reason));
+    let mut out = Vec::new();
+    for (i, a) in f.axes.iter().enumerate() {
+        let field = |x: &str| format!("axes[{i}].{x}");
+        check_key(file, i, a, f, perturbed)?;
+        let values = match (&a.values, a.from, a.to) {
+            (Some(v), None, None) if a.steps.is_none() => {
+                if v.is_empty() {
+                    return bad(field("values"), "must not be empty".to_owned());
+                }
+                Values::List(v.clone())
+            }
+            (None, Some(lo), Some(hi)) => {
+                if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+                    return bad(
+                        field("to"),
+                        format!("needs finite from ≤ to, got {lo} and {hi}"),
+                    );
+                }
+                match (f.sampling, a.steps) {
+                    (Sampling::Grid, Some(n)) if (2..=MAX_POINTS).contains(&n) => Values::List(
+                        (0..n)
+                            .map(|k| toml::Value::Float(lo + (hi - lo) * k as f64 / (n - 1) as f64))
+                            .collect(),
+                    ),
+                    (Sampling::Grid, _) => {
+                        return bad(
+                            field("steps"),
+                            "a range on a grid needs steps ≥ 2".to_owned(),
+                        )
+                    }
+                    (Sampling::Random, None) => Values::Range(lo, hi),
+                    (Sampling::Random, Some(_)) => {
+                        return bad(
+                            field("steps"),
+                            "random sampling draws from the range: no steps".to_owned(),
+                        )
+                    }
+                }
+            }
+            _ => {
+                return bad(
+                    format!("axes[{i}]"),
+                    "give either `values = [...]` or `from`, `to` (and `steps` on a grid)"
+                        .to_owned(),
+                )
+            }
+        };
+        if a.key == PERTURBATION {
+            let ok = |v: &toml::Value| number(v).is_some_and(|x| (0.0..=1.0).contains(&x));
+            let fine = match &values {
+                Values::List(v) => v.iter().all(ok),
+                Values::Range(lo, hi) => (0.0..=1.0).contains(lo) && (0.0..=1.0).contains(hi),
+            };
+            if !fine {
+                return bad(
+                    field("values"),
+                    "perturbation fractions must be numbers in [0, 1]".to_owned(),
+                );
+            }
+        }
+        out.push(values);
+    }
+    Ok(out)
+}
+
+fn check_key(
+    file: &str,
+    i: usize,
+    a: &AxisSpec,
+    f: &SweepFile,
+    perturbed: bool,
+) -> Result<(), SweepError> {
+    let field = format!("axes[{i}].key");
+    let bad = |reason: String| Err(SweepError::new(INVALID, file, &field, reason));
+    let key = a.key.trim();
+    if key.is_empty() || key.split('.').any(str::is_empty) {
+        return bad(format!("`{}` is not a dotted key (e.g. radio.loss)", a.key));
+    }
+    if key == "seed" {
+        return bad("the seed is not an axis: every run's seed derives from the sweep's `seed` (use `runs`)".to_owned());
+    }
+    if key == PERTURBATION && !perturbed {
+        return bad("the perturbation axis needs a [perturbation] section".to_owned());
+    }
+    if let Some(j) = f.axes[..i].iter().position(|b| b.key.trim() == key) {
+        return bad(format!("`{key}` is already axes[{j}]"));
+    }
+    Ok(())
+}
+
+fn lay_out(
+    file: &str,
+    f: &SweepFile,
+    axes: &[Values],
+) -> Result<Vec<Vec<toml::Value>>, SweepError> {
+    match f.sampling {
+        Sampling::Grid => {
+            if f.points.is_some() {
+                return Err(SweepError::new(
+                    INVALID,
+                    file,
+                    "points",
+                    "only for sampling = \"random\" (a grid has every combination)",
+                ));
+            }
+            let mut points: Vec<Vec<toml::Value>> = vec![Vec::new()];
+            for a in axes {
+                let Values::List(vs) = a else { continue };
+                if points.len() as u64 * vs.len() as u64 > MAX_POINTS {
+                    return Err(SweepError::new(
+                        INVALID,
+                        file,
+                        "axes",
+                        format!("more than {MAX_POINTS} points"),
+                    ));
+                }
+                points = points
+                    .into_iter()
+                    .flat_map(|p| {
+                        vs.iter().map(move |v| {
+                            let mut q = p.clone();
+                            q.push(v.clone());
+                            q
+                        })
+                    })
+                    .collect();
+            }
+            Ok(points)
+        }
+        Sampling::Random => {
+            let n = match f.points {
+                Some(n) if (1..=MAX_POINTS).contains(&n) => n,
+                other => {
+                    return Err(SweepError::new(
+                        INVALID,
+                        file,
+                        "points",
+                        format!("random sampling needs points = 1 to {MAX_POINTS}, got {other:?}"),
+                    ))
+                }
+            };
+            Ok((0..n)
+                .map(|p| {
+                    let mut rng = ChaCha8Rng::seed_from_u64(run_seed(f.seed, p, u64::MAX));
+                    axes.iter()
+                        .map(|a| match a {
+                            Values::List(v) => v[rng.random_range(0..v.len())].clone(),
+                            Values::Range(lo, hi) => {
+                                toml::Value::Float(lo + (hi - lo) * rng.random::<f64>())
+                            }
+                        })
+                        .collect()
+                })
+                .collect())
+        }
+    }
+}
+
+/// Every point must give a valid scenario: an axis value alone first (the error names
+/// it), then each combination.
+fn check_points(plan: &Plan) -> Result<(), SweepError> {
+    let file = plan.label.as_str();
+    for (i, key) in plan.axes.iter().enumerate() {
+        if key == PERTURBATION {
+            continue;
+        }
+        let mut seen: Vec<&toml::Value> = Vec::new();
+        for p in &plan.points {
+            let v = &p[i];
+            if seen.contains(&v) {
+                continue;
+            }
+            seen.push(v);
+            let mut o = plan.base.set.clone();
+            o.push(format!("{key}={v}"));
+            plan.model(&o).map_err(|e| {
+                SweepError::scenario(
+                    file,
+                    &format!("axes[{i}].values"),
+                    &format!("with {key} = {v}"),
+                    &e,
+                )
+            })?;
+        }
+    }
+    for (p, _) in plan.points.iter().enumerate() {
+        plan.model(&plan.overrides(p, None)).map_err(|e| {
+            SweepError::scenario(
+                file,
+                "axes",
+                &format!("at point {p} ({})", plan.overrides(p, None).join(", ")),
+                &e,
+            )
+        })?;
+    }
+    Ok(())
+}
