@@ -2,6 +2,7 @@
 //! the diagnostics cadence (every control instant and every log instant), logging, and
 //! early stopping on a terminal failure found by [`crate::analysis::Monitor`].
 
+use super::attack::AttackCounts;
 use super::channel::ChannelStats;
 use super::continuous::ContinuousSim;
 use super::error::RunError;
@@ -29,7 +30,11 @@ pub trait Engine {
     fn frame_counts(&self) -> FrameCounts;
     /// Controller counters so far.
     fn control_stats(&self) -> ControlStats;
-    /// The shared channel's counters, if the radio has one.
+    /// Frames each attacker overheard and injected (`[[attacks]]` order; none by default).
+    fn attack_counts(&self) -> Vec<AttackCounts> {
+        Vec::new()
+    }
+    /// The shared channel's counters, if there is one.
     fn channel_stats(&self) -> Option<ChannelStats> {
         None
     }
@@ -182,6 +187,7 @@ pub fn drive(
         frames: engine.frame_counts(),
         control: engine.control_stats(),
         channel: engine.channel_stats(),
+        attacks: engine.attack_counts(),
         warnings,
         steps,
         wall_seconds: started.elapsed().as_secs_f64(),

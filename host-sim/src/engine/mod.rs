@@ -7,6 +7,7 @@
 //! It reads the [`crate::model::Model`] only: nothing here knows the scenario file, the
 //! reports or the command line (`docs/architecture.md`).
 
+pub mod attack;
 pub mod channel;
 pub mod continuous;
 pub mod controller;

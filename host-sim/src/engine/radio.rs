@@ -28,6 +28,8 @@ use std::collections::BinaryHeap;
 const RADIO_STREAM: u64 = 2;
 /// Tolerance on delivery times (s): a frame due at `t + 1e-9` is delivered at `t`.
 const TIME_EPS: f64 = 1e-9;
+/// The sender index of frames from outside the swarm ([`Radio::inject`]).
+const EXTERNAL: usize = u32::MAX as usize;
 
 /// One frame on the air: up to [`MAX_FRAME_LEN`] bytes, stored inline (no heap).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -246,6 +248,28 @@ impl Radio {
         }
     }
 
+    /// A frame from outside the swarm (an attacker, [`super::attack`]) at `now`: one link
+    /// copy to each of `receivers`, with the per-link faults, outside the shared channel.
+    pub fn inject(&mut self, now: f64, receivers: &[usize], bytes: &[u8]) {
+        let frame = RadioFrame::new(bytes);
+        for &to in receivers {
+            self.link_copy(now, now, EXTERNAL, to, frame);
+        }
+    }
+
+    /// A transmission from outside the swarm on the shared channel, starting at `at`
+    /// from `position` (everyone hears it without one): it occupies the medium and
+    /// collides, and is delivered to no one. `false` (nothing done) without a channel.
+    pub fn transmit_external(&mut self, at: f64, position: Option<[f64; 2]>, bytes: &[u8]) -> bool {
+        match &mut self.channel {
+            Some(c) => {
+                c.transmit_external(at, position, bytes.len());
+                true
+            }
+            None => false,
+        }
+    }
+
     /// One link copy of a frame produced at `born` by `from`, off the air at `on_air`:
     /// loss, corruption, latency + jitter, reordering, duplication.
     fn link_copy(&mut self, on_air: f64, born: f64, from: usize, to: usize, frame: RadioFrame) {
@@ -289,7 +313,7 @@ impl Radio {
                 if let Some(inbox) = inboxes.get_mut(f.to as usize) {
                     inbox.push(f.frame);
                     self.stats.delivered += 1;
-                    if let Some(c) = &mut self.channel {
+                    if let (Some(c), false) = (&mut self.channel, f.from as usize == EXTERNAL) {
                         c.heard(f.to as usize, f.from as usize, f.born);
                     }
                 }

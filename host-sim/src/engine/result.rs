@@ -1,5 +1,6 @@
 //! Everything a run found, as the engine hands it to the reports.
 
+use super::attack::AttackCounts;
 use super::channel::ChannelStats;
 use super::hil::LinkStats;
 use super::stats::{ControlStats, FrameCounts};
@@ -51,6 +52,8 @@ pub struct RunResult {
     pub control: ControlStats,
     /// The shared channel's counters (`None` without `[radio.channel]`).
     pub channel: Option<ChannelStats>,
+    /// Frames each attacker overheard and injected (`[[attacks]]` order).
+    pub attacks: Vec<AttackCounts>,
     /// Things the user should know (ignored settings, …).
     pub warnings: Vec<String>,
     /// RK4 steps taken.

@@ -1,6 +1,7 @@
 //! The sampled simulator: controllers at their rate with zero-order hold, frames over the
 //! radio model, the plant integrated by RK4 between ticks.
 
+use super::attack::{AttackCounts, Attacks};
 use super::channel::ChannelStats;
 use super::controller::{AgentController, LocalCore};
 use super::driver::Engine;
@@ -8,9 +9,9 @@ use super::hil::{HilError, LinkStats};
 use super::plant::Plant;
 use super::radio::{Radio, RadioFrame};
 use super::sensors::Sensors;
-use super::stats::{ControlStats, FrameCounts};
+use super::stats::{add_frame_stats, ControlStats, FrameCounts};
 use crate::model::{resolve_estimates, BearingRate, EstimateInfo, Estimator, Model};
-use controller_core::{BearingMeasurement, Measurements, StepOutput, Vec2};
+use controller_core::{BearingMeasurement, FrameStats, Measurements, StepOutput, Vec2};
 
 /// The sampled-data simulator.
 pub struct SampledSim<'m> {
@@ -20,6 +21,7 @@ pub struct SampledSim<'m> {
     pub plant: Plant,
     sensors: Sensors,
     radio: Radio,
+    attacks: Attacks,
     inboxes: Vec<Vec<RadioFrame>>,
     outboxes: Vec<Vec<RadioFrame>>,
     outputs: Vec<Option<StepOutput<f64>>>,
@@ -95,6 +97,7 @@ impl<'m> SampledSim<'m> {
             plant: Plant::new(model),
             sensors: Sensors::new(&model.sensors, model.seed),
             radio,
+            attacks: Attacks::new(model),
             inboxes,
             outboxes: (0..n)
                 .map(|_| Vec::with_capacity(4 * FRAMES_PER_TICK))
@@ -155,6 +158,11 @@ impl Engine for SampledSim<'_> {
         }
         let model = self.model;
         self.radio.observe(&self.plant.q);
+        if !self.attacks.is_empty() {
+            let period = model.dt * model.steps_per_tick as f64;
+            self.attacks
+                .tick(t, period, &self.plant.q, model, &mut self.radio);
+        }
         self.radio.deliver(t, &mut self.inboxes);
         let dt = self.last_tick.map_or(0.0, |p| t - p);
         let exact = model.sensors.bearing_rate == BearingRate::Exact;
@@ -204,6 +212,16 @@ impl Engine for SampledSim<'_> {
             for f in &self.outboxes[i] {
                 self.radio
                     .broadcast(t, i, model.graph.radio.of(i), f.as_bytes());
+                if !self.attacks.is_empty() {
+                    self.attacks.overhear(
+                        t,
+                        i,
+                        f.as_bytes(),
+                        &self.plant.q,
+                        model,
+                        &mut self.radio,
+                    );
+                }
             }
             self.forces[i] = out.force;
             self.stats.record(
@@ -250,11 +268,13 @@ impl Engine for SampledSim<'_> {
             delivered: r.delivered,
             accepted: 0,
             rejected: 0,
+            by_reason: FrameStats::default(),
         };
         for ctl in &self.controllers {
             let s = ctl.frame_stats();
             c.accepted += u64::from(s.accepted);
             c.rejected += u64::from(s.rejected());
+            add_frame_stats(&mut c.by_reason, &s);
         }
         c
     }
@@ -265,6 +285,10 @@ impl Engine for SampledSim<'_> {
 
     fn channel_stats(&self) -> Option<ChannelStats> {
         self.radio.channel_stats()
+    }
+
+    fn attack_counts(&self) -> Vec<AttackCounts> {
+        self.attacks.counts()
     }
 
     fn take_error(&mut self) -> Option<HilError> {

@@ -1,5 +1,7 @@
 //! Counters of a run: frames through the radio and what the controllers did.
 
+use controller_core::FrameStats;
+
 use controller_core::{Fault, Status};
 
 /// Cumulative frame counters of a run (link copies; see `docs/outputs.md`).
@@ -27,6 +29,32 @@ pub struct FrameCounts {
     pub accepted: u64,
     /// Delivered copies the receivers' cores rejected (CRC, stale sequence, …).
     pub rejected: u64,
+    /// The receivers' cores' counters, summed: accepted and rejected by reason.
+    pub by_reason: FrameStats,
+}
+
+/// Adds the counters of `b` to `a` (saturating, as the core counts).
+pub fn add_frame_stats(a: &mut FrameStats, b: &FrameStats) {
+    let FrameStats {
+        accepted,
+        bad_length,
+        bad_crc,
+        unknown_version,
+        mode_mismatch,
+        malformed,
+        unknown_sender,
+        stale,
+        invalid_value,
+    } = *b;
+    a.accepted = a.accepted.saturating_add(accepted);
+    a.bad_length = a.bad_length.saturating_add(bad_length);
+    a.bad_crc = a.bad_crc.saturating_add(bad_crc);
+    a.unknown_version = a.unknown_version.saturating_add(unknown_version);
+    a.mode_mismatch = a.mode_mismatch.saturating_add(mode_mismatch);
+    a.malformed = a.malformed.saturating_add(malformed);
+    a.unknown_sender = a.unknown_sender.saturating_add(unknown_sender);
+    a.stale = a.stale.saturating_add(stale);
+    a.invalid_value = a.invalid_value.saturating_add(invalid_value);
 }
 
 /// What the controllers did over a run.

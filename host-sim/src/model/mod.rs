@@ -5,6 +5,7 @@
 //! Agents are referred to by index (their position in the scenario's `[[agents]]` list);
 //! `AgentModel::id` is the controller-core id used on the wire.
 
+pub mod attack;
 pub mod channel;
 mod core_config;
 mod criteria;
@@ -14,6 +15,7 @@ mod formation;
 pub mod graph;
 mod options;
 
+pub use attack::{AttackKind, AttackModel};
 pub use channel::{Access, ChannelModel, IntegrityMode};
 pub use core_config::{CoreAgent, MT, NB};
 pub use criteria::Criteria;
@@ -75,6 +77,8 @@ pub struct Model {
     pub criteria: Criteria,
     /// Edges and neighbour lists.
     pub graph: Graph,
+    /// Adversaries on the radio (`[[attacks]]`; empty: none).
+    pub attacks: Vec<AttackModel>,
 }
 
 impl Model {

@@ -2,6 +2,7 @@
 //! the summary table and the figures (one file per figure under [`plot`]). They read
 //! what the engine produced and never drive a run (`docs/architecture.md`).
 
+mod attack;
 mod channel;
 mod columns;
 mod csv;

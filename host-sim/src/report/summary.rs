@@ -102,6 +102,7 @@ pub fn summary_json(model: &Model, r: &RunResult, estimates: &[EstimateInfo]) ->
     });
     if let Some(obj) = v.as_object_mut() {
         super::channel::add_json(obj, model, r);
+        super::attack::add_json(obj, model, r);
     }
     // Host-in-the-loop runs only (wall-clock figures would make summaries of the same
     // seed differ).

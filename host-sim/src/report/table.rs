@@ -91,6 +91,7 @@ pub fn summary_table(m: &Model, r: &RunResult, out: &Path, n_files: usize) -> St
         ("saturated outputs", r.control.saturated.to_string()),
     ];
     rows.extend(super::channel::rows(m, r));
+    rows.extend(super::attack::rows(m, r));
     for h in &r.hil {
         rows.push((
             "emulated agent",

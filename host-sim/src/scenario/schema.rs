@@ -2,7 +2,7 @@
 //! (agents, triangles, leader, gains) and the schedule and matrix shorthands. The
 //! run-wide sections are in [`super::settings`].
 
-use super::settings::{ControllerSpec, Integration, RadioSpec, SensorSpec};
+use super::settings::{AttackSpec, ControllerSpec, Integration, RadioSpec, SensorSpec};
 use crate::model::{Criteria, Mode};
 use serde::{Deserialize, Serialize};
 
@@ -219,6 +219,9 @@ pub struct ScenarioFile {
     /// `[criteria]`.
     #[serde(default)]
     pub criteria: Criteria,
+    /// `[[attacks]]`: adversaries on the radio (`docs/attacks.md`).
+    #[serde(default)]
+    pub attacks: Vec<AttackSpec>,
 }
 
 fn default_duration() -> f64 {

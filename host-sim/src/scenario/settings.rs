@@ -168,3 +168,38 @@ impl Default for RadioSpec {
         }
     }
 }
+
+/// `[[attacks]]`: one adversary on the radio (`docs/attacks.md`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AttackSpec {
+    /// `replay`, `forge` or `flood`.
+    pub kind: String,
+    /// Active from (s; default 0).
+    #[serde(default)]
+    pub start: f64,
+    /// Active until (s; default: the end of the run).
+    #[serde(default)]
+    pub end: Option<f64>,
+    /// Where the attacker is (m); default: within reach of every agent.
+    #[serde(default)]
+    pub position: Option<[f64; 2]>,
+    /// `replay`: age of the replayed frames (s; default 1).
+    #[serde(default)]
+    pub delay: Option<f64>,
+    /// `forge`: the id of the agent whose frames are forged.
+    #[serde(default)]
+    pub victim: Option<i64>,
+    /// `forge`: the `γ` written into every angle item (default 5).
+    #[serde(default)]
+    pub gamma: Option<f64>,
+    /// `forge`: the velocity written into the frame (default: the victim's own).
+    #[serde(default)]
+    pub velocity: Option<[f64; 2]>,
+    /// `flood`: frames per second (default 1000).
+    #[serde(default)]
+    pub rate_hz: Option<f64>,
+    /// `flood`: bytes per frame (default 60).
+    #[serde(default)]
+    pub bytes: Option<usize>,
+}

@@ -73,5 +73,6 @@ pub fn strip_model(n: usize, duration: f64) -> Model {
         radio: RadioModel::ideal(),
         criteria: Criteria::default(),
         graph: Graph::new(n, &tri, None),
+        attacks: Vec::new(),
     }
 }

@@ -68,6 +68,9 @@ pub struct Channel {
     superframe: f64,
     order: u64,
     stats: ChannelStats,
+    /// Transmitters outside the swarm (attackers): their positions, `None` = heard by
+    /// everyone. Transmitter `n + k` is `external[k]`.
+    external: Vec<Option<Vec2<f64>>>,
 }
 
 impl Channel {
@@ -92,6 +95,7 @@ impl Channel {
             superframe,
             order: 0,
             stats: ChannelStats::default(),
+            external: Vec::new(),
         }
     }
 
@@ -115,14 +119,43 @@ impl Channel {
     }
 
     fn in_range(&self, a: usize, b: usize) -> bool {
-        match (
-            self.model.range,
-            self.positions.get(a),
-            self.positions.get(b),
-        ) {
-            (Some(r), Some(p), Some(q)) => (*p - *q).norm() <= r,
+        match (self.model.range, self.position(a), self.position(b)) {
+            (Some(r), Some(p), Some(q)) => (p - q).norm() <= r,
             _ => true,
         }
+    }
+
+    /// Where transmitter `i` is: an agent, or an external one with a position.
+    fn position(&self, i: usize) -> Option<Vec2<f64>> {
+        match i.checked_sub(self.positions.len()) {
+            None => self.positions.get(i).copied(),
+            Some(k) => self.external.get(k).copied().flatten(),
+        }
+    }
+
+    /// Puts a transmission from outside the swarm (an attacker) of `len` bytes on the
+    /// air at `start`, from `position` (heard by everyone without one). It collides with
+    /// what overlaps it and is delivered to no one.
+    pub fn transmit_external(&mut self, start: f64, position: Option<[f64; 2]>, len: usize) {
+        let p = position.map(|p| Vec2::new(p[0], p[1]));
+        let k = match self.external.iter().position(|e| *e == p) {
+            Some(k) => k,
+            None => {
+                self.external.push(p);
+                self.external.len() - 1
+            }
+        };
+        let air = self.model.air_time(len);
+        self.order += 1;
+        self.pending.push(Transmission {
+            start,
+            end: start + air,
+            born: start,
+            from: (self.positions.len() + k) as u32,
+            order: self.order,
+            done: false,
+            frame: RadioFrame::new(&[]),
+        });
     }
 
     /// Earliest start on the air (after the turnaround) of a frame of agent `from`
@@ -232,6 +265,13 @@ impl Channel {
                 continue;
             }
             let from = f.from as usize;
+            if from >= self.positions.len() {
+                // From outside the swarm: interference only.
+                if let Some(t) = self.pending.get_mut(k) {
+                    t.done = true;
+                }
+                continue;
+            }
             let mut lost = false;
             for &to in self.neighbours.of(from) {
                 if !self.in_range(from, to) {

@@ -4,6 +4,7 @@
 //! exit code).
 
 mod agents;
+mod attacks;
 mod checker;
 mod comm;
 mod graph;
@@ -38,6 +39,7 @@ pub fn validate(s: &ScenarioFile, file: &str, default_name: &str) -> Result<Mode
     let (triangles, ids_ok) = triangles::check(&mut c, s, &index, margin);
     graph::check(&mut c, s, &agents, &triangles, ids_ok, margin);
     let leader = references::leader(&mut c, s, &index);
+    let attacks = attacks::check(&mut c, s, &index);
     let velocity_reference = c.schedule("velocity_reference", &s.velocity_reference);
     let tri_idx: Vec<[usize; 3]> = triangles.iter().map(|t| t.vertices).collect();
     let graph = Graph::new(agents.len(), &tri_idx, leader.as_ref().map(|l| [l.a, l.b]));
@@ -101,6 +103,7 @@ pub fn validate(s: &ScenarioFile, file: &str, default_name: &str) -> Result<Mode
         },
         criteria: s.criteria.clone(),
         graph,
+        attacks,
     };
     // Last line of defence: the core's own checks (should agree with the above).
     let mut core_errors = Vec::new();

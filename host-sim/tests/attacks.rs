@@ -1,0 +1,164 @@
+//! Issue 10 §3: adversaries on the radio (`[[attacks]]`, docs/attacks.md), on the paper
+//! formation.
+//!
+//! * With `crc16` integrity a forger of agent 3 (the apex of φ1 and φ2) takes over its
+//!   frames (its own next frames then look like replays) and pulls the formation out of
+//!   its square.
+//! * Replayed frames are refused by the sequence numbers: the run is the clean one.
+//! * A flood on a shared channel costs the agents frames to collisions, and the summary
+//!   shows it.
+//! * Bad `[[attacks]]` entries get errors naming the file, the field and the reason.
+
+use host_sim::{load_toml, Model, Outcome, RunResult, Simulation};
+
+const PAPER: &str = include_str!("../scenarios/paper.toml");
+
+fn model(extra: &str) -> Model {
+    load_toml(&format!("{PAPER}\n{extra}"), "paper-attacked", &[]).expect("valid scenario")
+}
+
+fn run(m: &Model) -> RunResult {
+    Simulation::new(m).run().expect("run").result
+}
+
+/// Largest difference of the relative positions `q_i − q_1` of two runs (m): the shape,
+/// whatever the translation along `v*`.
+fn shape_difference(a: &RunResult, b: &RunResult) -> f64 {
+    let (p, q) = (&a.final_positions, &b.final_positions);
+    let mut worst = 0.0f64;
+    for i in 1..p.len() {
+        for k in 0..2 {
+            worst = worst.max(((p[i][k] - p[0][k]) - (q[i][k] - q[0][k])).abs());
+        }
+    }
+    worst
+}
+
+const FORGE: &str = r#"
+[[attacks]]
+kind = "forge"
+victim = 3
+gamma = 5.0
+start = 10.0
+"#;
+
+#[test]
+fn forged_frames_with_crc16_pull_the_formation_out_of_shape() {
+    let clean = run(&model(""));
+    assert_eq!(clean.outcome, Outcome::Converged, "{}", clean.reason);
+    let m = model(FORGE);
+    let r = run(&m);
+    let d = shape_difference(&r, &clean);
+    println!(
+        "forge (crc16): outcome {}, shape {d:.3} m from the clean run, {:?}",
+        r.outcome.as_str(),
+        r.frames.by_reason
+    );
+    assert_ne!(r.outcome, Outcome::Converged, "{}", r.reason);
+    assert!(d > 1.0, "the forged run ends {d} m from the clean shape");
+    // One forgery per broadcast of agent 3 from t = 10 s (100 Hz): 9,000.
+    assert_eq!(r.attacks.len(), 1);
+    assert_eq!(r.attacks[0].injected, 9000);
+    // The forgeries carry a valid CRC: the agents accept them and refuse agent 3's own
+    // frames as stale (3 neighbours each).
+    assert_eq!(r.frames.by_reason.bad_crc, 0);
+    assert!(
+        r.frames.by_reason.stale >= 3 * 8990,
+        "{:?}",
+        r.frames.by_reason
+    );
+    let summary = Simulation::new(&m).run().expect("run").summary_json(&m);
+    assert_eq!(summary["attacks"][0]["kind"], "forge");
+    assert_eq!(summary["attacks"][0]["victim"], 3);
+    assert!(summary["frames_rejected_by_reason"]["stale_sequence"].as_u64() > Some(0));
+}
+
+#[test]
+fn replayed_frames_are_refused_and_change_nothing() {
+    let clean = run(&model(""));
+    let r = run(&model(
+        "[[attacks]]\nkind = \"replay\"\ndelay = 0.5\nstart = 5.0\nend = 80.0\n",
+    ));
+    assert_eq!(r.outcome, Outcome::Converged, "{}", r.reason);
+    // Rejected frames change no state: the very same run.
+    assert_eq!(r.final_positions, clean.final_positions);
+    assert_eq!(r.settle_time, clean.settle_time);
+    let injected = r.attacks[0].injected;
+    assert!(injected > 20_000, "{injected}");
+    // Every replayed copy (3 receivers per frame in the paper graph) is refused as stale.
+    assert_eq!(r.frames.rejected, r.frames.by_reason.stale as u64);
+    assert!(r.frames.by_reason.stale as u64 >= 2 * injected);
+}
+
+#[test]
+fn a_flood_on_the_shared_channel_costs_frames_to_collisions() {
+    let channel = "[radio.channel]\npreset = \"crazyflie\"\naccess = \"tdma\"\n";
+    let clean = run(&model(channel));
+    let flood =
+        "[[attacks]]\nkind = \"flood\"\nrate_hz = 4000\nbytes = 60\nstart = 10.0\nend = 20.0\n";
+    let m = model(&format!("{channel}\n{flood}"));
+    let r = run(&m);
+    let (c0, c1) = (clean.channel.expect("channel"), r.channel.expect("channel"));
+    println!(
+        "tdma: collided copies {} clean, {} flooded; outcome {}",
+        c0.collided,
+        c1.collided,
+        r.outcome.as_str()
+    );
+    assert_eq!(c0.collided, 0, "tdma alone never collides");
+    assert!(c1.collided > 1000, "{}", c1.collided);
+    assert_eq!(r.attacks[0].injected, 40_000);
+    // Flood frames are never delivered: nothing was rejected, only lost.
+    assert_eq!(r.frames.rejected, 0);
+    let summary = Simulation::new(&m).run().expect("run").summary_json(&m);
+    assert_eq!(summary["attacks"][0]["kind"], "flood");
+    assert_eq!(summary["attacks"][0]["frames_injected"], 40_000);
+    assert_eq!(
+        summary["channel"]["collided_copies"].as_u64(),
+        Some(c1.collided)
+    );
+}
+
+#[test]
+fn bad_attack_entries_name_file_field_and_reason() {
+    let cases = [
+        (
+            "[[attacks]]\nkind = \"jam\"\n",
+            "attacks[0].kind",
+            "unknown attack",
+        ),
+        (
+            "[[attacks]]\nkind = \"forge\"\n",
+            "attacks[0].victim",
+            "needs the id",
+        ),
+        (
+            "[[attacks]]\nkind = \"forge\"\nvictim = 9\n",
+            "attacks[0].victim",
+            "no agent has id 9",
+        ),
+        (
+            "[[attacks]]\nkind = \"replay\"\ngamma = 1.0\n",
+            "attacks[0].gamma",
+            "only a `forge` attack",
+        ),
+        (
+            "[[attacks]]\nkind = \"flood\"\nbytes = 61\n",
+            "attacks[0].bytes",
+            "1 to 60",
+        ),
+        (
+            "[[attacks]]\nkind = \"flood\"\nstart = 50.0\nend = 40.0\n",
+            "attacks[0].end",
+            "after start",
+        ),
+    ];
+    for (extra, field, reason) in cases {
+        let e = load_toml(&format!("{PAPER}\n{extra}"), "bad.toml", &[])
+            .expect_err(extra)
+            .to_string();
+        assert!(e.contains("bad.toml"), "{e}");
+        assert!(e.contains(field), "{extra}: {e}");
+        assert!(e.contains(reason), "{extra}: {e}");
+    }
+}
