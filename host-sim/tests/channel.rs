@@ -197,3 +197,28 @@ fn twenty_agents_on_one_crazyflie_channel() {
     assert!(c.utilisation(r.final_time) > 0.3);
     assert_eq!(r.frames.dropped, c.collided);
 }
+
+#[test]
+fn every_agent_gets_the_swarm_integrity_and_its_broadcast_phase() {
+    let m = model(
+        &strip20(),
+        &["controller.comm_rate_hz=25", "controller.integrity=link"],
+    );
+    for i in 0..m.n() {
+        let c = m.agent_config(i).expect("config");
+        assert_eq!(c.integrity, controller_core::Integrity::Link);
+        assert_eq!((c.comm_every, c.comm_phase), (4, (i % 4) as u16));
+        // The emulated firmware's configuration carries the same (host-in-the-loop).
+        let t = host_sim::engine::hil::target_config(&m, i).expect("target");
+        assert_eq!(
+            (t.integrity, t.comm_every, t.comm_phase),
+            (c.integrity, 4, c.comm_phase)
+        );
+    }
+    let m = model("paper", &[]);
+    let c = m.agent_config(0).expect("config");
+    assert_eq!(
+        (c.integrity, c.comm_every, c.comm_phase),
+        (controller_core::Integrity::Crc16, 1, 0)
+    );
+}

@@ -51,6 +51,9 @@ pub fn target_config(model: &Model, i: usize) -> Result<AgentConfig<f32, TARGET_
             })?;
     }
     t.estimator = c.estimator;
+    t.integrity = c.integrity;
+    t.comm_every = c.comm_every;
+    t.comm_phase = c.comm_phase;
     t.initial_estimate = f(c.initial_estimate);
     t.min_estimate = f(c.min_estimate);
     t.friction = c.friction.map(f);
