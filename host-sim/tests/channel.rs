@@ -222,3 +222,39 @@ fn every_agent_gets_the_swarm_integrity_and_its_broadcast_phase() {
         (controller_core::Integrity::Crc16, 1, 0)
     );
 }
+
+#[test]
+fn the_summary_table_shows_the_channel_only_when_used() {
+    let out = std::path::Path::new("out");
+    let m = model(
+        "paper",
+        &[
+            "radio.channel.preset=crazyflie",
+            "radio.channel.access=aloha",
+            "controller.comm_rate_hz=50",
+            "duration=3.0",
+        ],
+    );
+    let r = run(&m);
+    let c = r.channel.expect("channel");
+    let text = host_sim::report::summary_table(&m, &r, out, 0);
+    for row in [
+        "broadcast",
+        "every 2 tick(s) (0.0200 s), integrity crc16",
+        "aloha (crazyflie), 2000000 bit/s, 11.125 bytes overhead, 130 µs turnaround",
+        "air time / utilisation",
+        "lost to collisions",
+        &format!(
+            "{} copies ({} of {} transmissions)",
+            c.collided, c.collided_transmissions, c.transmissions
+        ),
+        "neighbour data age",
+    ] {
+        assert!(text.contains(row), "no `{row}` in\n{text}");
+    }
+    let m = model("paper", &["duration=1.0"]);
+    let text = host_sim::report::summary_table(&m, &run(&m), out, 0);
+    for row in ["broadcast", "channel", "collisions", "neighbour data age"] {
+        assert!(!text.contains(row), "`{row}` in\n{text}");
+    }
+}
