@@ -235,3 +235,50 @@ fn hidden_terminals_collide_at_the_receiver_that_hears_both() {
     assert_eq!(inboxes[2].len(), 1);
     assert_eq!(r.channel_stats().expect("channel").collided, 2);
 }
+
+/// Inspections per link copy of a strip of `n` agents (each hears ≤ 4 neighbours on
+/// the radio graph, everyone on the medium) over `ticks` ticks.
+fn inspected_per_copy(range: Option<f64>, n: usize, ticks: usize) -> f64 {
+    let m = crate::scenario::strip_model(n, 1.0);
+    let mut c = channel(Access::Aloha, 2e5);
+    c.range = range;
+    let graph = &m.graph.radio;
+    let mut r = Radio::new(&radio(c), n, 1, 1024);
+    r.attach_channel(graph, PERIOD);
+    let q: Vec<Vec2<f64>> = m
+        .agents
+        .iter()
+        .map(|a| Vec2::new(a.position[0], a.position[1]))
+        .collect();
+    r.observe(&q);
+    let mut inboxes: Vec<Vec<RadioFrame>> = vec![Vec::new(); n];
+    for k in 0..ticks {
+        let t = k as f64 * PERIOD;
+        r.deliver(t, &mut inboxes);
+        inboxes.iter_mut().for_each(Vec::clear);
+        for i in 0..n {
+            if k % (n / 20).max(1) == i % (n / 20).max(1) {
+                r.broadcast(t, i, graph.of(i), &[7; 30]);
+            }
+        }
+    }
+    let s = r.channel_stats().expect("channel");
+    assert!(s.transmissions > 0);
+    s.inspected as f64 / r.stats().sent as f64
+}
+
+#[test]
+fn the_collision_check_costs_the_same_per_copy_for_100_and_2000_agents() {
+    // ALOHA at 200 kbit/s (1.9 ms frames); each agent broadcasts every n/20 ticks, so
+    // the medium carries the same load (20 frames per 10 ms tick, overloaded) for every
+    // n. Comparing each copy with every transmission would make the larger swarm's
+    // inspections per copy ~20× larger. Everyone hears everyone, and a 2 m range (the
+    // check then also skips overlapping transmissions the receiver does not hear).
+    for range in [None, Some(2.0)] {
+        let small = inspected_per_copy(range, 100, 400);
+        let large = inspected_per_copy(range, 2000, 400);
+        eprintln!("range {range:?}: {small:.3} → {large:.3} inspections per copy");
+        assert!(small > 0.5, "{range:?}: the check did no work: {small}");
+        assert!(large < 1.5 * small, "{range:?}: {small} → {large}");
+    }
+}
