@@ -2,7 +2,7 @@
 
 use crate::engine::channel::ChannelStats;
 use crate::engine::radio::{Radio, RadioFrame, RadioStats};
-use crate::model::graph::Adjacency;
+use crate::model::graph::{strip_triangles, Adjacency, Graph};
 use crate::model::{Access, ChannelModel, RadioModel};
 use controller_core::Vec2;
 
@@ -239,16 +239,16 @@ fn hidden_terminals_collide_at_the_receiver_that_hears_both() {
 /// Inspections per link copy of a strip of `n` agents (each hears ≤ 4 neighbours on
 /// the radio graph, everyone on the medium) over `ticks` ticks.
 fn inspected_per_copy(range: Option<f64>, n: usize, ticks: usize) -> f64 {
-    let m = crate::scenario::strip_model(n, 1.0);
+    // The strip of `scenario::strip_model`: triangles (i, i+1, i+2), 0.5 m apart.
+    let g = Graph::new(n, &strip_triangles(n), None);
+    let graph = &g.radio;
     let mut c = channel(Access::Aloha, 2e5);
     c.range = range;
-    let graph = &m.graph.radio;
     let mut r = Radio::new(&radio(c), n, 1, 1024);
     r.attach_channel(graph, PERIOD);
-    let q: Vec<Vec2<f64>> = m
-        .agents
-        .iter()
-        .map(|a| Vec2::new(a.position[0], a.position[1]))
+    let h = 3f64.sqrt() / 2.0;
+    let q: Vec<Vec2<f64>> = (0..n)
+        .map(|i| Vec2::new(0.5 * i as f64, h * (i % 2) as f64))
         .collect();
     r.observe(&q);
     let mut inboxes: Vec<Vec<RadioFrame>> = vec![Vec::new(); n];
