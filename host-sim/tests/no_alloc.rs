@@ -153,3 +153,27 @@ fn sampled_and_continuous_loops_do_not_allocate() {
     let n = allocations(|| sim.advance_ticks(0.2, 50));
     assert_eq!(n, 0);
 }
+
+#[test]
+fn the_shared_channel_does_not_allocate() {
+    // Faults on top of a channel (ALOHA with collisions, and TDMA), 20 agents.
+    let path = format!("{}/scenarios/strip20.toml", env!("CARGO_MANIFEST_DIR"));
+    for access in ["aloha", "tdma"] {
+        let o: Vec<String> = [
+            "radio.channel.preset=crazyflie".to_owned(),
+            format!("radio.channel.access={access}"),
+            "radio.channel.range=6".to_owned(),
+            "radio.loss=0.1".to_owned(),
+            "radio.latency=0.003".to_owned(),
+            "radio.jitter=0.002".to_owned(),
+            "controller.comm_rate_hz=50".to_owned(),
+        ]
+        .to_vec();
+        let m = load(&path, &o).expect("strip20");
+        let mut sim = SampledSim::new(&m).expect("sim");
+        sim.advance_ticks(0.0, 200);
+        let n = allocations(|| sim.advance_ticks(2.0, 300));
+        assert_eq!(n, 0, "{access}: {n} allocations in 300 ticks");
+        assert!(sim.channel_stats().expect("channel").transmissions > 0);
+    }
+}

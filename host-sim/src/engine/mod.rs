@@ -1,5 +1,6 @@
 //! The engine: everything that moves during a run. The plant (S1, RK4), each agent's
-//! sensors, the radio between agents, the agents' controllers (in process, or as
+//! sensors, the radio between agents (per-link faults, and optionally one shared
+//! medium: [`channel`]), the agents' controllers (in process, or as
 //! firmware in QEMU: [`hil`]), the sampled and continuous simulators, and the driver's
 //! time loop that advances them, consults [`crate::analysis`] and hands each logged
 //! instant to a [`Recorder`].

@@ -218,22 +218,25 @@ impl Channel {
     }
 
     /// Whether the copy of transmission `k` to `to` is lost to an overlapping one that
-    /// `to` hears (or sends itself). `pending` is sorted by start.
-    fn collides(&self, k: usize, to: usize) -> bool {
+    /// `to` hears (or sends itself), and how many transmissions were inspected.
+    /// `pending` is sorted by start.
+    fn collides(&self, k: usize, to: usize) -> (bool, u64) {
         let Some(f) = self.pending.get(k) else {
-            return false;
+            return (false, 0);
         };
         let hears = |g: &Transmission| {
             let from = g.from as usize;
             from == to || self.in_range(to, from)
         };
+        let mut seen = 0;
         let earlier = self.pending.get(..k).unwrap_or(&[]);
         for g in earlier.iter().rev() {
             if g.start < f.start - self.max_air - EPS {
                 break;
             }
+            seen += 1;
             if g.end > f.start + EPS && hears(g) {
-                return true;
+                return (true, seen);
             }
         }
         let later = self.pending.get(k + 1..).unwrap_or(&[]);
@@ -241,11 +244,12 @@ impl Channel {
             if g.start >= f.end - EPS {
                 break;
             }
+            seen += 1;
             if hears(g) {
-                return true;
+                return (true, seen);
             }
         }
-        false
+        (false, seen)
     }
 
     /// Resolves every transmission that has ended by `now`: each copy to a radio
@@ -276,7 +280,11 @@ impl Channel {
             for &to in self.neighbours.of(from) {
                 if !self.in_range(from, to) {
                     self.stats.out_of_range += 1;
-                } else if self.collides(k, to) {
+                    continue;
+                }
+                let (collided, seen) = self.collides(k, to);
+                self.stats.inspected += seen;
+                if collided {
                     self.stats.collided += 1;
                     lost = true;
                 } else {

@@ -26,6 +26,10 @@ pub struct ChannelStats {
     pub max_age: f64,
     /// Number of (tick, link) age samples.
     pub age_samples: u64,
+    /// Other transmissions the collision check inspected, over all copies: the
+    /// resolver's work (deterministic; stays proportional to the copies when the
+    /// cost is linear).
+    pub inspected: u64,
 }
 
 impl ChannelStats {

@@ -68,6 +68,13 @@ pub(super) fn comm_every(c: &mut Checker<'_>, s: &ScenarioFile, period: f64) -> 
 /// The shared medium of `[radio.channel]`, if any; `period` is the control period (s).
 pub(super) fn channel(c: &mut Checker<'_>, s: &ScenarioFile, period: f64) -> Option<ChannelModel> {
     let ch = s.radio.channel.as_ref()?;
+    if s.radio.bandwidth != 0.0 {
+        c.err(
+            InvalidValue,
+            "radio.bandwidth",
+            "not used with [radio.channel] (the channel's bit rate limits the air time); remove one",
+        );
+    }
     let (mut bit_rate, mut overhead, mut turnaround) = (None, 0.0, 0.0);
     let preset = match ch.preset.as_deref() {
         None => "custom",

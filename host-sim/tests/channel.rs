@@ -1,0 +1,292 @@
+//! Issue 9 §2 and §3: broadcasting every k-th control tick, and the shared radio channel
+//! (`docs/radio.md`). The figures asserted here are the ones measured there.
+
+use host_sim::engine::{self as sim, NullRecorder, RunResult};
+use host_sim::model::{Access, Model};
+use host_sim::{load, Outcome, Simulation};
+
+fn model(name: &str, overrides: &[&str]) -> Model {
+    let o: Vec<String> = overrides.iter().map(|s| (*s).to_owned()).collect();
+    load(name, &o).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+fn run(m: &Model) -> RunResult {
+    sim::run(m, &mut NullRecorder, &mut |_| {}).expect("run")
+}
+
+fn strip20() -> String {
+    format!("{}/scenarios/strip20.toml", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The error message of a scenario that must be refused.
+fn refused(name: &str, overrides: &[&str]) -> String {
+    let o: Vec<String> = overrides.iter().map(|s| (*s).to_owned()).collect();
+    match load(name, &o) {
+        Ok(_) => panic!("{overrides:?} accepted"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn paper_converges_broadcasting_at_50_and_25_hz() {
+    // docs/radio.md: settle 40.85 s at 100 Hz, 41.61 s at 50 Hz, 43.22 s at 25 Hz.
+    for (hz, settle) in [("50", 41.61), ("25", 43.22)] {
+        let m = model("paper", &[&format!("controller.comm_rate_hz={hz}")]);
+        assert_eq!(m.comm_every, if hz == "50" { 2 } else { 4 });
+        let r = run(&m);
+        assert_eq!(r.outcome, Outcome::Converged, "{hz} Hz: {}", r.reason);
+        let t = r.settle_time.expect("settled");
+        assert!((t - settle).abs() < 0.05, "{hz} Hz: settle {t} s");
+        assert!(r.final_max_angle_error < 1e-5);
+        // One broadcast per agent every k ticks, agent i on the ticks ≡ i mod k.
+        let (ticks, k) = (r.control.ticks / 4, m.comm_every as u64);
+        let expected: u64 = (0..4u64).map(|i| (ticks - i % k).div_ceil(k)).sum();
+        assert_eq!(r.frames.broadcasts, expected);
+        // Only at start-up: an agent whose neighbours' first broadcast is due at a later
+        // phase waits for it (docs/radio.md); never afterwards.
+        if let Some((t, _, f)) = r.control.last_fault {
+            assert!(t <= m.comm_period() + 1e-9, "{hz} Hz: {f:?} at {t} s");
+        }
+    }
+}
+
+#[test]
+fn paper_tolerates_5_hz_but_not_4_hz() {
+    let ok = run(&model(
+        "paper",
+        &[
+            "controller.comm_rate_hz=5",
+            "controller.neighbour_timeout=0.75",
+        ],
+    ));
+    assert_eq!(ok.outcome, Outcome::Converged, "{}", ok.reason);
+    let t = ok.settle_time.expect("settled");
+    assert!((t - 51.52).abs() < 0.05, "settle {t}");
+    let bad = run(&model(
+        "paper",
+        &[
+            "controller.comm_rate_hz=4",
+            "controller.neighbour_timeout=0.75",
+        ],
+    ));
+    assert_eq!(bad.outcome, Outcome::Collision, "{}", bad.reason);
+}
+
+#[test]
+fn comm_rate_and_channel_mistakes_name_the_field() {
+    let e = refused("paper", &["controller.comm_rate_hz=30"]);
+    assert!(
+        e.contains("builtin:paper") && e.contains("`controller.comm_rate_hz`"),
+        "{e}"
+    );
+    assert!(e.contains("whole multiple"), "{e}");
+    let e = refused("paper", &["controller.comm_rate_hz=200"]);
+    assert!(
+        e.contains("`controller.comm_rate_hz`") && e.contains("exceeds"),
+        "{e}"
+    );
+    let e = refused("paper", &["controller.comm_rate_hz=0"]);
+    assert!(e.contains("`controller.comm_rate_hz`"), "{e}");
+    let e = refused("paper", &["controller.comm_rate_hz=10"]);
+    assert!(e.contains("`controller.neighbour_timeout`"), "{e}");
+    let e = refused("paper", &["controller.integrity=sha"]);
+    assert!(e.contains("integrity"), "{e}");
+    let e = refused("paper", &["radio.channel.preset=wifi"]);
+    assert!(
+        e.contains("`radio.channel.preset`") && e.contains("crazyflie"),
+        "{e}"
+    );
+    let e = refused("paper", &["radio.channel.access=tdma"]);
+    assert!(e.contains("`radio.channel.bit_rate`"), "{e}");
+    let e = refused(
+        "paper",
+        &[
+            "radio.channel.preset=crazyflie",
+            "radio.channel.access=csma",
+        ],
+    );
+    assert!(e.contains("access"), "{e}");
+    let e = refused(
+        "paper",
+        &[
+            "radio.channel.preset=crazyflie",
+            "radio.channel.access=tdma",
+            "radio.channel.slot=1e-4",
+        ],
+    );
+    assert!(e.contains("`radio.channel.slot`"), "{e}");
+    let e = refused(
+        "paper",
+        &["radio.channel.preset=crazyflie", "radio.bandwidth=1000"],
+    );
+    assert!(e.contains("`radio.bandwidth`"), "{e}");
+    let e = refused(
+        "paper",
+        &["radio.channel.preset=crazyflie", "radio.channel.range=-1"],
+    );
+    assert!(e.contains("`radio.channel.range`"), "{e}");
+}
+
+#[test]
+fn the_crazyflie_preset_and_the_summary() {
+    let m = model(
+        "paper",
+        &[
+            "radio.channel.preset=crazyflie",
+            "radio.channel.access=tdma",
+            "controller.integrity=link",
+            "duration=2.0",
+        ],
+    );
+    let c = m.radio.channel.as_ref().expect("channel");
+    assert_eq!(
+        (c.bit_rate, c.overhead_bytes, c.turnaround),
+        (2e6, 11.125, 130e-6)
+    );
+    assert_eq!(c.access, Access::Tdma);
+    // A 60-byte frame plus overhead: 71.125 bytes = 284.5 µs at 2 Mbit/s.
+    assert!((c.slot - (130e-6 + 284.5e-6)).abs() < 1e-12);
+    let run = Simulation::new(&m).run().expect("run");
+    let s = run.summary_json(&m);
+    let ch = &s["channel"];
+    assert_eq!(ch["access"], "tdma");
+    assert_eq!(ch["preset"], "crazyflie");
+    assert_eq!(ch["collided_copies"], 0);
+    assert!(ch["air_time_s"].as_f64().expect("air") > 0.0);
+    assert!(ch["utilisation"].as_f64().expect("util") > 0.0);
+    let age = ch["max_neighbour_age_s"].as_f64().expect("age");
+    assert!((age - 0.01).abs() < 1e-9, "{age}");
+    assert_eq!(s["integrity"], "link");
+    // Without a channel or a reduced rate, none of these keys exist (byte-identical
+    // summaries of the existing scenarios).
+    let m = model("paper", &["duration=1.0"]);
+    let s = Simulation::new(&m).run().expect("run").summary_json(&m);
+    for key in ["channel", "integrity", "comm_period_s", "comm_every_ticks"] {
+        assert!(s.get(key).is_none(), "{key}");
+    }
+}
+
+#[test]
+fn twenty_agents_on_one_crazyflie_channel() {
+    let path = strip20();
+    let base = [
+        "radio.channel.preset=crazyflie",
+        "controller.integrity=link",
+    ];
+    // TDMA: 20 slots of 414.5 µs fit in the 10 ms tick; nothing collides and the
+    // neighbour data is exactly one tick old.
+    let mut o = base.to_vec();
+    o.push("radio.channel.access=tdma");
+    let m = model(&path, &o);
+    assert_eq!(m.n(), 20);
+    let r = run(&m);
+    assert_eq!(r.outcome, Outcome::Converged, "tdma: {}", r.reason);
+    let c = r.channel.expect("channel");
+    assert_eq!(c.collided, 0);
+    assert_eq!(r.frames.dropped, 0);
+    assert!((c.max_age - 0.01).abs() < 1e-9, "{}", c.max_age);
+    // ALOHA at the same load (a third of the air time busy) loses many copies to
+    // collisions, yet converges.
+    let mut o = base.to_vec();
+    o.push("radio.channel.access=aloha");
+    let r = run(&model(&path, &o));
+    assert_eq!(r.outcome, Outcome::Converged, "aloha: {}", r.reason);
+    let c = r.channel.expect("channel");
+    let lost = c.collided_transmissions as f64 / c.transmissions as f64;
+    assert!(lost > 0.3, "only {lost} of the transmissions collided");
+    assert!(c.utilisation(r.final_time) > 0.3);
+    assert_eq!(r.frames.dropped, c.collided);
+}
+
+#[test]
+fn every_agent_gets_the_swarm_integrity_and_its_broadcast_phase() {
+    let m = model(
+        &strip20(),
+        &["controller.comm_rate_hz=25", "controller.integrity=link"],
+    );
+    for i in 0..m.n() {
+        let c = m.agent_config(i).expect("config");
+        assert_eq!(c.integrity, controller_core::Integrity::Link);
+        assert_eq!((c.comm_every, c.comm_phase), (4, (i % 4) as u16));
+        // The emulated firmware's configuration carries the same (host-in-the-loop).
+        let t = host_sim::engine::hil::target_config(&m, i).expect("target");
+        assert_eq!(
+            (t.integrity, t.comm_every, t.comm_phase),
+            (c.integrity, 4, c.comm_phase)
+        );
+    }
+    let m = model("paper", &[]);
+    let c = m.agent_config(0).expect("config");
+    assert_eq!(
+        (c.integrity, c.comm_every, c.comm_phase),
+        (controller_core::Integrity::Crc16, 1, 0)
+    );
+}
+
+#[test]
+fn the_summary_table_shows_the_channel_only_when_used() {
+    let out = std::path::Path::new("out");
+    let m = model(
+        "paper",
+        &[
+            "radio.channel.preset=crazyflie",
+            "radio.channel.access=aloha",
+            "controller.comm_rate_hz=50",
+            "duration=3.0",
+        ],
+    );
+    let r = run(&m);
+    let c = r.channel.expect("channel");
+    let text = host_sim::report::summary_table(&m, &r, out, 0);
+    for row in [
+        "broadcast",
+        "every 2 tick(s) (0.0200 s), integrity crc16",
+        "aloha (crazyflie), 2000000 bit/s, 11.125 bytes overhead, 130 µs turnaround",
+        "air time / utilisation",
+        "lost to collisions",
+        &format!(
+            "{} copies ({} of {} transmissions)",
+            c.collided, c.collided_transmissions, c.transmissions
+        ),
+        "neighbour data age",
+    ] {
+        assert!(text.contains(row), "no `{row}` in\n{text}");
+    }
+    let m = model("paper", &["duration=1.0"]);
+    let text = host_sim::report::summary_table(&m, &run(&m), out, 0);
+    for row in ["broadcast", "channel", "collisions", "neighbour data age"] {
+        assert!(!text.contains(row), "`{row}` in\n{text}");
+    }
+}
+
+#[test]
+fn a_channel_run_is_reproducible_bit_for_bit() {
+    let o = [
+        "radio.channel.preset=crazyflie",
+        "radio.channel.access=aloha",
+        "radio.channel.range=3",
+        "radio.loss=0.05",
+        "radio.jitter=0.002",
+        "duration=3.0",
+    ];
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut files = Vec::new();
+    for (k, seed) in ["seed=4", "seed=4", "seed=5"].iter().enumerate() {
+        let mut o = o.to_vec();
+        o.push(seed);
+        let m = model(&strip20(), &o);
+        let out = dir.path().join(format!("run{k}"));
+        let r = Simulation::new(&m)
+            .keep_series(false)
+            .write_to(&out, false)
+            .run()
+            .expect("run");
+        assert!(r.result.channel.expect("channel").collided > 0);
+        files.push((
+            std::fs::read(out.join("summary.json")).expect("json"),
+            std::fs::read(out.join("timeseries.csv")).expect("csv"),
+        ));
+    }
+    assert!(files[0] == files[1], "same seed, different output");
+    assert!(files[0].0 != files[2].0, "the seed changes nothing");
+}
