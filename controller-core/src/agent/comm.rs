@@ -38,13 +38,13 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// receivers reject every counter not larger than the last one they accepted, so an
     /// agent that reuses an epoch is not heard until its counter passes its old one.
     pub fn set_boot_epoch(&mut self, epoch: u32) {
-        self.counter = auth::counter(epoch, 0);
+        self.counter = [epoch, 0];
         self.sync_countdown = 0;
     }
 
     /// The full counter the next frame will carry (see [`crate::wire::auth`]).
     pub fn next_counter(&self) -> Counter {
-        self.counter
+        auth::load(self.counter)
     }
 
     /// Encodes this tick's broadcast into frames of at most 60 bytes and passes each to
@@ -63,7 +63,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         let auth = matches!(self.config.integrity, Integrity::Auth(_));
         // `auth`: frame number 2³² − 1 is never used, so the counter stays in its epoch.
         let usable = |c: Counter| !auth || c as u32 != u32::MAX;
-        let mut counter = self.counter;
+        let mut counter = auth::load(self.counter);
         if !usable(counter) {
             return 0;
         }
@@ -83,7 +83,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 count += 1;
                 counter = counter.wrapping_add(1);
                 if !usable(counter) {
-                    self.counter = counter;
+                    self.counter = auth::store(counter);
                     return count;
                 }
                 writer.start_counted(mode, id, counter, velocity);
@@ -108,7 +108,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 self.sync_countdown = self.sync_countdown.saturating_sub(1);
             }
         }
-        self.counter = counter;
+        self.counter = auth::store(counter);
         count
     }
 
@@ -143,16 +143,17 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         let accepted_counter = if let Integrity::Auth(key) = &self.config.integrity {
             // The replay check first (cheap), then the tag, with the counter as carried
             // or as reconstructed from the last accepted one.
-            let counter = match (frame.carried_counter(), n.last_counter) {
+            let last = n.last_counter.map(auth::load);
+            let counter = match (frame.carried_counter(), last) {
                 (Some(c), _) => c,
                 (None, Some(last)) => auth::reconstruct(last, seq),
                 (None, None) => return Err(FrameError::Unsynced(sender)),
             };
-            if n.last_counter.is_some_and(|last| counter <= last) {
+            if last.is_some_and(|last| counter <= last) {
                 return Err(FrameError::Replayed { sender, counter });
             }
             frame.verify_tag(key, counter)?;
-            Some(counter)
+            Some(auth::store(counter))
         } else {
             if let Some(last) = n.last_seq {
                 // Serial-number arithmetic: newer means ahead by 1..=32767. A neighbour

@@ -54,7 +54,7 @@ pub struct Agent<T: Real, const MT: usize, const NB: usize> {
     /// The full counter of the next frame (see [`crate::wire::auth`]): the boot epoch in
     /// the high 32 bits, frames sent since boot in the low 32; the header carries its low
     /// 16 bits as the sequence number.
-    counter: u64,
+    counter: crate::wire::auth::StoredCounter,
     /// `auth`: broadcasts with only full frames (no room for the counter extension) until
     /// the next one that adds a sync frame.
     sync_countdown: u8,

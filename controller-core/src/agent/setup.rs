@@ -101,7 +101,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             time: T::zero(),
             velocity: Vec2::zeros(),
             partner_offset: None,
-            counter: 0,
+            counter: [0; 2],
             sync_countdown: 0,
             oldest: None,
             comm_countdown,

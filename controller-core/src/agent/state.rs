@@ -102,7 +102,7 @@ pub(super) struct Neighbour<T: Real, const MT: usize> {
     pub age: T,
     pub last_seq: Option<u16>,
     /// `auth`: the counter of the last frame accepted from it (see [`crate::wire::auth`]).
-    pub last_counter: Option<u64>,
+    pub last_counter: Option<crate::wire::auth::StoredCounter>,
     pub velocity: Option<Vec2<T>>,
     /// The last bearing `s` to it (zero before the first).
     pub s: Vec2<T>,

@@ -43,6 +43,22 @@ pub const fn counter(epoch: u32, n: u32) -> Counter {
     ((epoch as u64) << 32) | n as u64
 }
 
+/// A counter stored as `[high, low]` 32-bit words: keeps the agent's alignment at 4
+/// bytes on 32-bit targets (the C API promises it).
+pub(crate) type StoredCounter = [u32; 2];
+
+/// The stored form of a counter.
+#[inline(always)]
+pub(crate) const fn store(c: Counter) -> StoredCounter {
+    [(c >> 32) as u32, c as u32]
+}
+
+/// The counter of its stored form.
+#[inline(always)]
+pub(crate) const fn load(s: StoredCounter) -> Counter {
+    counter(s[0], s[1])
+}
+
 /// The counter with low 16 bits `seq` nearest to `last` (`last − 2¹⁵ … last + 2¹⁵ − 1`):
 /// the counter of a frame without extension from a sender whose last accepted counter
 /// is `last`.

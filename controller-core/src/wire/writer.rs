@@ -1,6 +1,6 @@
 //! Building frames (layout in [`super`]).
 
-use super::auth::{self, Counter, COUNTER_EXT_LEN, TAG_LEN};
+use super::auth::{self, Counter, StoredCounter, COUNTER_EXT_LEN, TAG_LEN};
 use super::{offset, Integrity, ANGLE_ITEM_LEN, FIXED_LEN, MAX_FRAME_LEN};
 use crate::{crc16, AgentId};
 
@@ -28,7 +28,7 @@ pub struct FrameWriter {
     integrity: Integrity,
     /// `auth`: the full counter of the current frame (its low 16 bits are the header's
     /// sequence number).
-    counter: Counter,
+    counter: StoredCounter,
 }
 
 impl FrameWriter {
@@ -38,7 +38,7 @@ impl FrameWriter {
             buf: [0; MAX_FRAME_LEN],
             len: 0,
             integrity,
-            counter: 0,
+            counter: [0; 2],
         }
     }
 
@@ -60,7 +60,7 @@ impl FrameWriter {
         counter: Counter,
         velocity: [f32; 2],
     ) {
-        self.counter = counter;
+        self.counter = auth::store(counter);
         let [q0, q1] = (counter as u16).to_le_bytes();
         let [v0, v1, v2, v3] = velocity[0].to_le_bytes();
         let [w0, w1, w2, w3] = velocity[1].to_le_bytes();
@@ -116,8 +116,9 @@ impl FrameWriter {
             Integrity::Link => {}
             Integrity::Auth(key) => {
                 if body + COUNTER_EXT_LEN + TAG_LEN <= MAX_FRAME_LEN {
-                    let [e0, e1, e2, e3] = ((self.counter >> 32) as u32).to_le_bytes();
-                    let [h0, h1] = ((self.counter >> 16) as u16).to_le_bytes();
+                    let [epoch, n] = self.counter;
+                    let [e0, e1, e2, e3] = epoch.to_le_bytes();
+                    let [h0, h1] = ((n >> 16) as u16).to_le_bytes();
                     let ext = self
                         .buf
                         .get_mut(body..)
@@ -128,7 +129,7 @@ impl FrameWriter {
                     }
                 }
                 let (signed, rest) = self.buf.split_at_mut(body.min(MAX_FRAME_LEN));
-                let tag = auth::tag(key, self.counter, signed);
+                let tag = auth::tag(key, auth::load(self.counter), signed);
                 if let Some(t) = rest.first_chunk_mut::<TAG_LEN>() {
                     *t = tag;
                 }
