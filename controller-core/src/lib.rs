@@ -51,7 +51,7 @@ pub use config::{
 };
 pub use scalar::Real;
 pub use stats::FrameStats;
-pub use wire::{FrameError, MAX_FRAME_LEN};
+pub use wire::{FrameError, SwarmKey, MAX_FRAME_LEN};
 
 /// Triangles per agent of the standard agent type ([`StandardAgent`]): what the host
 /// simulator, the C ABI and the tests use, and what `host-sim validate` checks a scenario

@@ -24,6 +24,12 @@ pub struct FrameStats {
     pub stale: u32,
     /// Non-finite or out-of-range values.
     pub invalid_value: u32,
+    /// `auth`: tag does not verify.
+    pub bad_tag: u32,
+    /// `auth`: counter not newer than the sender's last accepted one.
+    pub replayed: u32,
+    /// `auth`: no counter known for the sender and none in the frame.
+    pub unsynced: u32,
 }
 
 impl FrameStats {
@@ -39,6 +45,9 @@ impl FrameStats {
             Err(FrameError::UnknownSender(_) | FrameError::OwnFrame) => &mut self.unknown_sender,
             Err(FrameError::StaleSequence { .. }) => &mut self.stale,
             Err(FrameError::InvalidValue) => &mut self.invalid_value,
+            Err(FrameError::BadTag) => &mut self.bad_tag,
+            Err(FrameError::Replayed { .. }) => &mut self.replayed,
+            Err(FrameError::Unsynced(_)) => &mut self.unsynced,
         };
         *c = c.saturating_add(1);
     }
@@ -53,5 +62,8 @@ impl FrameStats {
             .saturating_add(self.unknown_sender)
             .saturating_add(self.stale)
             .saturating_add(self.invalid_value)
+            .saturating_add(self.bad_tag)
+            .saturating_add(self.replayed)
+            .saturating_add(self.unsynced)
     }
 }

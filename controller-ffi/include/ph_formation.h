@@ -51,9 +51,10 @@
 
 /**
  * Most frames one `ph_frames` call produces: an agent is the apex of at most one
- * controlled angle per triangle, and a frame holds four (wire v3, every integrity mode).
+ * controlled angle per triangle, a frame holds four (wire v3, every integrity mode),
+ * and with `PH_INTEGRITY_AUTH` a broadcast of full frames may add one sync frame.
  */
-#define PH_MAX_FRAMES_PER_TICK ((PH_MAX_TRIANGLES + 3) / 4)
+#define PH_MAX_FRAMES_PER_TICK (((PH_MAX_TRIANGLES + 3) / 4) + 1)
 
 /**
  * Most estimates one agent owns (two edges of two angles per triangle).
@@ -64,7 +65,7 @@
  * Version of this C ABI (the header's structs and functions). Compare the header's
  * value with `ph_abi_version()` of the library you link.
  */
-#define PH_ABI_VERSION 1
+#define PH_ABI_VERSION 2
 
 /**
  * An upper bound of a blob's length: a configuration with every capacity used
@@ -76,14 +77,14 @@
 /**
  * Bytes of agent memory (`sizeof` the agent, for 32-bit targets such as Cortex-M).
  */
-#define PH_AGENT_SIZE 3248
+#define PH_AGENT_SIZE 3452
 #endif
 
 #if defined(PH_PTR64)
 /**
  * Bytes of agent memory (`sizeof` the agent, for 64-bit hosts).
  */
-#define PH_AGENT_SIZE 3640
+#define PH_AGENT_SIZE 3792
 #endif
 
 #if defined(PH_PTR32)
@@ -275,6 +276,19 @@ enum ph_status
    * swarm).
    */
   PH_ERR_FRAME_MODE_MISMATCH = 70,
+  /**
+   * Frame (`auth`): the tag does not verify (forged, corrupted or another key).
+   */
+  PH_ERR_FRAME_BAD_TAG = 71,
+  /**
+   * Frame (`auth`): its counter is not newer than the sender's last accepted one
+   * (replayed or late).
+   */
+  PH_ERR_FRAME_REPLAYED = 72,
+  /**
+   * Frame (`auth`): no counter known for the sender yet and none in the frame.
+   */
+  PH_ERR_FRAME_UNSYNCED = 73,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -627,6 +641,11 @@ typedef struct {
    * Which step of each `comm_every` broadcasts (< `comm_every`).
    */
   uint16_t comm_phase;
+  /**
+   * The 128-bit swarm key when `integrity` is `PH_INTEGRITY_AUTH` (all zero
+   * otherwise). A secret: keep it in protected storage and never log it.
+   */
+  uint8_t auth_key[16];
 } ph_config;
 
 /**
@@ -767,6 +786,18 @@ typedef struct {
    * Non-finite or out-of-range values.
    */
   uint32_t invalid_value;
+  /**
+   * `auth`: the tag does not verify.
+   */
+  uint32_t bad_tag;
+  /**
+   * `auth`: counter not newer than the sender's last accepted one.
+   */
+  uint32_t replayed;
+  /**
+   * `auth`: no counter known for the sender and none in the frame.
+   */
+  uint32_t unsynced;
 } ph_frame_stats;
 
 /**
@@ -910,6 +941,18 @@ ph_status ph_frames(ph_agent *agent,
  * `count` is NULL or writable.
  */
 ph_status ph_frames_cb(ph_agent *agent, ph_send_fn send, void *ctx, size_t *count);
+
+/**
+ * `PH_INTEGRITY_AUTH`: sets this boot's epoch; the next frame's counter is
+ * `epoch · 2³²`. Call it once after `ph_agent_init*` and before the first `ph_frames`,
+ * with a value larger than at any earlier boot of this robot (keep it in non-volatile
+ * memory and increment it at every boot): receivers reject every counter not larger
+ * than the last one they accepted. Harmless with the other integrity modes.
+ *
+ * # Safety
+ * `agent` as for `ph_step`.
+ */
+ph_status ph_agent_set_boot_epoch(ph_agent *agent, uint32_t epoch);
 
 /**
  * The counters of received frames.

@@ -376,6 +376,21 @@ pub unsafe extern "C" fn ph_frames_cb(
     }
 }
 
+/// `PH_INTEGRITY_AUTH`: sets this boot's epoch; the next frame's counter is
+/// `epoch · 2³²`. Call it once after `ph_agent_init*` and before the first `ph_frames`,
+/// with a value larger than at any earlier boot of this robot (keep it in non-volatile
+/// memory and increment it at every boot): receivers reject every counter not larger
+/// than the last one they accepted. Harmless with the other integrity modes.
+///
+/// # Safety
+/// `agent` as for `ph_step`.
+#[no_mangle]
+pub unsafe extern "C" fn ph_agent_set_boot_epoch(agent: *mut ph_agent, epoch: u32) -> ph_status {
+    // SAFETY: per this function's contract.
+    let r = unsafe { storage::agent_mut(agent) }.map(|a| a.set_boot_epoch(epoch));
+    status(r)
+}
+
 /// The counters of received frames.
 ///
 /// # Safety

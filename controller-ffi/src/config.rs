@@ -6,7 +6,7 @@
 
 use controller_core::{
     AgentConfig, AngleConfig, EstimatorMode, Integrity, LeaderConfig, LeaderRole, Limits, Schedule,
-    ScheduleStep, TriangleConfig,
+    ScheduleStep, SwarmKey, TriangleConfig,
 };
 
 use crate::status::ph_status;
@@ -33,6 +33,10 @@ pub enum ph_integrity {
     PH_INTEGRITY_CRC16 = 0,
     /// No trailer: the link checks its own CRC (the Crazyflie radio does).
     PH_INTEGRITY_LINK = 1,
+    /// A 64-bit SipHash-2-4 tag under the swarm key `ph_config.auth_key` and replay
+    /// protection (see `docs/core.md`, "auth"); call `ph_agent_set_boot_epoch` after
+    /// `ph_agent_init*`.
+    PH_INTEGRITY_AUTH = 2,
 }
 
 /// Which end of the leader edge an agent is (values of `ph_leader.role`; S11 with
@@ -161,6 +165,9 @@ pub struct ph_config {
     pub comm_every: u16,
     /// Which step of each `comm_every` broadcasts (< `comm_every`).
     pub comm_phase: u16,
+    /// The 128-bit swarm key when `integrity` is `PH_INTEGRITY_AUTH` (all zero
+    /// otherwise). A secret: keep it in protected storage and never log it.
+    pub auth_key: [u8; 16],
 }
 
 fn schedule_to_core(s: &ph_schedule) -> Result<Schedule<f32>, ph_status> {
@@ -242,18 +249,24 @@ fn estimator_from_core(e: EstimatorMode) -> ph_estimator {
     }
 }
 
-fn integrity_to_core(e: u8) -> Result<Integrity, ph_status> {
+/// The integrity of code `e` (with the key `key` for `auth`; the key must be all zero
+/// otherwise, so that the C form stays exact).
+fn integrity_to_core(e: u8, key: &[u8; 16]) -> Result<Integrity, ph_status> {
+    let no_key = *key == [0; 16];
     match e {
-        x if x == ph_integrity::PH_INTEGRITY_CRC16 as u8 => Ok(Integrity::Crc16),
-        x if x == ph_integrity::PH_INTEGRITY_LINK as u8 => Ok(Integrity::Link),
+        x if x == ph_integrity::PH_INTEGRITY_CRC16 as u8 && no_key => Ok(Integrity::Crc16),
+        x if x == ph_integrity::PH_INTEGRITY_LINK as u8 && no_key => Ok(Integrity::Link),
+        x if x == ph_integrity::PH_INTEGRITY_AUTH as u8 => Ok(Integrity::Auth(SwarmKey::new(*key))),
         _ => Err(ph_status::PH_ERR_CONFIG_BAD_ENUM),
     }
 }
 
-fn integrity_from_core(e: Integrity) -> ph_integrity {
+/// The code and key (zero unless `auth`) of an integrity.
+fn integrity_from_core(e: &Integrity) -> (ph_integrity, [u8; 16]) {
     match e {
-        Integrity::Crc16 => ph_integrity::PH_INTEGRITY_CRC16,
-        Integrity::Link => ph_integrity::PH_INTEGRITY_LINK,
+        Integrity::Crc16 => (ph_integrity::PH_INTEGRITY_CRC16, [0; 16]),
+        Integrity::Link => (ph_integrity::PH_INTEGRITY_LINK, [0; 16]),
+        Integrity::Auth(key) => (ph_integrity::PH_INTEGRITY_AUTH, *key.expose_secret()),
     }
 }
 
@@ -326,6 +339,7 @@ pub fn to_core(c: &ph_config) -> Result<FfiConfig, ph_status> {
         integrity,
         comm_every,
         comm_phase,
+        auth_key,
     } = c;
     let n = usize::try_from(*triangle_count).unwrap_or(usize::MAX);
     let used = triangles
@@ -369,7 +383,7 @@ pub fn to_core(c: &ph_config) -> Result<FfiConfig, ph_status> {
         velocity_reference: schedule_to_core(velocity_reference)?,
         leader,
         limits: limits_to_core(limits),
-        integrity: integrity_to_core(*integrity)?,
+        integrity: integrity_to_core(*integrity, auth_key)?,
         comm_every: *comm_every,
         comm_phase: *comm_phase,
     })
@@ -392,8 +406,10 @@ pub fn from_core(c: &FfiConfig) -> ph_config {
         comm_every,
         comm_phase,
     } = c;
+    let (integrity, auth_key) = integrity_from_core(integrity);
     let mut out = ph_config {
-        integrity: integrity_from_core(*integrity) as u8,
+        integrity: integrity as u8,
+        auth_key,
         comm_every: *comm_every,
         comm_phase: *comm_phase,
         id: *id,

@@ -67,15 +67,16 @@ pub const PH_MAX_SCHEDULE_STEPS: usize = 8;
 /// buffer of `ph_frames`.
 pub const PH_MAX_FRAME_LEN: usize = 60;
 /// Most frames one `ph_frames` call produces: an agent is the apex of at most one
-/// controlled angle per triangle, and a frame holds four (wire v3, every integrity mode).
-// Written out (not `.div_ceil(4)`) so that cbindgen can translate it into the C header.
+/// controlled angle per triangle, a frame holds four (wire v3, every integrity mode),
+/// and with `PH_INTEGRITY_AUTH` a broadcast of full frames may add one sync frame.
+// Written out (not `div_ceil(4) + 1`) so that cbindgen can put it in the header.
 #[allow(clippy::manual_div_ceil)]
-pub const PH_MAX_FRAMES_PER_TICK: usize = (PH_MAX_TRIANGLES + 3) / 4;
+pub const PH_MAX_FRAMES_PER_TICK: usize = (PH_MAX_TRIANGLES + 3) / 4 + 1;
 /// Most estimates one agent owns (two edges of two angles per triangle).
 pub const PH_MAX_OWNED_ESTIMATES: usize = 4 * PH_MAX_TRIANGLES;
 /// Version of this C ABI (the header's structs and functions). Compare the header's
 /// value with `ph_abi_version()` of the library you link.
-pub const PH_ABI_VERSION: u32 = 1;
+pub const PH_ABI_VERSION: u32 = 2;
 
 /// The agent behind the C API.
 pub type FfiAgent = controller_core::Agent<f32, PH_MAX_TRIANGLES, PH_MAX_NEIGHBOURS>;
@@ -87,7 +88,11 @@ const _: () = assert!(PH_MAX_TRIANGLES == controller_core::MAX_TRIANGLES);
 const _: () = assert!(PH_MAX_NEIGHBOURS == controller_core::MAX_NEIGHBOURS);
 const _: () = assert!(
     PH_MAX_FRAMES_PER_TICK
-        == PH_MAX_TRIANGLES.div_ceil(controller_core::wire::Integrity::Crc16.max_angles())
+        == PH_MAX_TRIANGLES.div_ceil(controller_core::wire::Integrity::Crc16.max_angles()) + 1
+);
+const _: () = assert!(
+    controller_core::wire::Integrity::Auth(controller_core::SwarmKey::new([0; 16])).max_angles()
+        == controller_core::wire::Integrity::Crc16.max_angles()
 );
 const _: () = assert!(PH_MAX_SCHEDULE_STEPS == controller_core::MAX_SCHEDULE_STEPS);
 const _: () = assert!(PH_MAX_FRAME_LEN == controller_core::MAX_FRAME_LEN);

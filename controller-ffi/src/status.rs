@@ -96,6 +96,13 @@ pub enum ph_status {
     /// Frame: its integrity or estimator mode differs from this agent's (misconfigured
     /// swarm).
     PH_ERR_FRAME_MODE_MISMATCH = 70,
+    /// Frame (`auth`): the tag does not verify (forged, corrupted or another key).
+    PH_ERR_FRAME_BAD_TAG = 71,
+    /// Frame (`auth`): its counter is not newer than the sender's last accepted one
+    /// (replayed or late).
+    PH_ERR_FRAME_REPLAYED = 72,
+    /// Frame (`auth`): no counter known for the sender yet and none in the frame.
+    PH_ERR_FRAME_UNSYNCED = 73,
 }
 
 impl From<ConfigError> for ph_status {
@@ -130,6 +137,9 @@ impl From<FrameError> for ph_status {
             FrameError::StaleSequence { .. } => Self::PH_ERR_FRAME_STALE_SEQUENCE,
             FrameError::InvalidValue => Self::PH_ERR_FRAME_INVALID_VALUE,
             FrameError::Cobs => Self::PH_ERR_FRAME_COBS,
+            FrameError::BadTag => Self::PH_ERR_FRAME_BAD_TAG,
+            FrameError::Replayed { .. } => Self::PH_ERR_FRAME_REPLAYED,
+            FrameError::Unsynced(_) => Self::PH_ERR_FRAME_UNSYNCED,
         }
     }
 }
@@ -150,7 +160,7 @@ impl From<BlobError> for ph_status {
 
 /// Every status, for the code → status lookup of `ph_status_str`. `tests/header.rs`
 /// checks that it lists as many codes as the header's `ph_status` has.
-pub const ALL: [ph_status; 36] = {
+pub const ALL: [ph_status; 39] = {
     use ph_status::*;
     [
         PH_OK,
@@ -189,6 +199,9 @@ pub const ALL: [ph_status; 36] = {
         PH_ERR_FRAME_INVALID_VALUE,
         PH_ERR_FRAME_COBS,
         PH_ERR_FRAME_MODE_MISMATCH,
+        PH_ERR_FRAME_BAD_TAG,
+        PH_ERR_FRAME_REPLAYED,
+        PH_ERR_FRAME_UNSYNCED,
     ]
 };
 
@@ -233,6 +246,9 @@ impl ph_status {
             Self::PH_ERR_FRAME_INVALID_VALUE => c"PH_ERR_FRAME_INVALID_VALUE",
             Self::PH_ERR_FRAME_COBS => c"PH_ERR_FRAME_COBS",
             Self::PH_ERR_FRAME_MODE_MISMATCH => c"PH_ERR_FRAME_MODE_MISMATCH",
+            Self::PH_ERR_FRAME_BAD_TAG => c"PH_ERR_FRAME_BAD_TAG",
+            Self::PH_ERR_FRAME_REPLAYED => c"PH_ERR_FRAME_REPLAYED",
+            Self::PH_ERR_FRAME_UNSYNCED => c"PH_ERR_FRAME_UNSYNCED",
         }
     }
 

@@ -137,6 +137,12 @@ pub struct ph_frame_stats {
     pub stale: u32,
     /// Non-finite or out-of-range values.
     pub invalid_value: u32,
+    /// `auth`: the tag does not verify.
+    pub bad_tag: u32,
+    /// `auth`: counter not newer than the sender's last accepted one.
+    pub replayed: u32,
+    /// `auth`: no counter known for the sender and none in the frame.
+    pub unsynced: u32,
 }
 
 /// One distance estimate this agent owns (`ph_owned_estimates`).
@@ -248,6 +254,9 @@ pub fn stats_from_core(s: &FrameStats) -> ph_frame_stats {
         unknown_sender,
         stale,
         invalid_value,
+        bad_tag,
+        replayed,
+        unsynced,
     } = *s;
     ph_frame_stats {
         accepted,
@@ -259,6 +268,9 @@ pub fn stats_from_core(s: &FrameStats) -> ph_frame_stats {
         unknown_sender,
         stale,
         invalid_value,
+        bad_tag,
+        replayed,
+        unsynced,
     }
 }
 

@@ -11,6 +11,8 @@
 //!   host-in-the-loop robot over USART1 ([`boards::uart`], binary
 //!   `qemu-uart`); [`stand_in`]: trivial drivers (binary `firmware-example`,
 //!   the template for a real board).
+//! * [`keys`]: where a real board keeps the `auth` swarm key and its boot
+//!   epoch, and the QEMU placeholders.
 //! * [`paper`]: the paper's scenario (SPEC §9) as `f32` constants.
 //! * [`workload`]: the measured control step (decode and receive the
 //!   neighbours' frames, `Agent::step`, encode the own frames) for an agent in
@@ -33,6 +35,7 @@
 pub mod app;
 pub mod boards;
 pub mod hal;
+pub mod keys;
 pub mod measure;
 pub mod paper;
 pub mod stand_in;

@@ -1,6 +1,7 @@
 //! `firmware-example`: one robot's firmware, the template for a real board.
 //!
-//! It builds agent 1 of the paper scenario ([`paper::config`]) and runs it
+//! It builds agent 1 of the paper scenario ([`paper::config`]) with `auth`
+//! integrity (the placeholder key and boot epoch of [`keys`]) and runs it
 //! with [`run_agent`] at [`CONTROL_HZ`] on a [`Board`] of drivers. Here the
 //! drivers are the stand-ins of [`stand_in`] (fixed bearings, a loopback
 //! radio, a recording actuator, a polled clock), so the agent never hears
@@ -15,6 +16,7 @@
 //! [`Board`]: firmware_example::app::Board
 //! [`stand_in`]: firmware_example::stand_in
 //! [`hal`]: firmware_example::hal
+//! [`keys`]: firmware_example::keys
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
 /// Control rate (Hz).
@@ -29,25 +31,31 @@ mod firmware {
     use super::{CLOCK_HZ, CONTROL_HZ, RUN_TICKS};
     use core::ops::ControlFlow;
 
-    use controller_core::Agent;
+    use controller_core::{Agent, Integrity};
     use cortex_m_rt::entry;
     use firmware_example::app::{run_agent, Board};
     use firmware_example::paper;
     use firmware_example::stand_in::{
         FixedBearings, FixedVelocity, LoopbackRadio, PollClock, RecordingActuator,
     };
-    use firmware_example::{rt, stack};
+    use firmware_example::{keys, rt, stack};
 
     #[entry]
     fn main() -> ! {
         // This robot: agent 1 of the paper (2 triangles at most, 4 neighbours).
-        let agent = match Agent::<f32, 2, 4>::new(paper::config(0)) {
+        // Authenticated frames. A real board reads its swarm key from protected
+        // storage and persists its boot epoch: see `firmware_example::keys`.
+        let mut config = paper::config(0);
+        config.integrity = Integrity::Auth(keys::PLACEHOLDER_SWARM_KEY);
+        let mut agent = match Agent::<f32, 2, 4>::new(config) {
             Ok(a) => a,
             Err(e) => {
                 defmt::error!("configuration refused: {}", e);
                 rt::exit(rt::EXIT_FAILURE)
             }
         };
+        // Before the first frame: larger than at any earlier boot.
+        agent.set_boot_epoch(keys::placeholder_boot_epoch());
         defmt::info!(
             "firmware-example: agent {=u8}, control at {=u32} Hz over stand-in drivers",
             agent.id(),

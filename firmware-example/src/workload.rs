@@ -34,8 +34,9 @@
 //! broadcast in the measured tick and its own measurements.
 
 use controller_core::{
-    Agent, AgentConfig, AgentId, AngleConfig, BearingMeasurement, ConfigError, LeaderConfig,
-    LeaderRole, Measurements, Real, Schedule, Status, StepOutput, TriangleConfig, Vec2,
+    Agent, AgentConfig, AgentId, AngleConfig, BearingMeasurement, ConfigError, Integrity,
+    LeaderConfig, LeaderRole, Measurements, Real, Schedule, Status, StepOutput, TriangleConfig,
+    Vec2,
 };
 use heapless::Vec;
 
@@ -48,25 +49,45 @@ pub struct StepConfig {
     pub name: &'static str,
     /// Number of triangles (formation constraints) this robot takes part in.
     pub triangles: usize,
+    /// How every agent of the bench protects its frames.
+    pub integrity: Integrity,
 }
 
-/// The configurations measured by the `measure` binary, in order.
-pub const STEP_CONFIGS: [StepConfig; 4] = [
+/// The `auth` configurations' key: the public placeholder (see [`crate::keys`]).
+const AUTH: Integrity = Integrity::Auth(crate::keys::PLACEHOLDER_SWARM_KEY);
+
+/// The configurations measured by the `measure` binary, in order: `crc16`
+/// integrity (`triN`), and `auth` (`triN_auth`).
+pub const STEP_CONFIGS: [StepConfig; 6] = [
     StepConfig {
         name: "tri1",
         triangles: 1,
+        integrity: Integrity::Crc16,
     },
     StepConfig {
         name: "tri2",
         triangles: 2,
+        integrity: Integrity::Crc16,
     },
     StepConfig {
         name: "tri4",
         triangles: 4,
+        integrity: Integrity::Crc16,
     },
     StepConfig {
         name: "tri8",
         triangles: 8,
+        integrity: Integrity::Crc16,
+    },
+    StepConfig {
+        name: "tri2_auth",
+        triangles: 2,
+        integrity: AUTH,
+    },
+    StepConfig {
+        name: "tri8_auth",
+        triangles: 8,
+        integrity: AUTH,
     },
 ];
 
@@ -269,12 +290,16 @@ impl StepResult {
 /// The fan geometry of one configuration.
 struct Fan {
     k: usize,
+    integrity: Integrity,
 }
 
 impl Fan {
     fn new(cfg: &StepConfig) -> Result<Fan, BenchError> {
         match cfg.triangles {
-            k @ 1..=MAX_TRIANGLES => Ok(Fan { k }),
+            k @ 1..=MAX_TRIANGLES => Ok(Fan {
+                k,
+                integrity: cfg.integrity,
+            }),
             _ => Err(BenchError::Triangles),
         }
     }
@@ -371,6 +396,7 @@ impl Fan {
             _ => None,
         };
         c.limits.max_force = 1.0e5;
+        c.integrity = self.integrity;
         c
     }
 

@@ -1,12 +1,15 @@
 //! Feeds arbitrary bytes to agents as radio frames and as measurements, interleaved: one
 //! agent with `crc16` integrity (the frame's CRC is sometimes made valid, so that the
 //! fuzzer reaches past it) and one with `link` integrity (no CRC: every byte reaches the
-//! decoder). Invariants: no panic; a frame the agent accepts is one `decode_frame`
-//! accepts; the force is always finite and within `max_force`; every outgoing frame is at
-//! most 60 bytes and decodes.
+//! decoder), and one with `auth` integrity (the frame is sometimes signed with the swarm
+//! key and the counter its extension carries, so that the fuzzer reaches the replay
+//! logic and the decoder behind the tag). Invariants: no panic; a frame the agent accepts
+//! is one `decode_frame` accepts (`auth`: when it carries its counter); with `auth` the
+//! carried counters accepted from one sender strictly increase; the force is always
+//! finite and within `max_force`; every outgoing frame is at most 60 bytes and decodes.
 #![no_main]
 
-use controller_core::wire::{decode_frame, Integrity};
+use controller_core::wire::{auth, check_frame, decode_frame, Integrity, SwarmKey};
 use controller_core::{
     Agent, AgentConfig, AngleConfig, BearingMeasurement, EstimatorMode, Measurements,
     TriangleConfig, Vec2,
@@ -45,14 +48,35 @@ fn f32_at(data: &[u8], i: usize) -> f32 {
     f32::from_le_bytes(b)
 }
 
+const KEY: SwarmKey = SwarmKey::new(*b"fuzzing key 16 B");
+
+/// Re-signs an `auth` frame that carries its counter (tag over that counter and the bytes).
+fn sign(bytes: &mut [u8]) {
+    let Ok(view) = check_frame(bytes, Integrity::Auth(KEY), EstimatorMode::Shared) else {
+        return;
+    };
+    let Some(c) = view.carried_counter() else {
+        return;
+    };
+    let n = bytes.len() - auth::TAG_LEN;
+    let tag = auth::tag(&KEY, c, &bytes[..n]);
+    bytes[n..].copy_from_slice(&tag);
+}
+
 fn crc16(body: &[u8]) -> [u8; 2] {
     controller_core::crc16::checksum(body).to_le_bytes()
 }
 
 fuzz_target!(|data: &[u8]| {
-    let mut agents = [(agent(Integrity::Crc16), Integrity::Crc16), (agent(Integrity::Link), Integrity::Link)];
+    let mut agents = [
+        (agent(Integrity::Crc16), Integrity::Crc16),
+        (agent(Integrity::Link), Integrity::Link),
+        (agent(Integrity::Auth(KEY)), Integrity::Auth(KEY)),
+    ];
+    // `auth`: the last carried counter accepted per sender.
+    let mut last = [None::<u64>; 256];
     let limit = agents[0].0.config().limits.max_force;
-    // Chunks: one byte (bits 0–5: frame length L ≤ 63; bit 6: make the CRC valid), the
+    // Chunks: one byte (bits 0–5: frame length L ≤ 63; bit 6: make the CRC or tag valid), the
     // frame's L bytes, then 40 bytes of measurement floats.
     let mut rest = data;
     while let Some((&head, tail)) = rest.split_first() {
@@ -79,8 +103,21 @@ fuzz_target!(|data: &[u8]| {
                 let crc = crc16(&bytes[..n]);
                 bytes[n..].copy_from_slice(&crc);
             }
+            if matches!(integrity, Integrity::Auth(_)) && head & 64 != 0 {
+                sign(&mut bytes);
+            }
             if a.receive(&bytes).is_ok() {
-                assert!(decode_frame(&bytes, *integrity, EstimatorMode::Shared).is_ok());
+                let view = check_frame(&bytes, *integrity, EstimatorMode::Shared);
+                let carried = view.ok().and_then(|v| v.carried_counter());
+                match (&*integrity, carried) {
+                    (Integrity::Auth(_), None) => {}
+                    _ => assert!(decode_frame(&bytes, *integrity, EstimatorMode::Shared).is_ok()),
+                }
+                if let (Integrity::Auth(_), Some(c)) = (&*integrity, carried) {
+                    let prev = &mut last[usize::from(bytes[1])];
+                    assert!(prev.is_none_or(|p| c > p), "counter not increasing");
+                    *prev = Some(c);
+                }
             }
             let out = a.step(&meas);
             assert!(out.force.x.is_finite() && out.force.y.is_finite());

@@ -5,7 +5,8 @@
 use super::state::{AngleState, Remote, Side};
 use super::Agent;
 use crate::config::AgentId;
-use crate::wire::{check_mode, quant, FrameError, RawAngle};
+use crate::wire::auth::{self, Counter};
+use crate::wire::{check_mode, quant, FrameError, Integrity, RawAngle};
 use crate::{Real, Vec2};
 
 /// A broadcast item at full precision (the wire rounds the angle's values to binary16).
@@ -23,22 +24,54 @@ enum Item<T: Real> {
     },
 }
 
+/// `auth`: an agent whose broadcasts fill every frame (no room for the counter
+/// extension) adds a sync frame (velocity and counter extension, no items) to the first
+/// and then every `SYNC_EVERY`-th of them, so that a receiver that boots, or missed
+/// more than 2¹⁵ of its frames, learns its counter (see [`crate::wire::auth`]).
+pub const SYNC_EVERY: u8 = 8;
+
 impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
+    /// `auth`: sets this boot's epoch: the next frame's counter is `epoch · 2³²` (see
+    /// [`crate::wire::auth`]). Call it once after [`Agent::new`], before the first
+    /// [`Agent::frames`], with a value larger than at any earlier boot of this agent (the
+    /// firmware keeps it in non-volatile memory and increments it at every boot):
+    /// receivers reject every counter not larger than the last one they accepted, so an
+    /// agent that reuses an epoch is not heard until its counter passes its old one.
+    pub fn set_boot_epoch(&mut self, epoch: u32) {
+        self.counter = [epoch, 0];
+        self.sync_countdown = 0;
+    }
+
+    /// The full counter the next frame will carry (see [`crate::wire::auth`]).
+    pub fn next_counter(&self) -> Counter {
+        auth::load(self.counter)
+    }
+
     /// Encodes this tick's broadcast into frames of at most 60 bytes and passes each to
     /// `send`; returns the number of frames. The broadcast is the agent's velocity and,
     /// for every controlled angle it is the apex of and computed when it last sensed,
     /// what the angle's far vertices need (see [`crate::wire`]). Sends nothing (and
     /// returns 0) on the steps that [`crate::AgentConfig::comm_every`] skips.
+    ///
+    /// `auth`: every frame carries the next counter; a broadcast of full frames only is
+    /// followed by a sync frame now and then (see [`SYNC_EVERY`]); after `2³² − 1` frames
+    /// in one boot epoch the agent sends nothing more (a counter is never reused).
     pub fn frames(&mut self, mut send: impl FnMut(&[u8])) -> usize {
         if !self.comm_due {
             return 0;
         }
+        let auth = matches!(self.config.integrity, Integrity::Auth(_));
+        // `auth`: frame number 2³² − 1 is never used, so the counter stays in its epoch.
+        let usable = |c: Counter| !auth || c as u32 != u32::MAX;
+        let mut counter = auth::load(self.counter);
+        if !usable(counter) {
+            return 0;
+        }
         let (id, mode) = (self.config.id, self.mode);
         let velocity = [self.velocity.x.as_f32(), self.velocity.y.as_f32()];
-        let mut seq = self.seq;
         let mut count = 0;
         let (writer, angles) = (&mut self.writer, &self.angles);
-        writer.start(mode, id, seq, velocity);
+        writer.start_counted(mode, id, counter, velocity);
         for a in angles.as_slice().as_flattened() {
             let Some((gamma, sigma, rho)) = sent_angle(a) else {
                 continue;
@@ -48,19 +81,43 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             if !writer.push_angle(a.far, code) {
                 send(writer.finish());
                 count += 1;
-                seq = seq.wrapping_add(1);
-                writer.start(mode, id, seq, velocity);
+                counter = counter.wrapping_add(1);
+                if !usable(counter) {
+                    self.counter = auth::store(counter);
+                    return count;
+                }
+                writer.start_counted(mode, id, counter, velocity);
                 // One item always fits in an empty frame.
                 let _ = writer.push_angle(a.far, code);
             }
         }
+        // Frames fill up in order: a full last frame means no frame had room for the
+        // counter extension.
+        let full = writer.angles() == self.config.integrity.max_angles();
         send(writer.finish());
-        self.seq = seq.wrapping_add(1);
-        count + 1
+        count += 1;
+        counter = counter.wrapping_add(1);
+        if auth && full {
+            if self.sync_countdown == 0 && usable(counter) {
+                writer.start_counted(mode, id, counter, velocity);
+                send(writer.finish());
+                count += 1;
+                counter = counter.wrapping_add(1);
+                self.sync_countdown = SYNC_EVERY - 1;
+            } else {
+                self.sync_countdown = self.sync_countdown.saturating_sub(1);
+            }
+        }
+        self.counter = auth::store(counter);
+        count
     }
 
     /// Checks and applies one received frame. Rejected frames change nothing but the
-    /// counters. A neighbour that was stale may restart its sequence numbers.
+    /// counters. With `crc16` and `link` integrity, a neighbour that was stale may
+    /// restart its sequence numbers; with `auth`, a frame is applied only if its tag
+    /// verifies and its counter is larger than the sender's last accepted one (see
+    /// [`crate::wire::auth`]; a rebooted neighbour is heard again from its first frame
+    /// with the counter extension of its new, larger boot epoch).
     pub fn receive(&mut self, bytes: &[u8]) -> Result<(), FrameError> {
         let result = self.receive_inner(bytes);
         match result {
@@ -83,19 +140,39 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             .get(slot)
             .ok_or(FrameError::UnknownSender(sender))?;
         let seq = frame.header.seq;
-        if let Some(last) = n.last_seq {
-            // Serial-number arithmetic: newer means ahead by 1..=32767. A neighbour not
-            // heard within the timeout may have restarted.
-            let ahead = seq.wrapping_sub(last);
-            if (ahead == 0 || ahead >= 0x8000) && n.age <= timeout {
-                return Err(FrameError::StaleSequence { sender, seq });
+        let accepted_counter = if let Integrity::Auth(key) = &self.config.integrity {
+            // The replay check first (cheap), then the tag, with the counter as carried
+            // or as reconstructed from the last accepted one.
+            let last = n.last_counter.map(auth::load);
+            let counter = match (frame.carried_counter(), last) {
+                (Some(c), _) => c,
+                (None, Some(last)) => auth::reconstruct(last, seq),
+                (None, None) => return Err(FrameError::Unsynced(sender)),
+            };
+            if last.is_some_and(|last| counter <= last) {
+                return Err(FrameError::Replayed { sender, counter });
             }
-        }
+            frame.verify_tag(key, counter)?;
+            Some(auth::store(counter))
+        } else {
+            if let Some(last) = n.last_seq {
+                // Serial-number arithmetic: newer means ahead by 1..=32767. A neighbour
+                // not heard within the timeout may have restarted.
+                let ahead = seq.wrapping_sub(last);
+                if (ahead == 0 || ahead >= 0x8000) && n.age <= timeout {
+                    return Err(FrameError::StaleSequence { sender, seq });
+                }
+            }
+            None
+        };
         // The whole frame is valid before anything is applied. With estimators, the
         // distances are estimates: at least r_min (as rounded: rounding is monotone).
         frame.validate(self.rho_min_code)?;
         if let Some(n) = self.neighbours.get_mut(slot) {
             n.last_seq = Some(seq);
+            if accepted_counter.is_some() {
+                n.last_counter = accepted_counter;
+            }
             n.age = T::zero();
         }
         self.oldest = None;

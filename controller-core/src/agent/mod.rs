@@ -51,7 +51,13 @@ pub struct Agent<T: Real, const MT: usize, const NB: usize> {
     time: T,
     velocity: Vec2<T>,
     partner_offset: Option<Vec2<T>>,
-    seq: u16,
+    /// The full counter of the next frame (see [`crate::wire::auth`]): the boot epoch in
+    /// the high 32 bits, frames sent since boot in the low 32; the header carries its low
+    /// 16 bits as the sequence number.
+    counter: crate::wire::auth::StoredCounter,
+    /// `auth`: broadcasts with only full frames (no room for the counter extension) until
+    /// the next one that adds a sync frame.
+    sync_countdown: u8,
     /// The largest neighbour age when last sensed (`None` after a frame arrived since, or
     /// when it is NaN): lets [`Agent::check_fresh`] skip its loop.
     oldest: Option<T>,

@@ -101,6 +101,8 @@ pub(super) struct Neighbour<T: Real, const MT: usize> {
     /// Seconds since a frame was last accepted from it (`∞` before the first).
     pub age: T,
     pub last_seq: Option<u16>,
+    /// `auth`: the counter of the last frame accepted from it (see [`crate::wire::auth`]).
+    pub last_counter: Option<crate::wire::auth::StoredCounter>,
     pub velocity: Option<Vec2<T>>,
     /// The last bearing `s` to it (zero before the first).
     pub s: Vec2<T>,
@@ -121,6 +123,7 @@ impl<T: Real, const MT: usize> Neighbour<T, MT> {
             // Never heard: infinitely old (so `age <= timeout` alone means heard recently).
             age: T::lit(f64::INFINITY),
             last_seq: None,
+            last_counter: None,
             velocity: None,
             s: Vec2::zeros(),
             rate: Vec2::zeros(),

@@ -13,6 +13,14 @@
 //! | 12 | 10·k | k angle items (below) |
 //! | 12 + 10k | 0 or 2 | integrity trailer: CRC-16/IBM-SDLC of bytes `0..12+10k` ([`Integrity::Crc16`]), nothing ([`Integrity::Link`]) |
 //!
+//! With [`Integrity::Auth`] the items are followed by a 6-byte counter extension when it
+//! fits (at most 3 items) and then an 8-byte tag ([`auth`]):
+//!
+//! | offset | bytes | field |
+//! |---|---|---|
+//! | 12 + 10k | 0 or 6 | counter extension: boot epoch (`u32`), high 16 bits of the frame number (`u16`) |
+//! | end − 8 | 8 | SipHash-2-4 tag of the sender's full counter and every byte before the tag |
+//!
 //! One angle item per controlled angle `α = (n; v, w)` whose apex `n` is the sender
 //! (values in IEEE 754 binary16, see [`quant`]):
 //!
@@ -37,13 +45,17 @@
 //! Receivers reject, with a typed [`FrameError`] counted in [`crate::FrameStats`], every
 //! frame whose length, CRC, version, integrity or estimator mode, sender, sequence number
 //! or values (non-finite, `|σ| > 1`, `ρ ≤ 0`, an estimate below the receiver's `r_min`)
-//! are wrong; a rejected frame changes nothing but the counters.
+//! are wrong, and in `auth` mode every frame whose tag does not verify or whose counter
+//! is not newer than the sender's last accepted one; a rejected frame changes nothing
+//! but the counters.
 
+pub mod auth;
 mod cobs;
 pub mod quant;
 mod reader;
 mod writer;
 
+pub use auth::SwarmKey;
 pub use cobs::{cobs_decode, cobs_encode, CobsAccumulator, MAX_COBS_LEN};
 pub use reader::{check_frame, decode_frame, AngleItem, Frame, FrameView};
 pub(crate) use reader::{check_mode, RawAngle};
@@ -94,6 +106,8 @@ pub const MAX_ANGLES_PER_FRAME: usize = (MAX_FRAME_LEN - FIXED_LEN) / ANGLE_ITEM
 /// How frames are protected against corruption. Chosen per deployment in
 /// [`crate::AgentConfig::integrity`]; every agent of a swarm must use the same (the mode
 /// byte carries it and a receiver refuses any other).
+///
+/// The `Debug`, `Display` and `defmt` forms of [`Integrity::Auth`] redact the key.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Integrity {
@@ -104,6 +118,20 @@ pub enum Integrity {
     /// No trailer: the link already checks a CRC (the Crazyflie radio does), so the frame
     /// costs no bytes and no instructions for it.
     Link,
+    /// A 64-bit SipHash-2-4 tag under a pre-shared swarm key, over the sender's 64-bit
+    /// frame counter and the whole frame, and replay protection ([`auth`]): for any
+    /// channel an adversary can transmit on.
+    Auth(SwarmKey),
+}
+
+impl core::fmt::Display for Integrity {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Integrity::Crc16 => f.write_str("crc16"),
+            Integrity::Link => f.write_str("link"),
+            Integrity::Auth(key) => write!(f, "auth (key {key})"),
+        }
+    }
 }
 
 impl Integrity {
@@ -112,6 +140,7 @@ impl Integrity {
         match self {
             Integrity::Crc16 => 0,
             Integrity::Link => 1,
+            Integrity::Auth(_) => 2,
         }
     }
 
@@ -120,6 +149,7 @@ impl Integrity {
         match self {
             Integrity::Crc16 => 2,
             Integrity::Link => 0,
+            Integrity::Auth(_) => auth::TAG_LEN,
         }
     }
 
@@ -189,6 +219,20 @@ pub enum FrameError {
     InvalidValue,
     /// A COBS stream chunk that does not decode.
     Cobs,
+    /// `auth`: the tag does not verify (forged, corrupted, another key, or a counter the
+    /// receiver reconstructed wrongly).
+    BadTag,
+    /// `auth`: the frame's counter is not larger than the last one accepted from this
+    /// sender (a replay, or a frame that arrived late).
+    Replayed {
+        /// The sender.
+        sender: AgentId,
+        /// The frame's counter (as carried or reconstructed, see [`auth`]).
+        counter: u64,
+    },
+    /// `auth`: nothing accepted from this sender yet (or since this agent booted) and the
+    /// frame carries no counter extension: its counter is unknown.
+    Unsynced(AgentId),
 }
 
 impl core::fmt::Display for FrameError {
@@ -214,6 +258,15 @@ impl core::fmt::Display for FrameError {
                 "non-finite value, |σ| > 1, non-positive distance or estimate below r_min"
             ),
             Self::Cobs => write!(f, "COBS chunk does not decode"),
+            Self::BadTag => write!(f, "authentication tag does not verify"),
+            Self::Replayed { sender, counter } => write!(
+                f,
+                "replayed or late frame from agent {sender} (counter {counter:#018x})"
+            ),
+            Self::Unsynced(id) => write!(
+                f,
+                "no counter known for agent {id} yet and none in the frame"
+            ),
         }
     }
 }

@@ -1,5 +1,6 @@
 //! Checking and reading frames in place (layout in [`super`]).
 
+use super::auth::{self, Counter, SwarmKey, TAG_LEN};
 use super::{
     mode_byte, offset, quant, FrameError, FrameHeader, Integrity, ANGLE_ITEM_LEN, FIXED_LEN,
     MAX_ANGLES_PER_FRAME, MAX_FRAME_LEN, WIRE_VERSION,
@@ -72,6 +73,19 @@ pub struct FrameView<'a> {
     pub velocity: [f32; 2],
     /// The angle items.
     items: &'a [[u8; ANGLE_ITEM_LEN]],
+    /// `auth`: the bytes before the tag, the tag, and the counter the frame carries.
+    signed: Option<Signed<'a>>,
+}
+
+/// The authenticated part of an `auth` frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Signed<'a> {
+    /// Every byte before the tag.
+    bytes: &'a [u8],
+    /// The tag.
+    tag: &'a [u8; TAG_LEN],
+    /// The full counter, if the frame carries the extension.
+    counter: Option<Counter>,
 }
 
 impl<'a> FrameView<'a> {
@@ -83,6 +97,22 @@ impl<'a> FrameView<'a> {
     /// No angle items.
     pub fn is_empty(&self) -> bool {
         self.items.is_empty()
+    }
+
+    /// `auth`: the sender's full counter, if the frame carries the counter extension
+    /// (see [`super::auth`]); `None` otherwise and in the other integrity modes.
+    pub fn carried_counter(&self) -> Option<Counter> {
+        self.signed.and_then(|s| s.counter)
+    }
+
+    /// `auth`: checks the tag of the frame as sent with `counter` (in constant time);
+    /// [`FrameError::BadTag`] if it does not verify or the frame has no tag.
+    #[inline]
+    pub fn verify_tag(&self, key: &SwarmKey, counter: Counter) -> Result<(), FrameError> {
+        match self.signed {
+            Some(s) if auth::verify(key, counter, s.bytes, s.tag) => Ok(()),
+            _ => Err(FrameError::BadTag),
+        }
     }
 
     /// The raw items.
@@ -141,6 +171,10 @@ impl<'a> FrameView<'a> {
 
 /// Checks length, trailer, version and modes of one frame for a receiver with
 /// `integrity` and `estimator` mode, and returns a view of it. Never panics.
+///
+/// In `auth` mode the tag is *not* checked here: it depends on the sender's counter,
+/// which only a receiver that tracks the sender can know (see
+/// [`FrameView::verify_tag`], [`crate::Agent::receive`] and [`decode_frame`]).
 #[inline]
 pub fn check_frame(
     bytes: &[u8],
@@ -178,21 +212,34 @@ pub(crate) fn check_mode(
     if mode != expected_mode {
         return Err(FrameError::ModeMismatch(mode));
     }
+    let seq = u16::from_le_bytes([q0, q1]);
     let (items, rest) = items.as_chunks::<ANGLE_ITEM_LEN>();
-    if !rest.is_empty() {
-        return Err(FrameError::Malformed);
-    }
+    let signed = match (integrity, rest, trailer.first_chunk::<TAG_LEN>()) {
+        (Integrity::Auth(_), [], Some(tag)) => Some(Signed {
+            bytes: body,
+            tag,
+            counter: None,
+        }),
+        (Integrity::Auth(_), [e0, e1, e2, e3, h0, h1], Some(tag)) => {
+            let epoch = u32::from_le_bytes([*e0, *e1, *e2, *e3]);
+            let high = u32::from(u16::from_le_bytes([*h0, *h1]));
+            Some(Signed {
+                bytes: body,
+                tag,
+                counter: Some(auth::counter(epoch, (high << 16) | u32::from(seq))),
+            })
+        }
+        (_, [], _) => None,
+        _ => return Err(FrameError::Malformed),
+    };
     Ok(FrameView {
-        header: FrameHeader {
-            mode,
-            sender,
-            seq: u16::from_le_bytes([q0, q1]),
-        },
+        header: FrameHeader { mode, sender, seq },
         velocity: [
             f32::from_le_bytes([v0, v1, v2, v3]),
             f32::from_le_bytes([w0, w1, w2, w3]),
         ],
         items,
+        signed,
     })
 }
 
@@ -209,12 +256,22 @@ pub struct Frame {
 
 /// Checks a frame ([`check_frame`] and [`FrameView::validate`] with any positive
 /// distance) and decodes it. Never panics.
+///
+/// In `auth` mode it also verifies the tag with the counter the frame carries
+/// ([`FrameError::Unsynced`] for a frame without the counter extension); it keeps no
+/// state, so it cannot detect replays: agents use [`crate::Agent::receive`].
 pub fn decode_frame(
     bytes: &[u8],
     integrity: Integrity,
     estimator: EstimatorMode,
 ) -> Result<Frame, FrameError> {
     let view = check_frame(bytes, integrity, estimator)?;
+    if let Integrity::Auth(key) = &integrity {
+        let counter = view
+            .carried_counter()
+            .ok_or(FrameError::Unsynced(view.header.sender))?;
+        view.verify_tag(key, counter)?;
+    }
     view.validate(1)?;
     Ok(Frame {
         header: view.header,

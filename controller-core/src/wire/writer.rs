@@ -1,5 +1,6 @@
 //! Building frames (layout in [`super`]).
 
+use super::auth::{self, Counter, StoredCounter, COUNTER_EXT_LEN, TAG_LEN};
 use super::{offset, Integrity, ANGLE_ITEM_LEN, FIXED_LEN, MAX_FRAME_LEN};
 use crate::{crc16, AgentId};
 
@@ -25,6 +26,9 @@ pub struct FrameWriter {
     buf: [u8; MAX_FRAME_LEN],
     len: usize,
     integrity: Integrity,
+    /// `auth`: the full counter of the current frame (its low 16 bits are the header's
+    /// sequence number).
+    counter: StoredCounter,
 }
 
 impl FrameWriter {
@@ -34,13 +38,30 @@ impl FrameWriter {
             buf: [0; MAX_FRAME_LEN],
             len: 0,
             integrity,
+            counter: [0; 2],
         }
     }
 
-    /// Starts a frame: the mode byte, sender, sequence number and velocity.
+    /// Starts a frame: the mode byte, sender, sequence number and velocity. In `auth`
+    /// mode the frame's full counter is `seq` (epoch 0): use
+    /// [`FrameWriter::start_counted`].
     #[inline]
     pub fn start(&mut self, mode: u8, sender: AgentId, seq: u16, velocity: [f32; 2]) {
-        let [q0, q1] = seq.to_le_bytes();
+        self.start_counted(mode, sender, Counter::from(seq), velocity);
+    }
+
+    /// Starts a frame whose full counter (see [`super::auth`]) is `counter`; the header
+    /// carries its low 16 bits as the sequence number.
+    #[inline]
+    pub fn start_counted(
+        &mut self,
+        mode: u8,
+        sender: AgentId,
+        counter: Counter,
+        velocity: [f32; 2],
+    ) {
+        self.counter = auth::store(counter);
+        let [q0, q1] = (counter as u16).to_le_bytes();
         let [v0, v1, v2, v3] = velocity[0].to_le_bytes();
         let [w0, w1, w2, w3] = velocity[1].to_le_bytes();
         if let Some(head) = self.buf.first_chunk_mut::<FIXED_LEN>() {
@@ -80,14 +101,38 @@ impl FrameWriter {
         (self.len.saturating_sub(FIXED_LEN)) / ANGLE_ITEM_LEN
     }
 
-    /// Appends the integrity trailer and returns the finished frame.
+    /// Appends the integrity trailer and returns the finished frame. In `auth` mode: the
+    /// counter extension if it fits (at most 3 items), then the tag.
     #[inline]
     pub fn finish(&mut self) -> &[u8] {
-        let body = self.len;
-        if self.integrity == Integrity::Crc16 {
-            let crc = crc16::checksum(self.buf.get(..body).unwrap_or(&[]));
-            if let Some(t) = self.buf.get_mut(body..body + 2) {
-                t.copy_from_slice(&crc.to_le_bytes());
+        let mut body = self.len;
+        match &self.integrity {
+            Integrity::Crc16 => {
+                let crc = crc16::checksum(self.buf.get(..body).unwrap_or(&[]));
+                if let Some(t) = self.buf.get_mut(body..body + 2) {
+                    t.copy_from_slice(&crc.to_le_bytes());
+                }
+            }
+            Integrity::Link => {}
+            Integrity::Auth(key) => {
+                if body + COUNTER_EXT_LEN + TAG_LEN <= MAX_FRAME_LEN {
+                    let [epoch, n] = self.counter;
+                    let [e0, e1, e2, e3] = epoch.to_le_bytes();
+                    let [h0, h1] = ((n >> 16) as u16).to_le_bytes();
+                    let ext = self
+                        .buf
+                        .get_mut(body..)
+                        .and_then(|b| b.first_chunk_mut::<COUNTER_EXT_LEN>());
+                    if let Some(ext) = ext {
+                        *ext = [e0, e1, e2, e3, h0, h1];
+                        body += COUNTER_EXT_LEN;
+                    }
+                }
+                let (signed, rest) = self.buf.split_at_mut(body.min(MAX_FRAME_LEN));
+                let tag = auth::tag(key, auth::load(self.counter), signed);
+                if let Some(t) = rest.first_chunk_mut::<TAG_LEN>() {
+                    *t = tag;
+                }
             }
         }
         let end = body + self.integrity.trailer_len();
