@@ -6,7 +6,7 @@ use super::aggregate::{aggregate, PointStats, SETTLE_QUANTILES};
 use super::error::SweepError;
 use super::plan::{cell, Plan};
 use super::run::{Finished, RunRow};
-use super::runs_csv;
+use super::runs_csv::{self, float};
 use super::shard::Shard;
 use crate::analysis::Outcome;
 use serde::{Deserialize, Serialize};
@@ -94,7 +94,7 @@ fn num(x: f64) -> serde_json::Value {
 }
 
 fn opt_cell(x: Option<f64>) -> String {
-    x.map_or(String::new(), |v| v.to_string())
+    x.map_or(String::new(), float)
 }
 
 /// The `points.csv` header.
@@ -121,7 +121,7 @@ fn write_points_csv(path: &Path, m: &Manifest, stats: &[PointStats]) -> Result<(
         for f in &s.fractions {
             rec.extend([f.fraction, f.lo, f.hi].map(|x| {
                 if x.is_finite() {
-                    x.to_string()
+                    float(x)
                 } else {
                     String::new()
                 }

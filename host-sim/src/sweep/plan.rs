@@ -5,7 +5,7 @@ use super::error::{SweepError, INVALID, SCHEMA};
 use super::spec::{AxisSpec, PerturbationSpec, Sampling, SweepFile, SweepSource};
 use crate::api;
 use crate::model::Model;
-use crate::scenario::Source;
+use crate::scenario::{ScenarioErrors, Source};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -150,7 +150,7 @@ impl Plan {
     }
 
     /// Loads the base scenario with `overrides`.
-    pub fn model(&self, overrides: &[String]) -> Result<Model, crate::ScenarioErrors> {
+    pub fn model(&self, overrides: &[String]) -> Result<Model, ScenarioErrors> {
         api::load_toml(&self.base.text, &self.base.label, overrides)
     }
 }

@@ -124,7 +124,7 @@ pub fn run_job(plan: &Plan, j: u64) -> RunRow {
 }
 
 /// What a (possibly interrupted) sweep produced.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Finished {
     /// The finished runs, in job order.
     pub rows: Vec<RunRow>,

@@ -77,6 +77,18 @@ pub fn plot_xy(dir: &Path, stem: &str, chart: &XyChart) -> Result<Vec<PathBuf>, 
     Ok(vec![png, svg])
 }
 
+/// A tick label: three decimals at most, trailing zeros dropped (`0.15`, not
+/// `0.15000000000000002`).
+fn tick(x: f64) -> String {
+    let s = format!("{x:.3}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" {
+        "0".to_owned()
+    } else {
+        s.to_owned()
+    }
+}
+
 fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, c: &XyChart, bitmap: bool) -> DrawResult
 where
     DB::ErrorType: 'static,
@@ -119,7 +131,7 @@ where
     let cats = c.categories.clone().unwrap_or_default();
     let x_fmt = |x: &f64| {
         if c.categories.is_none() {
-            return format!("{x}");
+            return tick(*x);
         }
         let k = x.round();
         if (x - k).abs() < 1e-6 && k >= 0.0 {
