@@ -143,7 +143,7 @@ pub(super) fn command(args: &SweepArgs, quiet: bool) -> u8 {
             "{} of {} runs in {wall:.1} s wall on {} threads",
             finished.rows.len(),
             finished.jobs,
-            rayon::current_num_threads().max(args.jobs.unwrap_or(0))
+            args.jobs.unwrap_or_else(rayon::current_num_threads)
         );
     }
     if finished.interrupted {

@@ -73,7 +73,7 @@ pub fn draw(dir: &Path, m: &Manifest, stats: &[PointStats]) -> Result<Vec<PathBu
     let mut files = Vec::new();
     let runs: u64 = stats.iter().map(|s| s.n).sum();
     let subtitle = format!(
-        "{} · base {} · {} runs, {} per point, seed {} · 95 % Wilson intervals",
+        "{} · base {} · {} runs, {} per point, seed {}",
         m.sweep, m.base, runs, m.runs, m.seed
     );
     // Outcomes that happened somewhere (the others would be flat zero lines).
@@ -130,7 +130,7 @@ pub fn draw(dir: &Path, m: &Manifest, stats: &[PointStats]) -> Result<Vec<PathBu
         let stem = stem_of(key);
         let chart = XyChart {
             title: format!("{} — outcome fractions vs {key}", m.name),
-            subtitle: subtitle.clone(),
+            subtitle: format!("{subtitle} · bars: 95 % Wilson intervals"),
             x_label: key.clone(),
             y_label: "fraction of runs".to_owned(),
             categories: categories.clone(),
@@ -143,7 +143,7 @@ pub fn draw(dir: &Path, m: &Manifest, stats: &[PointStats]) -> Result<Vec<PathBu
         );
         let chart = XyChart {
             title: format!("{} — settle time vs {key}", m.name),
-            subtitle: subtitle.clone(),
+            subtitle: format!("{subtitle} · bars: p10–p90 of the runs that settled"),
             x_label: key.clone(),
             y_label: "settle time (s)".to_owned(),
             categories,
