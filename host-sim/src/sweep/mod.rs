@@ -2,8 +2,8 @@
 //! of the library API ([`crate::load_toml`], [`crate::Simulation`]).
 //!
 //! * [`spec`]: the sweep file's schema, parsed with located errors;
-//! * [`plan`]: checked against the base scenario, the points laid out (grid or random),
-//!   each run's seed derived from (sweep seed, point, run);
+//! * [`plan`]: checked against the base scenario (the axes and points in `axes.rs`: grid
+//!   or random), each run's seed derived from (sweep seed, point, run);
 //! * [`perturb`]: random initial shapes (as `host-sim design` makes them);
 //! * [`run`]: the runs, in parallel on rayon's pool, rows in job order;
 //! * [`shard`] and [`merge`]: a deterministic share of the runs, and shares combined;
@@ -16,6 +16,7 @@
 //! shards.
 
 pub mod aggregate;
+mod axes;
 pub mod builtin;
 pub mod error;
 pub mod figures;

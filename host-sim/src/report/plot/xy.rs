@@ -180,3 +180,67 @@ where
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn line(label: &str, pts: &[(f64, f64)]) -> XyLine {
+        XyLine {
+            label: label.to_owned(),
+            points: pts
+                .iter()
+                .map(|&(x, y)| XyPoint {
+                    x,
+                    y,
+                    lo: y - 0.1,
+                    hi: y + 0.1,
+                })
+                .collect(),
+            join: true,
+        }
+    }
+
+    #[test]
+    fn ticks_are_short() {
+        assert_eq!(tick(0.15000000000000002), "0.15");
+        assert_eq!(tick(2.0), "2");
+        assert_eq!(tick(-0.0001), "0");
+        assert_eq!(tick(12.3456), "12.346");
+    }
+
+    #[test]
+    fn numeric_and_categorical_figures_are_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let numeric = XyChart {
+            title: "t".to_owned(),
+            subtitle: "s".to_owned(),
+            x_label: "radio.loss".to_owned(),
+            y_label: "fraction".to_owned(),
+            categories: None,
+            y_range: Some((0.0, 1.0)),
+            // A NaN point (no run at that point) is skipped, not drawn.
+            lines: vec![line(
+                "converged",
+                &[(0.0, 1.0), (0.1, f64::NAN), (0.2, 0.5)],
+            )],
+        };
+        let files = plot_xy(dir.path(), "numeric", &numeric).unwrap();
+        let categorical = XyChart {
+            categories: Some(vec!["continuous".to_owned(), "sampled".to_owned()]),
+            y_range: None,
+            lines: vec![line("a", &[(0.0, 3.0), (1.0, 4.0)]), line("b", &[])],
+            ..numeric
+        };
+        let more = plot_xy(dir.path(), "categorical", &categorical).unwrap();
+        for f in files.iter().chain(&more) {
+            assert!(
+                std::fs::metadata(f).unwrap().len() > 1000,
+                "{}",
+                f.display()
+            );
+        }
+        let svg = std::fs::read_to_string(dir.path().join("categorical.svg")).unwrap();
+        assert!(svg.contains("continuous") && svg.contains("sampled"));
+    }
+}
