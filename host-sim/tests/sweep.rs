@@ -341,6 +341,24 @@ fn three_shards_merged_equal_one_run() {
 }
 
 #[test]
+fn common_seeds_give_every_point_the_same_runs_seeds() {
+    let p = plan(&TINY.replace("runs = 3", "runs = 2\ncommon_seeds = true")).unwrap();
+    let done = run_in_pool(&p, 2, Shard::ALL);
+    assert_eq!(done.rows.len(), 8);
+    for r in &done.rows {
+        assert_eq!(r.seed, run_seed(7, 0, r.run), "{r:?}");
+    }
+    // Points 0 and 2 differ only in the perturbation: the same rotation at both.
+    assert_eq!(done.rows[0].rotation_deg, done.rows[4].rotation_deg);
+    let own = plan(TINY).unwrap();
+    assert_ne!(
+        own.seed_of(1, 0),
+        own.seed_of(0, 0),
+        "by default each point has its own"
+    );
+}
+
+#[test]
 fn stopping_keeps_the_finished_runs() {
     let p = plan(TINY).unwrap();
     let pool = rayon::ThreadPoolBuilder::new()

@@ -30,6 +30,8 @@ pub struct Manifest {
     pub seed: u64,
     /// Runs per point.
     pub runs: u64,
+    /// Run `r` has the same seed at every point.
+    pub common_seeds: bool,
     /// `grid` or `random`.
     pub sampling: String,
     /// Axis keys.
@@ -59,6 +61,7 @@ impl Manifest {
             fingerprint: plan.fingerprint.clone(),
             seed: plan.seed,
             runs: plan.runs,
+            common_seeds: plan.common_seeds,
             sampling: plan.sampling.as_str().to_owned(),
             axes: plan.axes.clone(),
             points: plan

@@ -50,6 +50,8 @@ pub struct Plan {
     pub seed: u64,
     /// Runs per point.
     pub runs: u64,
+    /// Run `r` has the same seed at every point (common random numbers).
+    pub common_seeds: bool,
     /// Grid or random.
     pub sampling: Sampling,
     /// The base scenario.
@@ -122,6 +124,12 @@ impl Plan {
         ((j / self.runs) as usize, j % self.runs)
     }
 
+    /// The scenario seed of run `r` at point `p`: [`run_seed`] of the sweep seed, `p` (0
+    /// for every point with `common_seeds`) and `r`.
+    pub fn seed_of(&self, p: usize, r: u64) -> u64 {
+        run_seed(self.seed, if self.common_seeds { 0 } else { p as u64 }, r)
+    }
+
     /// The perturbation fraction at point `p` (its axis, else the section's).
     pub fn fraction(&self, p: usize) -> Option<f64> {
         let base = self.perturbation.as_ref()?.fraction;
@@ -192,6 +200,7 @@ fn check(src: &SweepSource, f: SweepFile, runs: Option<u64>) -> Result<Plan, Swe
         label: src.label.clone(),
         seed: f.seed,
         runs,
+        common_seeds: f.common_seeds,
         sampling: f.sampling,
         fingerprint: fingerprint(&[
             &src.text,
