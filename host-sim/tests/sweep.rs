@@ -193,6 +193,35 @@ fn builtin_sweeps_load() {
     }
 }
 
+#[test]
+fn a_base_scenario_file_is_found_next_to_the_sweep_file() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = host_sim::BUILTINS
+        .iter()
+        .find(|b| b.name == "formation-only")
+        .unwrap()
+        .text;
+    std::fs::write(tmp.path().join("square.toml"), text).unwrap();
+    let sweep = tmp.path().join("s.toml");
+    std::fs::write(&sweep, "[base]\nscenario = \"square.toml\"\n").unwrap();
+    let p = Plan::load(sweep.to_str().unwrap(), Some(2)).unwrap();
+    assert!(p.base.label.ends_with("square.toml"), "{}", p.base.label);
+    assert_eq!((p.points.len(), p.runs, p.name.as_str()), (1, 2, "s"));
+    // A broken base file: the sweep's field, the scenario's file, field and reason.
+    std::fs::write(
+        tmp.path().join("square.toml"),
+        text.replace("mass = 1.0", "mass = -1.0"),
+    )
+    .unwrap();
+    let e = Plan::load(sweep.to_str().unwrap(), None).unwrap_err();
+    assert_eq!((e.field.as_str(), e.code), ("base.scenario", 28));
+    assert!(
+        e.reason
+            .contains("square.toml: field `agent_defaults.mass`"),
+        "{e}"
+    );
+}
+
 // ---------------------------------------------------------------- layout and seeds
 
 #[test]
