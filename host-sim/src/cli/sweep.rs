@@ -1,5 +1,6 @@
 //! `host-sim sweep`: run a sweep file (or a built-in sweep) on every core with a progress
-//! bar, Ctrl-C keeping what finished; `host-sim sweep merge` combines shard outputs.
+//! bar, Ctrl-C keeping what finished; `host-sim sweep merge` combines shard outputs and
+//! `host-sim sweep plot` redraws a sweep's figures.
 
 use crate::exit_code;
 use crate::sweep::{self, Manifest, Plan, Shard, SweepError, BUILTIN_SWEEPS};
@@ -53,6 +54,11 @@ pub enum SweepCommand {
         #[arg(long)]
         no_plots: bool,
     },
+    /// (Re)draw the figures of a sweep's output directory from its sweep.json and runs.csv.
+    Plot {
+        /// The sweep's output directory.
+        dir: PathBuf,
+    },
 }
 
 /// Set by Ctrl-C: no new run starts.
@@ -75,6 +81,19 @@ pub(super) fn command(args: &SweepArgs, quiet: bool) -> u8 {
             .and_then(|(m, rows)| finish(out, &m, &rows, !no_plots, quiet))
         {
             Ok(()) => exit_code::CONVERGED,
+            Err(e) => fail(&e),
+        };
+    }
+    if let Some(SweepCommand::Plot { dir }) = &args.command {
+        return match sweep::redraw(dir) {
+            Ok(files) => {
+                if !quiet {
+                    for f in files {
+                        println!("{}", f.display());
+                    }
+                }
+                exit_code::CONVERGED
+            }
             Err(e) => fail(&e),
         };
     }

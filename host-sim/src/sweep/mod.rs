@@ -35,7 +35,7 @@ pub use aggregate::{aggregate, PointStats};
 pub use builtin::{builtin_sweep, BuiltinSweep, BUILTIN_SWEEPS};
 pub use error::SweepError;
 pub use merge::merge;
-pub use output::{write_all, Manifest};
+pub use output::{redraw, write_all, Manifest};
 pub use plan::{run_seed, Plan};
 pub use run::{run_all, run_job, Finished, RunRow};
 pub use shard::Shard;

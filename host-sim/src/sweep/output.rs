@@ -30,7 +30,8 @@ pub struct Manifest {
     pub seed: u64,
     /// Runs per point.
     pub runs: u64,
-    /// Run `r` has the same seed at every point.
+    /// Run `r` has the same seed at every point (absent: false).
+    #[serde(default)]
     pub common_seeds: bool,
     /// `grid` or `random`.
     pub sampling: String,
@@ -209,4 +210,12 @@ pub fn write_all(
         files.extend(super::figures::draw(dir, m, &stats)?);
     }
     Ok((files, stats))
+}
+
+/// Redraws the figures of the sweep output folder `dir` from its `sweep.json` and
+/// `runs.csv` (for a shard: `sweep merge` first); returns the files.
+pub fn redraw(dir: &Path) -> Result<Vec<PathBuf>, SweepError> {
+    let m = Manifest::read(dir)?;
+    let rows = runs_csv::read(&dir.join("runs.csv"), &m)?;
+    super::figures::draw(dir, &m, &aggregate(&rows, m.points.len()))
 }
