@@ -570,6 +570,20 @@ fn command_line_runs_a_sweep_and_refuses_a_bad_one() {
     );
     assert!(out.join("outcomes_vs_radio_loss.png").is_file());
     assert!(out.join("settle_vs_perturbation.svg").is_file());
+    // `sweep plot` redraws the figures from sweep.json and runs.csv.
+    std::fs::remove_file(out.join("outcomes_vs_radio_loss.png")).unwrap();
+    let plot = std::process::Command::new(bin)
+        .args(["-q", "sweep", "plot"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(
+        plot.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&plot.stderr)
+    );
+    assert!(out.join("outcomes_vs_radio_loss.png").is_file());
 
     std::fs::write(
         &file,
