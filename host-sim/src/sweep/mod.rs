@@ -6,8 +6,8 @@
 //!   or random), each run's seed derived from (sweep seed, point, run);
 //! * [`perturb`]: random initial shapes (as `host-sim design` makes them);
 //! * [`run`]: the runs, in parallel on rayon's pool, rows in job order;
-//! * [`shard`] and [`merge`]: a deterministic share of the runs, and shares combined;
-//! * [`aggregate`] and [`stats`]: outcome fractions with 95 % Wilson intervals and
+//! * [`shard`] and [`mod@merge`]: a deterministic share of the runs, and shares combined;
+//! * [`mod@aggregate`] and [`stats`]: outcome fractions with 95 % Wilson intervals and
 //!   settle-time quantiles per point;
 //! * [`output`], [`runs_csv`] and [`figures`]: `sweep.json`, `runs.csv`, `points.csv`,
 //!   `points.json` and the figures.

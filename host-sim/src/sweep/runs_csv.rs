@@ -24,7 +24,7 @@ const TAIL: [&str; 14] = [
     "reason",
 ];
 
-/// The header: `point, run`, the axis keys, then [`TAIL`].
+/// The header: `point, run`, the axis keys, then `seed, outcome, …, reason`.
 pub fn header(m: &Manifest) -> Vec<String> {
     let mut h = vec!["point".to_owned(), "run".to_owned()];
     h.extend(m.axes.iter().cloned());
