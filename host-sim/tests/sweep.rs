@@ -194,6 +194,29 @@ fn builtin_sweeps_load() {
 }
 
 #[test]
+fn command_line_overrides_join_the_base_and_the_fingerprint() {
+    let tmp = tempfile::tempdir().unwrap();
+    let f = tmp.path().join("tiny.toml");
+    std::fs::write(&f, TINY).unwrap();
+    let f = f.to_str().unwrap();
+    let plain = Plan::load(f, None).unwrap();
+    let set = ["duration=1".to_owned()];
+    let short = Plan::load_with(f, None, &set).unwrap();
+    assert_eq!(short.base.set.last(), Some(&set[0]));
+    assert_eq!(
+        short.model(&short.overrides(0, None)).unwrap().duration,
+        1.0
+    );
+    assert_ne!(
+        plain.fingerprint, short.fingerprint,
+        "shards with other --set must not merge"
+    );
+    let e = Plan::load_with(f, None, &["radio.loss=7".to_owned()]).unwrap_err();
+    assert_eq!(e.field, "base.set");
+    assert!(e.reason.contains("radio.loss"), "{e}");
+}
+
+#[test]
 fn a_base_scenario_file_is_found_next_to_the_sweep_file() {
     let tmp = tempfile::tempdir().unwrap();
     let text = host_sim::BUILTINS

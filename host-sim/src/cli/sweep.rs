@@ -28,6 +28,9 @@ pub struct SweepArgs {
     /// Run only shard K of N (jobs j with j mod N = K − 1); merge with `sweep merge`.
     #[arg(long, value_name = "K/N")]
     pub shard: Option<Shard>,
+    /// Override a base scenario field for every run, as for `run` (`--set duration=20`).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
     /// Worker threads (default: one per core).
     #[arg(long, value_name = "N")]
     pub jobs: Option<usize>,
@@ -107,7 +110,7 @@ pub(super) fn command(args: &SweepArgs, quiet: bool) -> u8 {
         eprintln!("error: give a sweep file or built-in name (host-sim sweep --list)");
         return exit_code::USAGE;
     };
-    let plan = match Plan::load(name, args.runs) {
+    let plan = match Plan::load_with(name, args.runs, &args.set) {
         Ok(p) => p,
         Err(e) => return fail(&e),
     };

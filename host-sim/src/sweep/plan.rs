@@ -104,8 +104,16 @@ impl Plan {
     /// Reads, parses and checks a sweep (a file or a built-in name); `runs` replaces the
     /// file's runs per point.
     pub fn load(arg: &str, runs: Option<u64>) -> Result<Self, SweepError> {
+        Self::load_with(arg, runs, &[])
+    }
+
+    /// As [`Plan::load`], with `set` appended to `[base].set` (the command line's
+    /// `--set`; part of the fingerprint, so shards must be given the same).
+    pub fn load_with(arg: &str, runs: Option<u64>, set: &[String]) -> Result<Self, SweepError> {
         let source = SweepSource::resolve(arg)?;
-        Self::from_source(&source, runs)
+        let mut file = source.parse()?;
+        file.base.set.extend(set.iter().cloned());
+        check(&source, file, runs)
     }
 
     /// Parses and checks a sweep's text.
@@ -207,6 +215,7 @@ fn check(src: &SweepSource, f: SweepFile, runs: Option<u64>) -> Result<Plan, Swe
             &base.text,
             &f.seed.to_string(),
             &runs.to_string(),
+            &f.base.set.join("\n"),
         ]),
         base,
         perturbation,
