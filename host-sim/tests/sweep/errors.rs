@@ -134,7 +134,7 @@ fn builtin_sweeps_load() {
     let a = Plan::load("basin", None).expect("basin");
     assert_eq!((a.points.len(), a.runs), (6, 100));
     let b = Plan::load("noise-loss", None).expect("noise-loss");
-    assert_eq!(b.points.len(), 36);
+    assert_eq!((b.points.len(), b.runs), (36, 100));
     assert_eq!(b.points[35][0], toml::Value::Float(5.0));
     // (c) needs `controller.comm_rate_hz` in the scenario schema; until it is there it is
     // refused, naming the key.
