@@ -13,8 +13,8 @@ use proc_macro2::{TokenStream, TokenTree};
 use std::path::{Path, PathBuf};
 use syn::visit::Visit;
 
-/// The layers, lowest first, and the lower layers each may import. `design` (a shape →
-/// scenario generator) is not written yet; its place is reserved.
+/// The layers, lowest first, and the lower layers each may import. `sweep` (Monte Carlo
+/// sweeps) is a client of the API, below the command line.
 const LAYERS: &[(&str, &[&str])] = &[
     ("exit_code", &[]),
     ("model", &["exit_code"]),
@@ -35,6 +35,19 @@ const LAYERS: &[(&str, &[&str])] = &[
         ],
     ),
     (
+        "sweep",
+        &[
+            "exit_code",
+            "model",
+            "scenario",
+            "design",
+            "analysis",
+            "engine",
+            "report",
+            "api",
+        ],
+    ),
+    (
         "cli",
         &[
             "exit_code",
@@ -45,6 +58,7 @@ const LAYERS: &[(&str, &[&str])] = &[
             "engine",
             "report",
             "api",
+            "sweep",
         ],
     ),
 ];

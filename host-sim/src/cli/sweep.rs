@@ -1,5 +1,6 @@
 //! `host-sim sweep`: run a sweep file (or a built-in sweep) on every core with a progress
-//! bar, Ctrl-C keeping what finished; `host-sim sweep merge` combines shard outputs.
+//! bar, Ctrl-C keeping what finished; `host-sim sweep merge` combines shard outputs and
+//! `host-sim sweep plot` redraws a sweep's figures.
 
 use crate::exit_code;
 use crate::sweep::{self, Manifest, Plan, Shard, SweepError, BUILTIN_SWEEPS};
@@ -27,6 +28,9 @@ pub struct SweepArgs {
     /// Run only shard K of N (jobs j with j mod N = K − 1); merge with `sweep merge`.
     #[arg(long, value_name = "K/N")]
     pub shard: Option<Shard>,
+    /// Override a base scenario field for every run, as for `run` (`--set duration=20`).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
     /// Worker threads (default: one per core).
     #[arg(long, value_name = "N")]
     pub jobs: Option<usize>,
@@ -53,6 +57,11 @@ pub enum SweepCommand {
         #[arg(long)]
         no_plots: bool,
     },
+    /// (Re)draw the figures of a sweep's output directory from its sweep.json and runs.csv.
+    Plot {
+        /// The sweep's output directory.
+        dir: PathBuf,
+    },
 }
 
 /// Set by Ctrl-C: no new run starts.
@@ -78,6 +87,19 @@ pub(super) fn command(args: &SweepArgs, quiet: bool) -> u8 {
             Err(e) => fail(&e),
         };
     }
+    if let Some(SweepCommand::Plot { dir }) = &args.command {
+        return match sweep::redraw(dir) {
+            Ok(files) => {
+                if !quiet {
+                    for f in files {
+                        println!("{}", f.display());
+                    }
+                }
+                exit_code::CONVERGED
+            }
+            Err(e) => fail(&e),
+        };
+    }
     if args.list {
         for b in BUILTIN_SWEEPS {
             println!("{:<12} {}", b.name, b.description);
@@ -88,7 +110,7 @@ pub(super) fn command(args: &SweepArgs, quiet: bool) -> u8 {
         eprintln!("error: give a sweep file or built-in name (host-sim sweep --list)");
         return exit_code::USAGE;
     };
-    let plan = match Plan::load(name, args.runs) {
+    let plan = match Plan::load_with(name, args.runs, &args.set) {
         Ok(p) => p,
         Err(e) => return fail(&e),
     };
@@ -143,7 +165,7 @@ pub(super) fn command(args: &SweepArgs, quiet: bool) -> u8 {
             "{} of {} runs in {wall:.1} s wall on {} threads",
             finished.rows.len(),
             finished.jobs,
-            rayon::current_num_threads().max(args.jobs.unwrap_or(0))
+            args.jobs.unwrap_or_else(rayon::current_num_threads)
         );
     }
     if finished.interrupted {

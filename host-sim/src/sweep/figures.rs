@@ -1,11 +1,12 @@
 //! The sweep's figures, two per axis: the outcome fractions (with their 95 % intervals)
-//! against the axis, and the settle time (median, p10–p90 bar) against it. On a grid, one
-//! line per combination of the other axes; random points are drawn as markers.
+//! against the axis, one panel per outcome that happened, and the settle time (median,
+//! p10–p90 bar) against it. On a grid, one line per combination of the other axes;
+//! random points are drawn as markers.
 
 use super::aggregate::PointStats;
 use super::error::SweepError;
 use super::output::Manifest;
-use crate::report::plot::{plot_xy, XyChart, XyLine, XyPoint};
+use crate::report::plot::{plot_xy, XyChart, XyLine, XyPanel, XyPoint};
 use std::path::{Path, PathBuf};
 
 /// `radio.loss` → `radio_loss` (file stems).
@@ -60,20 +61,12 @@ fn groups(m: &Manifest, a: usize) -> Vec<(String, Vec<usize>)> {
     out
 }
 
-fn with_group(what: &str, group: &str) -> String {
-    if group.is_empty() {
-        what.to_owned()
-    } else {
-        format!("{what} · {group}")
-    }
-}
-
 /// Draws every figure into `dir`; returns the files.
 pub fn draw(dir: &Path, m: &Manifest, stats: &[PointStats]) -> Result<Vec<PathBuf>, SweepError> {
     let mut files = Vec::new();
     let runs: u64 = stats.iter().map(|s| s.n).sum();
     let subtitle = format!(
-        "{} · base {} · {} runs, {} per point, seed {} · 95 % Wilson intervals",
+        "{} · base {} · {} runs, {} per point, seed {}",
         m.sweep, m.base, runs, m.runs, m.seed
     );
     // Outcomes that happened somewhere (the others would be flat zero lines).
@@ -88,13 +81,26 @@ pub fn draw(dir: &Path, m: &Manifest, stats: &[PointStats]) -> Result<Vec<PathBu
             v.sort_by(|&i, &j| x[i].total_cmp(&x[j]));
             v
         };
-        let mut outcome_lines = Vec::new();
+        // One panel per outcome that happened, one series per group (colour = group).
+        let mut panels: Vec<XyPanel> = seen
+            .iter()
+            .map(|&o| XyPanel {
+                y_label: format!("{} (fraction)", m.outcomes[o]),
+                y_range: Some((-0.02, 1.02)),
+                lines: Vec::new(),
+            })
+            .collect();
         let mut settle_lines = Vec::new();
         for (group, ps) in groups(m, a) {
             let ps = order(&ps);
-            for &o in &seen {
-                outcome_lines.push(XyLine {
-                    label: with_group(&m.outcomes[o], &group),
+            let label = if group.is_empty() {
+                "all points".to_owned()
+            } else {
+                group
+            };
+            for (panel, &o) in panels.iter_mut().zip(&seen) {
+                panel.lines.push(XyLine {
+                    label: label.clone(),
                     points: ps
                         .iter()
                         .map(|&p| {
@@ -111,7 +117,7 @@ pub fn draw(dir: &Path, m: &Manifest, stats: &[PointStats]) -> Result<Vec<PathBu
                 });
             }
             settle_lines.push(XyLine {
-                label: with_group("settle time p50 (bar p10–p90)", &group),
+                label,
                 points: ps
                     .iter()
                     .filter_map(|&p| {
@@ -130,12 +136,10 @@ pub fn draw(dir: &Path, m: &Manifest, stats: &[PointStats]) -> Result<Vec<PathBu
         let stem = stem_of(key);
         let chart = XyChart {
             title: format!("{} — outcome fractions vs {key}", m.name),
-            subtitle: subtitle.clone(),
+            subtitle: format!("{subtitle} · bars: 95 % Wilson intervals"),
             x_label: key.clone(),
-            y_label: "fraction of runs".to_owned(),
             categories: categories.clone(),
-            y_range: Some((-0.02, 1.02)),
-            lines: outcome_lines,
+            panels,
         };
         files.extend(
             plot_xy(dir, &format!("outcomes_vs_{stem}"), &chart)
@@ -143,12 +147,14 @@ pub fn draw(dir: &Path, m: &Manifest, stats: &[PointStats]) -> Result<Vec<PathBu
         );
         let chart = XyChart {
             title: format!("{} — settle time vs {key}", m.name),
-            subtitle: subtitle.clone(),
+            subtitle: format!("{subtitle} · median, bars: p10–p90 of the runs that settled"),
             x_label: key.clone(),
-            y_label: "settle time (s)".to_owned(),
             categories,
-            y_range: None,
-            lines: settle_lines,
+            panels: vec![XyPanel {
+                y_label: "settle time (s)".to_owned(),
+                y_range: None,
+                lines: settle_lines,
+            }],
         };
         files.extend(
             plot_xy(dir, &format!("settle_vs_{stem}"), &chart)

@@ -6,7 +6,7 @@ use super::aggregate::{aggregate, PointStats, SETTLE_QUANTILES};
 use super::error::SweepError;
 use super::plan::{cell, Plan};
 use super::run::{Finished, RunRow};
-use super::runs_csv;
+use super::runs_csv::{self, float};
 use super::shard::Shard;
 use crate::analysis::Outcome;
 use serde::{Deserialize, Serialize};
@@ -30,6 +30,9 @@ pub struct Manifest {
     pub seed: u64,
     /// Runs per point.
     pub runs: u64,
+    /// Run `r` has the same seed at every point (absent: false).
+    #[serde(default)]
+    pub common_seeds: bool,
     /// `grid` or `random`.
     pub sampling: String,
     /// Axis keys.
@@ -59,6 +62,7 @@ impl Manifest {
             fingerprint: plan.fingerprint.clone(),
             seed: plan.seed,
             runs: plan.runs,
+            common_seeds: plan.common_seeds,
             sampling: plan.sampling.as_str().to_owned(),
             axes: plan.axes.clone(),
             points: plan
@@ -94,7 +98,7 @@ fn num(x: f64) -> serde_json::Value {
 }
 
 fn opt_cell(x: Option<f64>) -> String {
-    x.map_or(String::new(), |v| v.to_string())
+    x.map_or(String::new(), float)
 }
 
 /// The `points.csv` header.
@@ -121,7 +125,7 @@ fn write_points_csv(path: &Path, m: &Manifest, stats: &[PointStats]) -> Result<(
         for f in &s.fractions {
             rec.extend([f.fraction, f.lo, f.hi].map(|x| {
                 if x.is_finite() {
-                    x.to_string()
+                    float(x)
                 } else {
                     String::new()
                 }
@@ -206,4 +210,12 @@ pub fn write_all(
         files.extend(super::figures::draw(dir, m, &stats)?);
     }
     Ok((files, stats))
+}
+
+/// Redraws the figures of the sweep output folder `dir` from its `sweep.json` and
+/// `runs.csv` (for a shard: `sweep merge` first); returns the files.
+pub fn redraw(dir: &Path) -> Result<Vec<PathBuf>, SweepError> {
+    let m = Manifest::read(dir)?;
+    let rows = runs_csv::read(&dir.join("runs.csv"), &m)?;
+    super::figures::draw(dir, &m, &aggregate(&rows, m.points.len()))
 }

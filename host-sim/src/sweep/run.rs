@@ -20,7 +20,7 @@ pub struct RunRow {
     pub point: usize,
     /// Run index within the point.
     pub run: u64,
-    /// The scenario seed of the run ([`super::plan::run_seed`]).
+    /// The scenario seed of the run ([`Plan::seed_of`]).
     pub seed: u64,
     /// The outcome's name (`summary.json`), or [`ERROR`].
     pub outcome: String,
@@ -76,7 +76,7 @@ impl RunRow {
 /// Runs job `j` of `plan`.
 pub fn run_job(plan: &Plan, j: u64) -> RunRow {
     let (p, r) = plan.job(j);
-    let seed = super::plan::run_seed(plan.seed, p as u64, r);
+    let seed = plan.seed_of(p, r);
     let mut overrides = plan.overrides(p, Some(seed));
     let model = match plan.model(&overrides) {
         Ok(m) => m,
@@ -124,7 +124,7 @@ pub fn run_job(plan: &Plan, j: u64) -> RunRow {
 }
 
 /// What a (possibly interrupted) sweep produced.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Finished {
     /// The finished runs, in job order.
     pub rows: Vec<RunRow>,

@@ -24,7 +24,7 @@ const TAIL: [&str; 14] = [
     "reason",
 ];
 
-/// The header: `point, run`, the axis keys, then [`TAIL`].
+/// The header: `point, run`, the axis keys, then `seed, outcome, …, reason`.
 pub fn header(m: &Manifest) -> Vec<String> {
     let mut h = vec!["point".to_owned(), "run".to_owned()];
     h.extend(m.axes.iter().cloned());
@@ -32,8 +32,14 @@ pub fn header(m: &Manifest) -> Vec<String> {
     h
 }
 
-fn opt<T: ToString>(x: Option<T>) -> String {
-    x.map_or(String::new(), |v| v.to_string())
+/// A float in its shortest round-trip form, with an exponent when small or large
+/// (`5.329070518200751e-15`), as Rust's `Debug` writes it.
+pub fn float(x: f64) -> String {
+    format!("{x:?}")
+}
+
+fn opt(x: Option<f64>) -> String {
+    x.map_or(String::new(), float)
 }
 
 /// Writes `rows` (their points' axis values from `m`).
@@ -48,16 +54,16 @@ pub fn write(path: &Path, m: &Manifest, rows: &[RunRow]) -> Result<(), SweepErro
             r.seed.to_string(),
             r.outcome.clone(),
             opt(r.settle_time),
-            r.final_time.to_string(),
-            r.final_max_angle_error.to_string(),
-            r.final_displacement_error.to_string(),
-            r.final_velocity_error.to_string(),
-            r.min_distance.to_string(),
+            float(r.final_time),
+            float(r.final_max_angle_error),
+            float(r.final_displacement_error),
+            float(r.final_velocity_error),
+            float(r.min_distance),
             opt(r.min_estimate),
-            r.v0.to_string(),
-            r.v_final.to_string(),
+            float(r.v0),
+            float(r.v_final),
             opt(r.rotation_deg),
-            opt(r.shortened),
+            r.shortened.map_or(String::new(), |k| k.to_string()),
             r.reason.clone(),
         ]);
         w.write_record(&rec).map_err(|e| err(&e))?;

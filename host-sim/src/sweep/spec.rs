@@ -22,6 +22,9 @@ pub struct SweepFile {
     /// Runs per point.
     #[serde(default = "one")]
     pub runs: u64,
+    /// Common random numbers: run `r` has the same seed at every point.
+    #[serde(default)]
+    pub common_seeds: bool,
     /// How points are chosen.
     #[serde(default)]
     pub sampling: Sampling,

@@ -42,7 +42,7 @@ mod trajectories;
 mod xy;
 
 pub use error::PlotError;
-pub use xy::{plot_xy, XyChart, XyLine, XyPoint};
+pub use xy::{plot_xy, XyChart, XyLine, XyPanel, XyPoint};
 
 use input::{load_run, Run};
 use plotters::coord::Shift;

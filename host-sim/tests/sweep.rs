@@ -1,0 +1,72 @@
+//! `host-sim sweep`: sweep-file errors (file, field, reason), the same results whatever the
+//! number of threads, 3 shards + merge = one run, and the aggregation's statistics against
+//! hand-computed values.
+
+use host_sim::sweep::{
+    aggregate, merge, quantile, run_all, run_seed, wilson, write_all, Manifest, Plan, RunRow,
+    Shard, SweepError, SweepSource,
+};
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// 2 × 2 points, 3 runs each, 2 s of formation-only with bearing noise, radio loss and a
+/// random initial shape: every run's figures depend on its seed.
+const TINY: &str = r#"
+name = "tiny"
+seed = 7
+runs = 3
+
+[base]
+scenario = "formation-only"
+set = ["duration=2", "sensors.bearing_noise_deg=0.5"]
+
+[perturbation]
+rotate = true
+
+[[axes]]
+key = "perturbation"
+values = [0.1, 0.4]
+
+[[axes]]
+key = "radio.loss"
+values = [0.0, 0.3]
+"#;
+
+fn plan(text: &str) -> Result<Plan, SweepError> {
+    Plan::from_source(&SweepSource::from_text("test.toml", text), None)
+}
+
+fn err(text: &str) -> SweepError {
+    match plan(text) {
+        Ok(_) => panic!("accepted:\n{text}"),
+        Err(e) => e,
+    }
+}
+
+fn with_axis(axis: &str) -> String {
+    format!("[base]\nscenario = \"formation-only\"\n\n[[axes]]\n{axis}\n")
+}
+
+fn run_in_pool(p: &Plan, threads: usize, shard: Shard) -> host_sim::sweep::Finished {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    let stop = AtomicBool::new(false);
+    pool.install(|| run_all(p, shard, &stop, &|_: &RunRow| {}))
+}
+
+const FILES: [&str; 4] = ["sweep.json", "runs.csv", "points.csv", "points.json"];
+
+fn read(dir: &Path, f: &str) -> String {
+    std::fs::read_to_string(dir.join(f)).unwrap()
+}
+
+#[path = "sweep/cli.rs"]
+mod cli;
+#[path = "sweep/errors.rs"]
+mod errors;
+#[path = "sweep/runs.rs"]
+mod runs;
+#[path = "sweep/stats.rs"]
+mod stats;
