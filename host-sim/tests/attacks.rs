@@ -162,3 +162,82 @@ fn bad_attack_entries_name_file_field_and_reason() {
         assert!(e.contains(reason), "{extra}: {e}");
     }
 }
+
+/// The paper scenario with `auth` integrity: its own `[controller]` table gets the two
+/// keys (a second `[controller]` header would be a TOML error).
+fn paper_auth(extra: &str) -> Model {
+    let text = PAPER.replacen(
+        "[controller]\n",
+        "[controller]\nintegrity = \"auth\"\nauth_key = \"000102030405060708090a0b0c0d0e0f\"\n",
+        1,
+    );
+    assert!(
+        text.contains("auth_key"),
+        "paper.toml has a [controller] table"
+    );
+    load_toml(&format!("{text}\n{extra}"), "paper-auth", &[]).expect("valid scenario")
+}
+
+#[test]
+fn with_auth_the_same_forgery_changes_nothing_but_the_counters() {
+    let clean = run(&paper_auth(""));
+    assert_eq!(clean.outcome, Outcome::Converged, "{}", clean.reason);
+    let r = run(&paper_auth(FORGE));
+    let d = shape_difference(&r, &clean);
+    println!(
+        "forge (auth): outcome {}, shape {d:.2e} m from the clean auth run, {:?}",
+        r.outcome.as_str(),
+        r.frames.by_reason
+    );
+    assert_eq!(r.outcome, Outcome::Converged, "{}", r.reason);
+    assert!(d <= 1e-3, "shape {d} m from the clean run");
+    // Every forged copy fails its tag; agent 3's own frames are all accepted.
+    assert_eq!(r.attacks[0].injected, 9000);
+    assert_eq!(r.frames.by_reason.bad_tag as u64, 3 * 9000);
+    assert_eq!(r.frames.by_reason.stale, 0);
+    assert_eq!(r.frames.rejected, 3 * 9000);
+    // Replays too are refused (by the counter), and change nothing.
+    let rp = run(&paper_auth(
+        "[[attacks]]\nkind = \"replay\"\ndelay = 0.5\nstart = 5.0\n",
+    ));
+    assert_eq!(rp.final_positions, clean.final_positions);
+    assert_eq!(u64::from(rp.frames.by_reason.replayed), rp.frames.rejected);
+}
+
+#[test]
+fn the_auth_key_is_checked_and_never_written() {
+    let bad = [
+        ("integrity = \"auth\"\n", "needs the swarm key"),
+        (
+            "integrity = \"auth\"\nauth_key = \"0011\"\n",
+            "exactly 32 hexadecimal digits",
+        ),
+        (
+            "auth_key = \"000102030405060708090a0b0c0d0e0f\"\n",
+            "only integrity = \"auth\"",
+        ),
+    ];
+    for (keys, reason) in bad {
+        let text = PAPER.replacen("[controller]\n", &format!("[controller]\n{keys}"), 1);
+        let e = load_toml(&text, "k.toml", &[]).expect_err(keys).to_string();
+        assert!(
+            e.contains("controller.auth_key") && e.contains(reason),
+            "{e}"
+        );
+    }
+    let m = paper_auth("");
+    let summary = Simulation::new(&m)
+        .run()
+        .expect("run")
+        .summary_json(&m)
+        .to_string();
+    assert!(
+        summary.contains("\"auth\""),
+        "the summary names the integrity"
+    );
+    assert!(!summary.contains("000102030405060708090a0b0c0d0e0f"));
+    assert!(
+        !format!("{m:?}").contains("0a0b0c0d0e0f"),
+        "Debug of the model"
+    );
+}

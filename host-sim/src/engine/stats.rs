@@ -45,6 +45,9 @@ pub fn add_frame_stats(a: &mut FrameStats, b: &FrameStats) {
         unknown_sender,
         stale,
         invalid_value,
+        bad_tag,
+        replayed,
+        unsynced,
     } = *b;
     a.accepted = a.accepted.saturating_add(accepted);
     a.bad_length = a.bad_length.saturating_add(bad_length);
@@ -55,6 +58,9 @@ pub fn add_frame_stats(a: &mut FrameStats, b: &FrameStats) {
     a.unknown_sender = a.unknown_sender.saturating_add(unknown_sender);
     a.stale = a.stale.saturating_add(stale);
     a.invalid_value = a.invalid_value.saturating_add(invalid_value);
+    a.bad_tag = a.bad_tag.saturating_add(bad_tag);
+    a.replayed = a.replayed.saturating_add(replayed);
+    a.unsynced = a.unsynced.saturating_add(unsynced);
 }
 
 /// What the controllers did over a run.

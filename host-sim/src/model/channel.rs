@@ -45,6 +45,9 @@ pub enum IntegrityMode {
     Crc16,
     /// The link checks its own CRC: no trailer.
     Link,
+    /// A 64-bit SipHash-2-4 tag under the swarm key and replay protection
+    /// (`docs/core.md`, "auth"); the key is `controller.auth_key`.
+    Auth,
 }
 
 impl IntegrityMode {
@@ -53,14 +56,18 @@ impl IntegrityMode {
         match self {
             IntegrityMode::Crc16 => "crc16",
             IntegrityMode::Link => "link",
+            IntegrityMode::Auth => "auth",
         }
     }
 
-    /// The core's value.
-    pub fn core(self) -> controller_core::Integrity {
+    /// The core's value (`key`: the swarm key of `auth`).
+    pub fn core(self, key: &[u8; 16]) -> controller_core::Integrity {
         match self {
             IntegrityMode::Crc16 => controller_core::Integrity::Crc16,
             IntegrityMode::Link => controller_core::Integrity::Link,
+            IntegrityMode::Auth => {
+                controller_core::Integrity::Auth(controller_core::wire::auth::SwarmKey::new(*key))
+            }
         }
     }
 }

@@ -58,7 +58,7 @@ impl Model {
         c.velocity_damping = a.velocity_damping;
         c.velocity_reference = self.velocity_reference.clone();
         c.limits = self.limits;
-        c.integrity = self.integrity.core();
+        c.integrity = self.integrity.core(&self.auth_key);
         c.comm_every = u16::try_from(self.comm_every)
             .map_err(|_| format!("comm_every = {} exceeds 65535", self.comm_every))?;
         c.comm_phase = u16::try_from(self.comm_phase(i)).unwrap_or(0);

@@ -52,6 +52,8 @@ pub struct Model {
     pub comm_every: usize,
     /// How frames are protected (the same for every agent).
     pub integrity: IntegrityMode,
+    /// The swarm key of `auth` integrity (zero otherwise). Never written to any output.
+    pub auth_key: [u8; 16],
     /// Estimator as named in the file.
     pub estimator: Estimator,
     /// `r̂(0)`.

@@ -18,6 +18,9 @@ fn rejections(s: &FrameStats) -> Value {
         "unknown_sender": s.unknown_sender,
         "stale_sequence": s.stale,
         "invalid_value": s.invalid_value,
+        "bad_tag": s.bad_tag,
+        "replayed": s.replayed,
+        "unsynced": s.unsynced,
     })
 }
 
@@ -82,7 +85,10 @@ pub(super) fn rows(m: &Model, r: &RunResult) -> Vec<(&'static str, String)> {
         rows.push((
             "rejected frames",
             format!(
-                "{} bad CRC, {} stale sequence, {} unknown sender, {} malformed/length, {} invalid value, {} mode mismatch",
+                "{} bad tag, {} replayed, {} unsynced, {} bad CRC, {} stale sequence, {} unknown sender, {} malformed/length, {} invalid value, {} mode mismatch",
+                s.bad_tag,
+                s.replayed,
+                s.unsynced,
                 s.bad_crc,
                 s.stale,
                 s.unknown_sender,

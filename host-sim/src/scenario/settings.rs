@@ -46,8 +46,10 @@ pub struct ControllerSpec {
     /// Broadcast rate (Hz): `≤ rate_hz`, and `rate_hz` a whole multiple of it; default
     /// `rate_hz` (broadcast every tick).
     pub comm_rate_hz: Option<f64>,
-    /// Frame integrity of the swarm: `crc16` or `link`.
+    /// Frame integrity of the swarm: `crc16`, `link` or `auth`.
     pub integrity: IntegrityMode,
+    /// `auth`: the 128-bit swarm key as 32 hexadecimal digits.
+    pub auth_key: Option<String>,
 }
 
 impl Default for ControllerSpec {
@@ -63,6 +65,7 @@ impl Default for ControllerSpec {
             angle_margin_deg: 5.0,
             comm_rate_hz: None,
             integrity: IntegrityMode::Crc16,
+            auth_key: None,
         }
     }
 }

@@ -61,6 +61,7 @@ pub fn strip_model(n: usize, duration: f64) -> Model {
         steps_per_tick: 10,
         comm_every: 1,
         integrity: IntegrityMode::Crc16,
+        auth_key: [0; 16],
         estimator: Estimator::Shared,
         initial_estimate: 1.0,
         min_estimate: 0.1,

@@ -3,7 +3,7 @@
 
 use super::checker::Checker;
 use crate::model::channel::{CRAZYFLIE_BIT_RATE, CRAZYFLIE_OVERHEAD_BYTES, CRAZYFLIE_TURNAROUND};
-use crate::model::{Access, ChannelModel};
+use crate::model::{Access, ChannelModel, IntegrityMode};
 use crate::scenario::error::ErrorKind::InvalidValue;
 use crate::scenario::ScenarioFile;
 use controller_core::MAX_FRAME_LEN;
@@ -157,4 +157,51 @@ pub(super) fn channel(c: &mut Checker<'_>, s: &ScenarioFile, period: f64) -> Opt
         );
     }
     Some(m)
+}
+
+/// The swarm key of `controller.auth_key` (32 hexadecimal digits): required with
+/// `integrity = "auth"`, refused with the other modes. Zero when absent or invalid.
+pub(super) fn auth_key(c: &mut Checker<'_>, s: &ScenarioFile) -> [u8; 16] {
+    let ctl = &s.controller;
+    let field = "controller.auth_key";
+    let mut key = [0u8; 16];
+    match (ctl.integrity, &ctl.auth_key) {
+        (IntegrityMode::Auth, None) => c.err(
+            InvalidValue,
+            field,
+            "integrity = \"auth\" needs the swarm key: 32 hexadecimal digits (128 bits)",
+        ),
+        (IntegrityMode::Auth, Some(hex)) => {
+            let digits: Vec<u8> = hex
+                .chars()
+                .filter_map(|ch| ch.to_digit(16).map(|d| d as u8))
+                .collect();
+            if digits.len() != 32 || hex.chars().count() != 32 {
+                c.err(
+                    InvalidValue,
+                    field,
+                    format!(
+                        "must be exactly 32 hexadecimal digits (128 bits), got {} characters",
+                        hex.chars().count()
+                    ),
+                );
+            } else {
+                for (k, pair) in digits.chunks(2).enumerate() {
+                    if let (Some(b), [hi, lo]) = (key.get_mut(k), pair) {
+                        *b = hi << 4 | lo;
+                    }
+                }
+            }
+        }
+        (mode, Some(_)) => c.err(
+            InvalidValue,
+            field,
+            format!(
+                "only integrity = \"auth\" uses a key (this swarm's integrity is \"{}\")",
+                mode.as_str()
+            ),
+        ),
+        (_, None) => {}
+    }
+    key
 }

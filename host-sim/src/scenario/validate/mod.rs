@@ -35,6 +35,7 @@ pub fn validate(s: &ScenarioFile, file: &str, default_name: &str) -> Result<Mode
     let period = dt * steps_per_tick as f64;
     let comm_every = comm::comm_every(&mut c, s, period);
     let channel = comm::channel(&mut c, s, period);
+    let auth_key = comm::auth_key(&mut c, s);
     let (agents, index) = agents::check(&mut c, s);
     let (triangles, ids_ok) = triangles::check(&mut c, s, &index, margin);
     graph::check(&mut c, s, &agents, &triangles, ids_ok, margin);
@@ -72,6 +73,7 @@ pub fn validate(s: &ScenarioFile, file: &str, default_name: &str) -> Result<Mode
         steps_per_tick,
         comm_every,
         integrity: ctl.integrity,
+        auth_key,
         estimator: ctl.estimator,
         initial_estimate: ctl.initial_estimate,
         min_estimate: ctl.min_estimate,
