@@ -17,6 +17,8 @@ pub const COLLISION: u8 = 11;
 pub const ESTIMATE_COLLAPSE: u8 = 12;
 /// The state became non-finite, too fast, or `V` grew without bound.
 pub const DIVERGED: u8 = 13;
+/// `host-sim design` refused its input (points, options or template), naming why.
+pub const DESIGN_REFUSED: u8 = 29;
 /// Host-in-the-loop: `qemu-system-arm` not found.
 pub const HIL_NO_QEMU: u8 = 30;
 /// Host-in-the-loop: the firmware ELF not found.

@@ -59,7 +59,7 @@ impl Monitor {
     pub fn observe(&mut self, model: &Model, d: &Diagnostics, est: &[f64]) -> bool {
         let s = &d.snap;
         let cr = &model.criteria;
-        let name = |i: usize| model.agents.get(i).map_or(0, |a| a.id);
+        let name = |i: usize| model.agents.get(i).map_or("?", |a| a.name.as_str());
         // V: its start, and its largest rise above the running minimum.
         let epoch = model.schedule_epoch(s.t);
         if self.v0.is_none() {
@@ -156,7 +156,7 @@ impl Monitor {
 
     /// Records the collapse of estimate `k`, held at `r_min` since `t0`.
     fn collapse(&mut self, model: &Model, d: &Diagnostics, k: usize, t0: f64) {
-        let name = |i: usize| model.agents.get(i).map_or(0, |a| a.id);
+        let name = |i: usize| model.agents.get(i).map_or("?", |a| a.name.as_str());
         let s = &d.snap;
         let Some(e) = d.estimates.get(k) else {
             return;

@@ -20,7 +20,8 @@
 //! assert!(toml.contains("[target]"));
 //! ```
 
-pub mod colouring;
+/// One-byte wire ids (lives in the model layer, which the loader uses too).
+pub use crate::model::wire_ids as colouring;
 pub mod error;
 mod geometry;
 mod grow;

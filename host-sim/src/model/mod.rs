@@ -12,6 +12,8 @@ pub mod estimates;
 mod formation;
 pub mod graph;
 mod options;
+pub mod target;
+pub mod wire_ids;
 
 pub use core_config::{CoreAgent, MT, NB};
 pub use criteria::Criteria;
@@ -20,6 +22,7 @@ pub use estimates::{estimate_layout, resolve_estimates, EstimateInfo};
 pub use formation::{AgentModel, AngleModel, LeaderModel, TriangleModel};
 pub use graph::Graph;
 pub use options::{BearingRate, Estimator, Mode};
+pub use target::Target;
 
 use controller_core::{Limits, Schedule};
 
@@ -69,6 +72,8 @@ pub struct Model {
     pub criteria: Criteria,
     /// Edges and neighbour lists.
     pub graph: Graph,
+    /// The shape the formation should take (compared with the final positions).
+    pub target: Target,
 }
 
 impl Model {
@@ -113,19 +118,10 @@ impl Model {
         (self.duration / self.dt).round().max(0.0) as usize
     }
 
-    /// Whether agent `i` is in triangle `t`.
-    fn in_triangle(t: &TriangleModel, i: usize) -> bool {
-        t.vertices.contains(&i)
-    }
-
     /// Indices of the triangles agent `i` belongs to, in scenario order (the order of
     /// its controller-core configuration).
     pub fn triangles_of(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
-        self.triangles
-            .iter()
-            .enumerate()
-            .filter(move |(_, t)| Self::in_triangle(t, i))
-            .map(|(k, _)| k)
+        self.graph.membership.of(i).iter().copied()
     }
 
     /// `v*(t)`.

@@ -19,9 +19,20 @@ fn fin(x: f64) -> Value {
     opt(Some(x))
 }
 
+/// A user's agent id in JSON: a number when it is one, else a string.
+fn user_id(name: &str) -> Value {
+    name.parse::<u64>()
+        .map_or_else(|_| Value::String(name.to_owned()), Value::from)
+}
+
 /// `summary.json` of a run.
 pub fn summary_json(model: &Model, r: &RunResult, estimates: &[EstimateInfo]) -> Value {
-    let id = |i: usize| model.agents.get(i).map_or(0, |a| a.id);
+    let id = |i: usize| {
+        model
+            .agents
+            .get(i)
+            .map_or(Value::Null, |a| user_id(&a.name))
+    };
     let fault = r
         .control
         .last_fault
@@ -43,7 +54,7 @@ pub fn summary_json(model: &Model, r: &RunResult, estimates: &[EstimateInfo]) ->
         "final_time_s": r.final_time,
         "dt_s": model.dt,
         "control_period_s": model.control_period(),
-        "agents": model.agents.iter().map(|a| a.id).collect::<Vec<_>>(),
+        "agents": model.agents.iter().map(|a| user_id(&a.name)).collect::<Vec<_>>(),
         "edges": model.graph.edges.iter().map(|e| [id(e[0]), id(e[1])]).collect::<Vec<_>>(),
         "leaders": model.leader.as_ref().map(|l| [id(l.a), id(l.b)]),
         "settle_time_s": opt(r.settle_time),
