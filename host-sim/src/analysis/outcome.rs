@@ -15,6 +15,10 @@ pub enum Outcome {
     Diverged,
     /// None of the above, but not within tolerance at the end.
     NotConverged,
+    /// Every controlled angle, the leader edge and the velocity are within tolerance, but
+    /// the formation is not the target shape (a triangle folded across an edge: the angles
+    /// cannot tell a triangle from its mirror image).
+    WrongShape,
 }
 
 impl Outcome {
@@ -26,6 +30,7 @@ impl Outcome {
             Outcome::EstimateCollapse => "estimate_collapse",
             Outcome::Diverged => "diverged",
             Outcome::NotConverged => "not_converged",
+            Outcome::WrongShape => "wrong_shape",
         }
     }
 
@@ -38,6 +43,7 @@ impl Outcome {
             Outcome::EstimateCollapse => x::ESTIMATE_COLLAPSE,
             Outcome::Diverged => x::DIVERGED,
             Outcome::NotConverged => x::NOT_CONVERGED,
+            Outcome::WrongShape => x::WRONG_SHAPE,
         }
     }
 }

@@ -12,6 +12,7 @@ pub mod estimates;
 mod formation;
 pub mod graph;
 mod options;
+pub mod shape;
 pub mod target;
 pub mod wire_ids;
 

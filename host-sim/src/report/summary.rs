@@ -1,5 +1,6 @@
 //! `summary.json`: everything a run found, for people and scripts (`docs/outputs.md`).
 
+use crate::analysis::shape_check::shape_check;
 use crate::engine::hil::LinkStats;
 use crate::engine::RunResult;
 use crate::model::{EstimateInfo, Model};
@@ -23,6 +24,23 @@ fn fin(x: f64) -> Value {
 fn user_id(name: &str) -> Value {
     name.parse::<u64>()
         .map_or_else(|_| Value::String(name.to_owned()), Value::from)
+}
+
+/// The final formation against the target shape (`null` without one).
+fn shape_json(model: &Model, q: &[[f64; 2]]) -> Value {
+    match shape_check(model, q) {
+        None => Value::Null,
+        Some(c) => json!({
+            "target": if model.target.from_file { "file" } else { "angles" },
+            "max_error_rel": fin(c.fit.max_rel),
+            "rms_error_rel": fin(c.fit.rms_rel),
+            "reflected": c.fit.reflected,
+            "scale": fin(c.fit.scale),
+            "folded_triangles": c.folded.iter().filter_map(|&k| model.triangles.get(k)).map(|t| {
+                t.vertices.map(|v| model.agents.get(v).map_or(Value::Null, |a| user_id(&a.name)))
+            }).collect::<Vec<_>>(),
+        }),
+    }
 }
 
 /// `summary.json` of a run.
@@ -76,6 +94,7 @@ pub fn summary_json(model: &Model, r: &RunResult, estimates: &[EstimateInfo]) ->
             "rhat": fin(*rh), "r": fin(*rt)
         })).collect::<Vec<_>>(),
         "triangle_orientation_kept": r.orientation_kept,
+        "shape": shape_json(model, &r.final_positions),
         "frames_sent": r.frames.sent,
         "frames_dropped": r.frames.dropped,
         "frames_rejected": r.frames.rejected,
@@ -107,6 +126,7 @@ pub fn summary_json(model: &Model, r: &RunResult, estimates: &[EstimateInfo]) ->
             "velocity_tolerance": model.criteria.velocity_tolerance,
             "collision_distance": model.criteria.collision_distance,
             "collapse_time_s": model.criteria.collapse_time,
+            "shape_tolerance": model.criteria.shape_tolerance,
         },
         "warnings": r.warnings,
         "steps": r.steps,
