@@ -36,6 +36,7 @@ fn shape_json(model: &Model, q: &[[f64; 2]]) -> Value {
             "rms_error_rel": fin(c.fit.rms_rel),
             "reflected": c.fit.reflected,
             "scale": fin(c.fit.scale),
+            "target_positions": model.target.positions.iter().map(|p| [fin(p[0]), fin(p[1])]).collect::<Vec<_>>(),
             "folded_triangles": c.folded.iter().filter_map(|&k| model.triangles.get(k)).map(|t| {
                 t.vertices.map(|v| model.agents.get(v).map_or(Value::Null, |a| user_id(&a.name)))
             }).collect::<Vec<_>>(),

@@ -32,6 +32,16 @@ impl std::fmt::Display for Id {
     }
 }
 
+/// `summary.json`'s `shape`.
+#[derive(Debug, Deserialize)]
+pub(super) struct ShapeSummary {
+    pub(super) target: String,
+    pub(super) max_error_rel: Option<f64>,
+    pub(super) reflected: bool,
+    pub(super) folded_triangles: Vec<[Id; 3]>,
+    pub(super) target_positions: Vec<[Option<f64>; 2]>,
+}
+
 /// The fields of `summary.json` the plots use.
 #[derive(Debug, Deserialize)]
 pub(super) struct Summary {
@@ -43,6 +53,9 @@ pub(super) struct Summary {
     pub(super) edges: Vec<[Id; 2]>,
     #[serde(default)]
     pub(super) leaders: Option<[Id; 2]>,
+    /// The final formation against its target (absent in runs made before it existed).
+    #[serde(default)]
+    pub(super) shape: Option<ShapeSummary>,
     #[serde(default)]
     pub(super) mode: Option<serde_json::Value>,
     #[serde(default)]
