@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use syn::visit::Visit;
 
 /// The layers, lowest first, and the lower layers each may import. `design` (a shape →
-/// scenario generator) is not written yet; its place is reserved.
+/// scenario generator, `host-sim design`) sits above `scenario`.
 const LAYERS: &[(&str, &[&str])] = &[
     ("exit_code", &[]),
     ("model", &["exit_code"]),
