@@ -48,9 +48,9 @@ pub struct DesignArgs {
     /// Side / lattice step / smallest distance of the built-in shape (m).
     #[arg(long, value_name = "M", default_value_t = 1.0)]
     pub spacing: f64,
-    /// Largest initial displacement, as a fraction of the formation's size (RMS distance
-    /// from its centroid), in [0, 1].
-    #[arg(long, value_name = "F", default_value_t = 0.05)]
+    /// Largest initial displacement of each agent, as a fraction of the mean edge length
+    /// of the constructed graph, in [0, 1] (local, so it means the same at any N).
+    #[arg(long, value_name = "F", default_value_t = 0.1)]
     pub perturbation: f64,
     /// Also rotate the initial formation by a random angle about its centroid.
     #[arg(long)]
@@ -191,7 +191,10 @@ fn design(args: &DesignArgs) -> Result<(String, String), DesignError> {
     if !(0.0..=1.0).contains(&args.perturbation) {
         return Err(option(
             "perturbation",
-            format!("must be a fraction in [0, 1], got {}", args.perturbation),
+            format!(
+                "must be a fraction of the mean edge length in [0, 1], got {}",
+                args.perturbation
+            ),
         ));
     }
     let template = match &args.template {
@@ -236,6 +239,13 @@ fn design(args: &DesignArgs) -> Result<(String, String), DesignError> {
         leader,
     };
     let c = construct(&points, &opts)?;
+    // The library's fraction is of the formation's size (RMS distance from the centroid).
+    let size = crate::design::initial::formation_size(&points);
+    let fraction = if size > 0.0 {
+        (args.perturbation * c.figures.mean_edge / size).min(1.0)
+    } else {
+        0.0
+    };
     let v = args.v_star.unwrap_or([0.0, 0.0]);
     if v.iter().any(|x| !x.is_finite()) {
         return Err(option("v-star", format!("must be finite, got {v:?}")));
@@ -256,7 +266,7 @@ fn design(args: &DesignArgs) -> Result<(String, String), DesignError> {
         seed: args.seed,
         leader: !args.no_leader,
         perturbation: Perturbation {
-            fraction: args.perturbation,
+            fraction,
             rotate: args.rotate,
             seed: args.seed,
         },
