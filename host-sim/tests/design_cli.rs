@@ -230,3 +230,21 @@ fn capacity_errors_name_the_agent_and_the_fix() {
         "{e}"
     );
 }
+
+#[test]
+fn a_hundred_thousand_agents_load_with_wire_ids_unique_within_two_hops() {
+    let n = 100_000;
+    let ids: Vec<String> = (0..n).map(|i| format!("\"r{i}\"")).collect();
+    let m =
+        host_sim::load_toml(&strip_scenario(&ids), "huge", &[]).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(m.n(), n);
+    assert_eq!(m.agents[n - 1].name, format!("r{}", n - 1));
+    // The strip's square has degree 4 on each side: 5 wire ids do.
+    assert!(m.agents.iter().map(|a| a.id).max().unwrap() < 8);
+    for i in 0..n {
+        for &j in m.graph.radio.of(i) {
+            assert_ne!(m.agents[i].id, m.agents[j].id);
+        }
+    }
+    assert_eq!(m.target.positions.len(), n);
+}
