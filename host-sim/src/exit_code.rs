@@ -19,6 +19,11 @@ pub const COLLISION: u8 = 11;
 pub const ESTIMATE_COLLAPSE: u8 = 12;
 /// The state became non-finite, too fast, or `V` grew without bound.
 pub const DIVERGED: u8 = 13;
+/// Every angle is within tolerance but the formation is not the target shape (a
+/// triangle folded across an edge, or the fitted shape off by more than the tolerance).
+pub const WRONG_SHAPE: u8 = 14;
+/// `host-sim design` refused its input (points, options or template), naming why.
+pub const DESIGN_REFUSED: u8 = 29;
 /// Host-in-the-loop: `qemu-system-arm` not found.
 pub const HIL_NO_QEMU: u8 = 30;
 /// Host-in-the-loop: the firmware ELF not found.

@@ -13,7 +13,8 @@ use proc_macro2::{TokenStream, TokenTree};
 use std::path::{Path, PathBuf};
 use syn::visit::Visit;
 
-/// The layers, lowest first, and the lower layers each may import. `sweep` (Monte Carlo
+/// The layers, lowest first, and the lower layers each may import. `design` (a shape →
+/// scenario generator, `host-sim design`) sits above `scenario`; `sweep` (Monte Carlo
 /// sweeps) is a client of the API, below the command line.
 const LAYERS: &[(&str, &[&str])] = &[
     ("exit_code", &[]),

@@ -8,6 +8,7 @@
 mod min_distance;
 mod monitor;
 mod outcome;
+pub mod shape_check;
 mod snapshot;
 
 pub use min_distance::MinDistance;

@@ -3,8 +3,10 @@
 //! gives the verdict at the end (`docs/outputs.md`, "Outcome").
 
 use super::outcome::{Event, Outcome};
+use super::shape_check::{folded_names, shape_check};
 use super::snapshot::{Diagnostics, Snapshot};
 use crate::model::Model;
+use controller_core::Vec2;
 
 /// Watches the snapshots of a run for failures and keeps the run's extremes.
 #[derive(Clone, Debug)]
@@ -59,7 +61,7 @@ impl Monitor {
     pub fn observe(&mut self, model: &Model, d: &Diagnostics, est: &[f64]) -> bool {
         let s = &d.snap;
         let cr = &model.criteria;
-        let name = |i: usize| model.agents.get(i).map_or(0, |a| a.id);
+        let name = |i: usize| model.agents.get(i).map_or("?", |a| a.name.as_str());
         // V: its start, and its largest rise above the running minimum.
         let epoch = model.schedule_epoch(s.t);
         if self.v0.is_none() {
@@ -156,7 +158,7 @@ impl Monitor {
 
     /// Records the collapse of estimate `k`, held at `r_min` since `t0`.
     fn collapse(&mut self, model: &Model, d: &Diagnostics, k: usize, t0: f64) {
-        let name = |i: usize| model.agents.get(i).map_or(0, |a| a.id);
+        let name = |i: usize| model.agents.get(i).map_or("?", |a| a.name.as_str());
         let s = &d.snap;
         let Some(e) = d.estimates.get(k) else {
             return;
@@ -213,7 +215,11 @@ impl Monitor {
     ///
     /// A terminal failure preceded by an estimate collapse is reported as the collapse (the
     /// cause); a collapse in a run that still converged is only an event.
-    pub fn verdict(&self, model: &Model, last: &Snapshot) -> (Outcome, String) {
+    ///
+    /// A run whose angles, leader edge and velocity are within tolerance is `converged`
+    /// only if its final positions `q` also match the target shape within
+    /// `criteria.shape_tolerance` with no folded triangle, else `wrong_shape`.
+    pub fn verdict(&self, model: &Model, last: &Snapshot, q: &[Vec2<f64>]) -> (Outcome, String) {
         let cr = &model.criteria;
         let chain = || {
             self.events
@@ -245,6 +251,32 @@ impl Monitor {
                 last.disp_err,
                 last.vel_err
             );
+            let pos: Vec<[f64; 2]> = q.iter().map(|p| [p.x, p.y]).collect();
+            if let Some(c) = shape_check(model, &pos) {
+                if !c.folded.is_empty() || c.fit.max_rel > cr.shape_tolerance {
+                    let folded = if c.folded.is_empty() {
+                        String::new()
+                    } else {
+                        format!(
+                            "{} folded across an edge ({}); ",
+                            if c.folded.len() == 1 {
+                                "triangle"
+                            } else {
+                                "triangles"
+                            },
+                            folded_names(model, &c.folded).join(", ")
+                        )
+                    };
+                    let why = format!(
+                        "every angle error below {} rad from t = {:.3} s, but the formation is not the target shape: {folded}an agent is {:.3e} of the target's size from its target point (tolerance {})",
+                        cr.angle_tolerance,
+                        self.settle_candidate.unwrap_or(0.0),
+                        c.fit.max_rel,
+                        cr.shape_tolerance
+                    );
+                    return (Outcome::WrongShape, why);
+                }
+            }
             if !self.events.is_empty() {
                 why.push_str(&format!(" (despite: {})", chain()));
             }

@@ -15,6 +15,10 @@ pub enum Outcome {
     Diverged,
     /// None of the above, but not within tolerance at the end.
     NotConverged,
+    /// Every controlled angle, the leader edge and the velocity are within tolerance, but
+    /// the formation is not the target shape (a triangle folded across an edge: the angles
+    /// cannot tell a triangle from its mirror image).
+    WrongShape,
 }
 
 impl Outcome {
@@ -26,6 +30,7 @@ impl Outcome {
         Outcome::EstimateCollapse,
         Outcome::Diverged,
         Outcome::NotConverged,
+        Outcome::WrongShape,
     ];
 
     /// The name in `summary.json`.
@@ -36,6 +41,7 @@ impl Outcome {
             Outcome::EstimateCollapse => "estimate_collapse",
             Outcome::Diverged => "diverged",
             Outcome::NotConverged => "not_converged",
+            Outcome::WrongShape => "wrong_shape",
         }
     }
 
@@ -48,6 +54,7 @@ impl Outcome {
             Outcome::EstimateCollapse => x::ESTIMATE_COLLAPSE,
             Outcome::Diverged => x::DIVERGED,
             Outcome::NotConverged => x::NOT_CONVERGED,
+            Outcome::WrongShape => x::WRONG_SHAPE,
         }
     }
 }
@@ -84,9 +91,10 @@ mod tests {
                 Outcome::EstimateCollapse => 2,
                 Outcome::Diverged => 3,
                 Outcome::NotConverged => 4,
+                Outcome::WrongShape => 5,
             }
         }
-        const VARIANTS: usize = 5;
+        const VARIANTS: usize = 6;
         assert_eq!(Outcome::ALL.len(), VARIANTS);
         let mut seen = [false; VARIANTS];
         for &o in Outcome::ALL {

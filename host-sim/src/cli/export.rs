@@ -18,12 +18,8 @@ pub(super) fn export_command(args: &ExportArgs, quiet: bool) -> u8 {
         Ok(m) => m,
         Err(e) => return super::report(&e),
     };
-    let Some(i) = model
-        .agents
-        .iter()
-        .position(|a| a.id.to_string() == args.agent)
-    else {
-        let ids: Vec<String> = model.agents.iter().map(|a| a.id.to_string()).collect();
+    let Some(i) = model.agents.iter().position(|a| a.name == args.agent) else {
+        let ids: Vec<&str> = model.agents.iter().map(|a| a.name.as_str()).collect();
         eprintln!(
             "error: --agent {}: scenario {} has no agent with that id (its agents: {})",
             args.agent,
@@ -69,8 +65,9 @@ pub(super) fn export_command(args: &ExportArgs, quiet: bool) -> u8 {
     }
     if !quiet {
         eprintln!(
-            "agent {} of {}: {n}-byte blob (format {}), {} triangles{}",
+            "agent {} (wire id {}) of {}: {n}-byte blob (format {}), {} triangles{}",
             args.agent,
+            config.id,
             model.source,
             controller_ffi::blob::BLOB_VERSION,
             config.triangles.len(),

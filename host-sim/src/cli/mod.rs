@@ -1,15 +1,19 @@
-//! The command line: `host-sim [run|validate|list|plot|export|sweep]` (exit codes in
-//! [`crate::exit_code`] and `docs/outputs.md`): a thin client of the library API
+//! The command line: `host-sim [run|validate|list|plot|design|export|sweep]` (exit codes
+//! in [`crate::exit_code`] and `docs/outputs.md`): a thin client of the library API
 //! ([`crate::Simulation`]).
 
+mod design;
 mod export;
 mod run;
 mod sweep;
+
+pub use design::{DesignArgs, Shape};
 
 use crate::engine::hil;
 use crate::exit_code;
 use crate::scenario::{ScenarioErrors, BUILTINS};
 use clap::{Args, Parser, Subcommand};
+use design::design_command;
 use run::run_command;
 use std::path::PathBuf;
 
@@ -34,7 +38,7 @@ pub enum Command {
     Run(RunArgs),
     /// Check a scenario and report every problem (exit code per kind of problem).
     Validate {
-        /// Scenario file or built-in name.
+        /// Scenario file, built-in name, or `-` (stdin).
         scenario: String,
         /// Override a field before validation, e.g. `--set radio.loss=0.2`.
         #[arg(long = "set", value_name = "KEY=VALUE")]
@@ -47,6 +51,9 @@ pub enum Command {
         /// The run's output directory.
         dir: PathBuf,
     },
+    /// Design a formation from a shape: a points file or a built-in generator → a
+    /// complete scenario (stdout or -o), quality figures on stderr.
+    Design(DesignArgs),
     /// Run a Monte Carlo sweep (docs/sweeps.md) on every core, or merge its shards.
     Sweep(sweep::SweepArgs),
     /// Write one agent's configuration as the C API's checked blob (docs/c-api.md).
@@ -75,7 +82,7 @@ pub struct ExportArgs {
 /// Arguments of `host-sim run`.
 #[derive(Debug, Args)]
 pub struct RunArgs {
-    /// Scenario file or built-in name (`host-sim list`).
+    /// Scenario file, built-in name (`host-sim list`), or `-` to read it from stdin.
     #[arg(default_value = "paper")]
     pub scenario: String,
     /// Output directory (default `out/<scenario name>/`).
@@ -151,6 +158,7 @@ pub fn execute(cli: Cli) -> u8 {
         Some(Command::Run(args)) => run_command(&args, quiet),
         Some(Command::Export(args)) => export::export_command(&args, quiet),
         Some(Command::Validate { scenario, set }) => validate_command(&scenario, &set, quiet),
+        Some(Command::Design(args)) => design_command(&args, quiet),
         Some(Command::List) => {
             for b in BUILTINS {
                 println!("{:<16} {}", b.name, b.description);
@@ -180,8 +188,26 @@ fn report(errors: &ScenarioErrors) -> u8 {
     errors.exit_code()
 }
 
+/// Loads a scenario: `-` reads it from stdin, anything else is a file or a built-in.
+pub(crate) fn load(scenario: &str, set: &[String]) -> Result<crate::model::Model, ScenarioErrors> {
+    if scenario != "-" {
+        return crate::api::load(scenario, set);
+    }
+    let mut text = String::new();
+    use std::io::Read;
+    if let Err(e) = std::io::stdin().read_to_string(&mut text) {
+        return Err(ScenarioErrors(vec![crate::scenario::ScenarioError::new(
+            crate::scenario::ErrorKind::Io,
+            "<stdin>",
+            "",
+            format!("cannot read: {e}"),
+        )]));
+    }
+    crate::api::load_toml(&text, "<stdin>", set)
+}
+
 fn validate_command(scenario: &str, set: &[String], quiet: bool) -> u8 {
-    match crate::api::load(scenario, set) {
+    match load(scenario, set) {
         Ok(m) => {
             if !quiet {
                 println!(

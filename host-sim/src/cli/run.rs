@@ -60,7 +60,7 @@ impl api::Progress for Progress {
 }
 
 pub(super) fn run_command(args: &RunArgs, quiet: bool) -> u8 {
-    let model = match crate::api::load(&args.scenario, &args.overrides()) {
+    let model = match super::load(&args.scenario, &args.overrides()) {
         Ok(m) => m,
         Err(e) => return report(&e),
     };

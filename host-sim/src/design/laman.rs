@@ -32,10 +32,10 @@ use std::f64::consts::PI;
 
 /// Default angle margin (degrees), as the loader's `controller.angle_margin_deg`.
 pub const DEFAULT_MARGIN_DEG: f64 = 5.0;
-/// Default triangles per agent: host-sim's controller-core capacity `MT`.
-pub const DEFAULT_MAX_TRIANGLES: usize = 8;
-/// Default neighbours per agent: host-sim's controller-core capacity `NB`.
-pub const DEFAULT_MAX_NEIGHBOURS: usize = 12;
+/// Default triangles per agent: the controller-core capacity `MT`.
+pub const DEFAULT_MAX_TRIANGLES: usize = crate::model::MT;
+/// Default neighbours per agent: the controller-core capacity `NB`.
+pub const DEFAULT_MAX_NEIGHBOURS: usize = crate::model::NB;
 /// Delaunay neighbours kept per point (nearest first; see `neighbours.rs`).
 const NEIGHBOUR_CAP: usize = 16;
 

@@ -20,7 +20,8 @@
 //! assert!(toml.contains("[target]"));
 //! ```
 
-pub mod colouring;
+/// One-byte wire ids (lives in the model layer, which the loader uses too).
+pub use crate::model::wire_ids as colouring;
 pub mod error;
 mod geometry;
 mod grow;
@@ -29,7 +30,8 @@ pub mod laman;
 mod neighbours;
 pub mod points;
 pub mod render;
-pub mod shape;
+/// Shape comparison (lives in the model layer, which the run's outcome uses too).
+pub use crate::model::shape;
 
 pub use colouring::{
     adjacency_from_triangles, check_distance2, distance2_colouring, ColouringError,

@@ -155,7 +155,7 @@ pub fn drive(
         .map_err(|e| format!("cannot write the time series: {e}"))?;
     progress(diag.snap.t);
     let (q, v, est) = engine.view();
-    let (outcome, reason) = monitor.verdict(model, &diag.snap);
+    let (outcome, reason) = monitor.verdict(model, &diag.snap, q);
     let s = &diag.snap;
     Ok(RunResult {
         outcome,

@@ -7,10 +7,12 @@ use controller_core::{
     ScheduleStep, TriangleConfig,
 };
 
-/// Triangle capacity of one host agent (`MT` of `controller_core::Agent`).
-pub const MT: usize = 8;
-/// Neighbour capacity of one host agent (`NB` of `controller_core::Agent`).
-pub const NB: usize = 12;
+/// Triangle capacity of one host agent (`MT` of `controller_core::Agent`): the core's
+/// standard capacity, stated once in `controller_core::MAX_TRIANGLES`.
+pub const MT: usize = controller_core::MAX_TRIANGLES;
+/// Neighbour capacity of one host agent (`NB` of `controller_core::Agent`): the core's
+/// `controller_core::MAX_NEIGHBOURS`.
+pub const NB: usize = controller_core::MAX_NEIGHBOURS;
 /// The controller-core agent the host simulates.
 pub type CoreAgent = controller_core::Agent<f64, MT, NB>;
 
@@ -47,7 +49,7 @@ impl Model {
             c.triangles.push(tc).map_err(|_| {
                 format!(
                     "agent {} belongs to more than {MT} triangles (controller capacity)",
-                    a.id
+                    a.name
                 )
             })?;
         }

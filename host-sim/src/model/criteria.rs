@@ -21,6 +21,11 @@ pub struct Criteria {
     pub displacement_tolerance: f64,
     /// Final `max_n |v_n − v*|` below this (m/s) counts as converged.
     pub velocity_tolerance: f64,
+    /// The final formation, best fitted to the target shape (translation, rotation,
+    /// scale, mirror), must have every agent within this fraction of the target's size
+    /// (its RMS distance from the centroid) of its target point, and no triangle folded,
+    /// to count as converged (`wrong_shape` otherwise).
+    pub shape_tolerance: f64,
 }
 
 impl Default for Criteria {
@@ -33,6 +38,7 @@ impl Default for Criteria {
             angle_tolerance: 1e-3,
             displacement_tolerance: 1e-2,
             velocity_tolerance: 1e-2,
+            shape_tolerance: 5e-2,
         }
     }
 }

@@ -6,7 +6,11 @@ use controller_core::Schedule;
 /// One agent's plant and initial state.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AgentModel {
-    /// Wire id.
+    /// The user's id as written in the scenario (an integer or a short name): what every
+    /// output and message shows.
+    pub name: String,
+    /// Wire id (one byte): the user's id when every id is an integer 0–255, else assigned
+    /// by a distance-2 colouring of the radio graph ([`super::wire_ids`]).
     pub id: u8,
     /// `q(0)`.
     pub position: [f64; 2],

@@ -1,7 +1,7 @@
 //! The interaction graph: the triangulated Laman check (SPEC §3), neighbour lists and
 //! edges, all by agent index (position in the scenario's agent list).
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeSet, HashMap, HashSet};
 
 /// Compressed adjacency lists: `of(i)` is agent `i`'s sorted neighbour indices.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -25,6 +25,18 @@ impl Adjacency {
         start.push(0);
         for s in &sets {
             list.extend(s.iter().copied());
+            start.push(list.len());
+        }
+        Self { start, list }
+    }
+
+    /// Builds the lists as given (each already sorted).
+    pub fn from_lists(lists: &[Vec<usize>]) -> Self {
+        let mut start = Vec::with_capacity(lists.len() + 1);
+        let mut list = Vec::with_capacity(lists.iter().map(Vec::len).sum());
+        start.push(0);
+        for l in lists {
+            list.extend_from_slice(l);
             start.push(list.len());
         }
         Self { start, list }
@@ -69,6 +81,8 @@ pub struct Graph {
     pub triangle: Adjacency,
     /// Radio neighbours: triangle neighbours plus the leader partner.
     pub radio: Adjacency,
+    /// Each agent's triangles (indices, ascending: scenario order).
+    pub membership: Adjacency,
 }
 
 impl Graph {
@@ -85,10 +99,21 @@ impl Graph {
         }
         let triangle = Adjacency::from_pairs(n, tri_pairs());
         let radio = Adjacency::from_pairs(n, tri_pairs().chain(leader));
+        let mut lists: Vec<Vec<usize>> = vec![Vec::new(); n];
+        for (k, t) in triangles.iter().enumerate() {
+            for &v in t {
+                if let Some(l) = lists.get_mut(v) {
+                    if l.last() != Some(&k) {
+                        l.push(k);
+                    }
+                }
+            }
+        }
         Self {
             edges: edges.into_iter().collect(),
             triangle,
             radio,
+            membership: Adjacency::from_lists(&lists),
         }
     }
 }
@@ -116,7 +141,9 @@ pub enum LamanError {
 /// start from one edge; every new agent joins two agents that already share an edge) and
 /// returns a construction order of the triangles.
 pub fn laman_order(n: usize, triangles: &[[usize; 3]]) -> Result<Vec<usize>, LamanError> {
-    let first = triangles.first().ok_or(LamanError::Empty)?;
+    if triangles.is_empty() {
+        return Err(LamanError::Empty);
+    }
     let mut in_some = vec![false; n];
     for t in triangles {
         for &v in t {
@@ -134,46 +161,69 @@ pub fn laman_order(n: usize, triangles: &[[usize; 3]]) -> Result<Vec<usize>, Lam
             triangles: triangles.len(),
         });
     }
-    let mut placed = vec![false; n];
-    let mut edges: BTreeSet<[usize; 2]> = BTreeSet::new();
+    // Event driven, O(M): a triangle can attach only when one of its edges appears
+    // (both its ends are then placed), so each new edge looks at the triangles on it.
     let key = |a: usize, b: usize| [a.min(b), a.max(b)];
-    let add = |t: &[usize; 3], placed: &mut Vec<bool>, edges: &mut BTreeSet<[usize; 2]>| {
-        for &v in t {
-            if let Some(p) = placed.get_mut(v) {
+    let sides = |t: &[usize; 3]| [key(t[0], t[1]), key(t[1], t[2]), key(t[0], t[2])];
+    let mut on_edge: HashMap<[usize; 2], Vec<usize>> = HashMap::with_capacity(3 * triangles.len());
+    for (ti, t) in triangles.iter().enumerate().skip(1) {
+        for e in sides(t) {
+            on_edge.entry(e).or_default().push(ti);
+        }
+    }
+    let mut st = Growth {
+        placed: vec![false; n],
+        added: vec![false; triangles.len()],
+        edges: HashSet::with_capacity(2 * n),
+        pending: Vec::new(),
+        order: Vec::with_capacity(triangles.len()),
+    };
+    st.add(0, triangles);
+    while let Some(e) = st.pending.pop() {
+        for &ti in on_edge.get(&e).map_or(&[][..], Vec::as_slice) {
+            let t = &triangles[ti];
+            let unplaced = t
+                .iter()
+                .filter(|&&v| !st.placed.get(v).copied().unwrap_or(true))
+                .count();
+            if !st.added[ti] && unplaced == 1 {
+                st.add(ti, triangles);
+            }
+        }
+    }
+    let (added, order) = (st.added, st.order);
+    let remaining: Vec<usize> = (0..triangles.len()).filter(|&ti| !added[ti]).collect();
+    if remaining.is_empty() {
+        Ok(order)
+    } else {
+        Err(LamanError::Unattached(remaining))
+    }
+}
+
+/// The state of [`laman_order`]'s growth.
+struct Growth {
+    placed: Vec<bool>,
+    added: Vec<bool>,
+    edges: HashSet<[usize; 2]>,
+    pending: Vec<[usize; 2]>,
+    order: Vec<usize>,
+}
+
+impl Growth {
+    fn add(&mut self, ti: usize, triangles: &[[usize; 3]]) {
+        let t = triangles[ti];
+        self.added[ti] = true;
+        self.order.push(ti);
+        for v in t {
+            if let Some(p) = self.placed.get_mut(v) {
                 *p = true;
             }
         }
-        edges.insert(key(t[0], t[1]));
-        edges.insert(key(t[1], t[2]));
-        edges.insert(key(t[0], t[2]));
-    };
-    add(first, &mut placed, &mut edges);
-    let mut order = vec![0];
-    let mut remaining: Vec<usize> = (1..triangles.len()).collect();
-    // Each pass adds every triangle that attaches now; a valid 2-tree grows from any
-    // of its triangles, so the greedy order is complete when one exists.
-    loop {
-        let before = remaining.len();
-        remaining.retain(|&ti| {
-            let t = &triangles[ti];
-            let new: Vec<usize> = t.iter().copied().filter(|&v| !placed[v]).collect();
-            if new.len() != 1 {
-                return true;
+        for [a, b] in [[t[0], t[1]], [t[1], t[2]], [t[0], t[2]]] {
+            let e = [a.min(b), a.max(b)];
+            if self.edges.insert(e) {
+                self.pending.push(e);
             }
-            let old: Vec<usize> = t.iter().copied().filter(|&v| placed[v]).collect();
-            if old.len() == 2 && edges.contains(&key(old[0], old[1])) {
-                add(t, &mut placed, &mut edges);
-                order.push(ti);
-                false
-            } else {
-                true
-            }
-        });
-        if remaining.is_empty() {
-            return Ok(order);
-        }
-        if remaining.len() == before {
-            return Err(LamanError::Unattached(remaining));
         }
     }
 }

@@ -14,6 +14,9 @@ pub mod estimates;
 mod formation;
 pub mod graph;
 mod options;
+pub mod shape;
+pub mod target;
+pub mod wire_ids;
 
 pub use attack::{AttackKind, AttackModel};
 pub use channel::{Access, ChannelModel, IntegrityMode};
@@ -24,6 +27,7 @@ pub use estimates::{estimate_layout, resolve_estimates, EstimateInfo};
 pub use formation::{AgentModel, AngleModel, LeaderModel, TriangleModel};
 pub use graph::Graph;
 pub use options::{BearingRate, Estimator, Mode};
+pub use target::Target;
 
 use controller_core::{Limits, Schedule};
 
@@ -79,6 +83,8 @@ pub struct Model {
     pub criteria: Criteria,
     /// Edges and neighbour lists.
     pub graph: Graph,
+    /// The shape the formation should take (compared with the final positions).
+    pub target: Target,
     /// Adversaries on the radio (`[[attacks]]`; empty: none).
     pub attacks: Vec<AttackModel>,
 }
@@ -136,19 +142,10 @@ impl Model {
         (self.duration / self.dt).round().max(0.0) as usize
     }
 
-    /// Whether agent `i` is in triangle `t`.
-    fn in_triangle(t: &TriangleModel, i: usize) -> bool {
-        t.vertices.contains(&i)
-    }
-
     /// Indices of the triangles agent `i` belongs to, in scenario order (the order of
     /// its controller-core configuration).
     pub fn triangles_of(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
-        self.triangles
-            .iter()
-            .enumerate()
-            .filter(move |(_, t)| Self::in_triangle(t, i))
-            .map(|(k, _)| k)
+        self.graph.membership.of(i).iter().copied()
     }
 
     /// `v*(t)`.

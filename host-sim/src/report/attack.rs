@@ -30,7 +30,11 @@ pub(super) fn add_json(obj: &mut Map<String, Value>, m: &Model, r: &RunResult) {
     if m.attacks.is_empty() {
         return;
     }
-    let id = |i: usize| m.agents.get(i).map_or(0, |a| a.id);
+    let id = |i: usize| {
+        m.agents
+            .get(i)
+            .map_or(Value::Null, |a| super::summary::user_id(&a.name))
+    };
     let list = m
         .attacks
         .iter()
@@ -51,7 +55,7 @@ pub(super) fn add_json(obj: &mut Map<String, Value>, m: &Model, r: &RunResult) {
             });
             if let (Some(o), AttackKind::Forge { victim, gamma, .. }) = (e.as_object_mut(), &a.kind)
             {
-                o.insert("victim".to_owned(), json!(id(*victim)));
+                o.insert("victim".to_owned(), id(*victim));
                 o.insert("gamma".to_owned(), json!(gamma));
             }
             e

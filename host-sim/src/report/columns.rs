@@ -25,11 +25,11 @@ pub const BASE_COLUMNS: [&str; 13] = [
 
 /// The column names of `timeseries.csv` for `model` with these estimates.
 pub fn header(model: &Model, estimates: &[EstimateInfo]) -> Vec<String> {
-    let id = |i: usize| model.agents[i].id;
+    let id = |i: usize| model.agents[i].name.as_str();
     let mut h: Vec<String> = BASE_COLUMNS.iter().map(|s| (*s).to_owned()).collect();
     for a in &model.agents {
         for c in ["x", "y", "vx", "vy"] {
-            h.push(format!("{c}_{}", a.id));
+            h.push(format!("{c}_{}", a.name));
         }
     }
     for t in &model.triangles {

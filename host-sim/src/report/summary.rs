@@ -1,5 +1,6 @@
 //! `summary.json`: everything a run found, for people and scripts (`docs/outputs.md`).
 
+use crate::analysis::shape_check::shape_check;
 use crate::engine::hil::LinkStats;
 use crate::engine::RunResult;
 use crate::model::{EstimateInfo, Model};
@@ -19,9 +20,38 @@ fn fin(x: f64) -> Value {
     opt(Some(x))
 }
 
+/// A user's agent id in JSON: a number when it is one, else a string.
+pub(super) fn user_id(name: &str) -> Value {
+    name.parse::<u64>()
+        .map_or_else(|_| Value::String(name.to_owned()), Value::from)
+}
+
+/// The final formation against the target shape (`null` without one).
+fn shape_json(model: &Model, q: &[[f64; 2]]) -> Value {
+    match shape_check(model, q) {
+        None => Value::Null,
+        Some(c) => json!({
+            "target": if model.target.from_file { "file" } else { "angles" },
+            "max_error_rel": fin(c.fit.max_rel),
+            "rms_error_rel": fin(c.fit.rms_rel),
+            "reflected": c.fit.reflected,
+            "scale": fin(c.fit.scale),
+            "target_positions": model.target.positions.iter().map(|p| [fin(p[0]), fin(p[1])]).collect::<Vec<_>>(),
+            "folded_triangles": c.folded.iter().filter_map(|&k| model.triangles.get(k)).map(|t| {
+                t.vertices.map(|v| model.agents.get(v).map_or(Value::Null, |a| user_id(&a.name)))
+            }).collect::<Vec<_>>(),
+        }),
+    }
+}
+
 /// `summary.json` of a run.
 pub fn summary_json(model: &Model, r: &RunResult, estimates: &[EstimateInfo]) -> Value {
-    let id = |i: usize| model.agents.get(i).map_or(0, |a| a.id);
+    let id = |i: usize| {
+        model
+            .agents
+            .get(i)
+            .map_or(Value::Null, |a| user_id(&a.name))
+    };
     let fault = r
         .control
         .last_fault
@@ -43,7 +73,7 @@ pub fn summary_json(model: &Model, r: &RunResult, estimates: &[EstimateInfo]) ->
         "final_time_s": r.final_time,
         "dt_s": model.dt,
         "control_period_s": model.control_period(),
-        "agents": model.agents.iter().map(|a| a.id).collect::<Vec<_>>(),
+        "agents": model.agents.iter().map(|a| user_id(&a.name)).collect::<Vec<_>>(),
         "edges": model.graph.edges.iter().map(|e| [id(e[0]), id(e[1])]).collect::<Vec<_>>(),
         "leaders": model.leader.as_ref().map(|l| [id(l.a), id(l.b)]),
         "settle_time_s": opt(r.settle_time),
@@ -65,6 +95,7 @@ pub fn summary_json(model: &Model, r: &RunResult, estimates: &[EstimateInfo]) ->
             "rhat": fin(*rh), "r": fin(*rt)
         })).collect::<Vec<_>>(),
         "triangle_orientation_kept": r.orientation_kept,
+        "shape": shape_json(model, &r.final_positions),
         "frames_sent": r.frames.sent,
         "frames_dropped": r.frames.dropped,
         "frames_rejected": r.frames.rejected,
@@ -96,6 +127,7 @@ pub fn summary_json(model: &Model, r: &RunResult, estimates: &[EstimateInfo]) ->
             "velocity_tolerance": model.criteria.velocity_tolerance,
             "collision_distance": model.criteria.collision_distance,
             "collapse_time_s": model.criteria.collapse_time,
+            "shape_tolerance": model.criteria.shape_tolerance,
         },
         "warnings": r.warnings,
         "steps": r.steps,

@@ -17,7 +17,7 @@ fn g(x: f64) -> String {
 /// The table `host-sim run` prints at the end of a run: `out` is the output directory,
 /// `n_files` the number of files written there.
 pub fn summary_table(m: &Model, r: &RunResult, out: &Path, n_files: usize) -> String {
-    let id = |i: usize| m.agents.get(i).map_or(0, |a| a.id);
+    let id = |i: usize| m.agents.get(i).map_or("?", |a| a.name.as_str());
     let mut rows: Vec<(&str, String)> = vec![
         ("scenario", format!("{} ({})", m.name, m.source)),
         (

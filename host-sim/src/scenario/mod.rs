@@ -17,8 +17,8 @@ mod validate;
 pub use builtin::{builtin, Builtin, BUILTINS};
 pub use error::{ErrorKind, ScenarioError, ScenarioErrors};
 pub use schema::{
-    AgentDefaults, AgentSpec, AngleSpec, Diagonal, GainsSpec, LeaderSpec, ScenarioFile,
-    ScheduleSpec, StepSpec, TriangleSpec,
+    AgentDefaults, AgentId, AgentSpec, AngleSpec, Diagonal, GainsSpec, LeaderSpec, ScenarioFile,
+    ScheduleSpec, StepSpec, TargetSpec, TriangleSpec,
 };
 pub use settings::{ChannelSpec, ControllerSpec, Integration, RadioSpec, SensorSpec};
 pub use source::Source;

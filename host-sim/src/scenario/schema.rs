@@ -99,12 +99,32 @@ impl Default for AgentDefaults {
     }
 }
 
+/// An agent's id as the user writes it: a non-negative integer or a short name.
+#[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum AgentId {
+    /// `id = 7` (must be ≥ 0).
+    Number(i64),
+    /// `id = "north-3"` (1–32 letters, digits, `-`, `.`).
+    Name(String),
+}
+
+impl std::fmt::Display for AgentId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Number(i) => write!(f, "{i}"),
+            Self::Name(s) => f.write_str(s),
+        }
+    }
+}
+
 /// One `[[agents]]` entry.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AgentSpec {
-    /// Identifier, 0–255, unique.
-    pub id: i64,
+    /// Identifier, unique: a non-negative integer or a short name (the wire id is
+    /// assigned from it, see `docs/scenarios.md`).
+    pub id: AgentId,
     /// `q(0)` (m).
     pub position: [f64; 2],
     /// `v(0)` (m/s), default zero.
@@ -126,7 +146,7 @@ pub struct AgentSpec {
 #[serde(deny_unknown_fields)]
 pub struct AngleSpec {
     /// The apex agent id.
-    pub apex: i64,
+    pub apex: AgentId,
     /// Desired angle in degrees (give this or `desired_rad`).
     #[serde(default)]
     pub desired_deg: Option<f64>,
@@ -149,7 +169,7 @@ pub struct AngleSpec {
 #[serde(deny_unknown_fields)]
 pub struct TriangleSpec {
     /// The three vertex ids.
-    pub vertices: [i64; 3],
+    pub vertices: [AgentId; 3],
     /// Exactly two controlled angles with distinct apexes.
     pub angles: Vec<AngleSpec>,
 }
@@ -159,7 +179,7 @@ pub struct TriangleSpec {
 #[serde(deny_unknown_fields)]
 pub struct LeaderSpec {
     /// `[a, b]` with `z = q_a − q_b`.
-    pub agents: [i64; 2],
+    pub agents: [AgentId; 2],
     /// `k_z`.
     pub stiffness: f64,
     /// `D_z`.
@@ -219,9 +239,22 @@ pub struct ScenarioFile {
     /// `[criteria]`.
     #[serde(default)]
     pub criteria: Criteria,
+    /// `[target]`: the shape the formation should take (optional; `host-sim design`
+    /// writes it).
+    #[serde(default)]
+    pub target: Option<TargetSpec>,
     /// `[[attacks]]`: adversaries on the radio (`docs/attacks.md`).
     #[serde(default)]
     pub attacks: Vec<AttackSpec>,
+}
+
+/// `[target]`: the target shape, one `[x, y]` per agent in `[[agents]]` order; compared
+/// with the final formation up to translation, rotation, scale and mirror.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TargetSpec {
+    /// Target positions (m), in agent order.
+    pub positions: Vec<[f64; 2]>,
 }
 
 fn default_duration() -> f64 {

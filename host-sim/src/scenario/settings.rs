@@ -192,7 +192,7 @@ pub struct AttackSpec {
     pub delay: Option<f64>,
     /// `forge`: the id of the agent whose frames are forged.
     #[serde(default)]
-    pub victim: Option<i64>,
+    pub victim: Option<super::schema::AgentId>,
     /// `forge`: the `γ` written into every angle item (default 5).
     #[serde(default)]
     pub gamma: Option<f64>,

@@ -8,7 +8,7 @@
 
 use crate::model::graph::{strip_triangles, Graph};
 use crate::model::{AgentModel, AngleModel, Model, RadioModel, SensorModel, TriangleModel};
-use crate::model::{BearingRate, Criteria, Estimator, IntegrityMode, Mode};
+use crate::model::{BearingRate, Criteria, Estimator, IntegrityMode, Mode, Target};
 use controller_core::{Limits, Schedule};
 
 /// A strip of `n ≥ 3` agents, printed-paper gains (c = 10, d = 1, c_e = 10), desired
@@ -20,6 +20,7 @@ pub fn strip_model(n: usize, duration: f64) -> Model {
         .map(|i| {
             let f = i as f64;
             AgentModel {
+                name: i.to_string(),
                 id: (i % 256) as u8,
                 position: [
                     0.5 * f + 0.08 * (1.3 * f).sin(),
@@ -75,5 +76,12 @@ pub fn strip_model(n: usize, duration: f64) -> Model {
         criteria: Criteria::default(),
         graph: Graph::new(n, &tri, None),
         attacks: Vec::new(),
+        // The equilateral strip the 60° angles encode.
+        target: Target {
+            positions: (0..n)
+                .map(|i| [0.5 * i as f64, h * (i % 2) as f64])
+                .collect(),
+            from_file: false,
+        },
     }
 }

@@ -13,6 +13,35 @@ use std::path::Path;
 // ---------------------------------------------------------------------------
 // Input
 
+/// An agent id in `summary.json`: an integer or a name.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(untagged)]
+pub(super) enum Id {
+    /// `7`.
+    Number(i64),
+    /// `"north-3"`.
+    Name(String),
+}
+
+impl std::fmt::Display for Id {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Number(i) => write!(f, "{i}"),
+            Self::Name(s) => f.write_str(s),
+        }
+    }
+}
+
+/// `summary.json`'s `shape`.
+#[derive(Debug, Deserialize)]
+pub(super) struct ShapeSummary {
+    pub(super) target: String,
+    pub(super) max_error_rel: Option<f64>,
+    pub(super) reflected: bool,
+    pub(super) folded_triangles: Vec<[Id; 3]>,
+    pub(super) target_positions: Vec<[Option<f64>; 2]>,
+}
+
 /// The fields of `summary.json` the plots use.
 #[derive(Debug, Deserialize)]
 pub(super) struct Summary {
@@ -20,10 +49,13 @@ pub(super) struct Summary {
     pub(super) outcome: String,
     #[serde(default)]
     pub(super) outcome_reason: Option<String>,
-    pub(super) agents: Vec<i64>,
-    pub(super) edges: Vec<[i64; 2]>,
+    pub(super) agents: Vec<Id>,
+    pub(super) edges: Vec<[Id; 2]>,
     #[serde(default)]
-    pub(super) leaders: Option<[i64; 2]>,
+    pub(super) leaders: Option<[Id; 2]>,
+    /// The final formation against its target (absent in runs made before it existed).
+    #[serde(default)]
+    pub(super) shape: Option<ShapeSummary>,
     #[serde(default)]
     pub(super) mode: Option<serde_json::Value>,
     #[serde(default)]
@@ -219,7 +251,7 @@ pub(super) fn load_run(dir: &Path) -> Result<Run, PlotError> {
             .map(|(_, s)| s)
             .collect()
     } else {
-        summary.agents.iter().map(i64::to_string).collect()
+        summary.agents.iter().map(Id::to_string).collect()
     };
     let mut agent_xy = Vec::with_capacity(agent_ids.len());
     for id in &agent_ids {
@@ -234,15 +266,16 @@ pub(super) fn load_run(dir: &Path) -> Result<Run, PlotError> {
         .rev()
         .map(|(i, id)| (id.as_str(), i))
         .collect();
-    let lookup = |id: i64| agent_index.get(id.to_string().as_str()).copied();
+    let lookup = |id: &Id| agent_index.get(id.to_string().as_str()).copied();
     let leaders: Vec<usize> = summary
         .leaders
+        .as_ref()
         .map(|[a, b]| [lookup(a), lookup(b)].into_iter().flatten().collect())
         .unwrap_or_default();
     let edges: Vec<(usize, usize)> = summary
         .edges
         .iter()
-        .filter_map(|&[a, b]| Some((lookup(a)?, lookup(b)?)))
+        .filter_map(|[a, b]| Some((lookup(a)?, lookup(b)?)))
         .collect();
 
     let mut path_agents = spread(agent_ids.len(), MAX_AGENT_PATHS);

@@ -15,6 +15,8 @@ pub(super) enum Key {
     /// An edge with a node at each end.
     Net(RGBColor),
     Triangle(RGBColor),
+    /// The colour scale [`super::style::ramp`] from 0 (left) to 1 (right): a colour bar.
+    Ramp,
     /// No key (a note line).
     None,
 }
@@ -112,6 +114,15 @@ where
             }
             Key::Triangle(c) => {
                 area.draw(&TriangleMarker::new(((x0 + x1) / 2, y), 7, c.filled()))?;
+            }
+            Key::Ramp => {
+                let steps = 16;
+                for k in 0..steps {
+                    let xa = x0 + (x1 - x0) * k / steps;
+                    let xb = x0 + (x1 - x0) * (k + 1) / steps;
+                    let c = super::style::ramp(f64::from(k) / f64::from(steps - 1));
+                    area.draw(&Rectangle::new([(xa, y - 6), (xb, y + 6)], c.filled()))?;
+                }
             }
             Key::None => {}
         }

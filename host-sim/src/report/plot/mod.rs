@@ -10,6 +10,7 @@
 //! | `energy` | V and its terms V_kin, V_ang, V_lead, V_est vs time, log scale |
 //! | `estimates` | each distance estimate r̂ (solid) against its true distance r (dashed), at most [`MAX_ESTIMATES`] |
 //! | `maneuvers` | leader displacement and velocity errors, and the minimum inter-agent distance vs time |
+//! | `shape` | the final formation, fitted onto its target shape (translation, rotation, scale, mirror), over the target; folded triangles marked |
 //!
 //! Every figure has the scenario name and outcome in its title, a subtitle
 //! with the outcome reason, mode and estimator, axis labels and a legend in a
@@ -33,6 +34,7 @@ mod input;
 mod legend;
 mod maneuvers;
 mod ranges;
+mod shape;
 mod style;
 #[cfg(test)]
 mod tests;
@@ -108,6 +110,10 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
     let run = load_run(dir)?;
     let mut written = Vec::with_capacity(2 * Figure::ALL.len());
     for figure in Figure::ALL {
+        // Runs written before `shape` existed have no target to draw.
+        if figure == Figure::Shape && run.summary.shape.is_none() {
+            continue;
+        }
         render(dir, figure, &run, &mut written)?;
     }
     Ok(written)
@@ -129,23 +135,25 @@ fn ensure_font() -> Result<(), PlotError> {
     }
 }
 
-/// The five figures.
-#[derive(Debug, Clone, Copy)]
+/// The figures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Figure {
     Trajectories,
     AngleErrors,
     Energy,
     Estimates,
     Maneuvers,
+    Shape,
 }
 
 impl Figure {
-    const ALL: [Figure; 5] = [
+    const ALL: [Figure; 6] = [
         Figure::Trajectories,
         Figure::AngleErrors,
         Figure::Energy,
         Figure::Estimates,
         Figure::Maneuvers,
+        Figure::Shape,
     ];
 
     fn stem(self) -> &'static str {
@@ -155,6 +163,7 @@ impl Figure {
             Figure::Energy => "energy",
             Figure::Estimates => "estimates",
             Figure::Maneuvers => "maneuvers",
+            Figure::Shape => "shape",
         }
     }
 }
@@ -205,5 +214,6 @@ where
         Figure::Energy => energy::draw(root, run, bitmap),
         Figure::Estimates => estimates::draw(root, run, bitmap),
         Figure::Maneuvers => maneuvers::draw(root, run, bitmap),
+        Figure::Shape => shape::draw(root, run, bitmap),
     }
 }

@@ -28,6 +28,28 @@ pub(super) fn colour(i: usize) -> RGBColor {
     PALETTE[i % PALETTE.len()]
 }
 
+/// A continuous colour scale for `f` in [0, 1] (five anchors of matplotlib's viridis,
+/// linearly interpolated: dark blue → green → yellow), for colouring many agents by index.
+pub(super) fn ramp(f: f64) -> RGBColor {
+    const ANCHORS: [(f64, f64, f64); 5] = [
+        (68.0, 1.0, 84.0),
+        (59.0, 82.0, 139.0),
+        (33.0, 145.0, 140.0),
+        (94.0, 201.0, 98.0),
+        (253.0, 231.0, 37.0),
+    ];
+    let x = if f.is_finite() {
+        f.clamp(0.0, 1.0)
+    } else {
+        0.0
+    } * 4.0;
+    let k = (x.floor() as usize).min(3);
+    let u = x - k as f64;
+    let (a, b) = (ANCHORS[k], ANCHORS[k + 1]);
+    let mix = |p: f64, q: f64| (p + (q - p) * u).round() as u8;
+    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
+}
+
 /// Draws the polyline `pts` (in `area`'s coordinates), `width` pixels wide,
 /// solid or dashed.
 ///

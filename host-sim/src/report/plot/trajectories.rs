@@ -38,9 +38,16 @@ where
             ));
         }
     } else {
+        // Many agents: one colour bar instead of a row per agent.
+        let first = run.agent_ids.first().map_or("", String::as_str);
+        let last = run.agent_ids.last().map_or("", String::as_str);
         entries.push(entry(
-            format!("agent paths ({})", run.paths.len()),
-            Key::Line(colour(0), 2),
+            format!("agent paths ({}), by agent index", run.paths.len()),
+            Key::Ramp,
+        ));
+        entries.push(entry(
+            format!("  left: 1st agent ({first}), right: {n}th ({last})"),
+            Key::None,
         ));
     }
     let shades = snapshot_shades(run.snapshots.len());
@@ -116,7 +123,12 @@ where
     }
     for (i, p) in run.paths.iter().enumerate() {
         let pts = points(&p.x, &p.y);
-        stroke(chart.plotting_area(), &pts, colour(i), 2, false, bitmap)?;
+        let c = if label_each {
+            colour(i)
+        } else {
+            ramp(p.agent as f64 / n.saturating_sub(1).max(1) as f64)
+        };
+        stroke(chart.plotting_area(), &pts, c, 2, false, bitmap)?;
     }
     let radius = if n > 100 { 2 } else { 4 };
     for (s, shade) in run.snapshots.iter().zip(&shades) {

@@ -12,7 +12,7 @@ use std::collections::HashMap;
 pub(super) fn check(
     c: &mut Checker<'_>,
     s: &ScenarioFile,
-    index: &HashMap<i64, usize>,
+    index: &HashMap<String, usize>,
 ) -> Vec<AttackModel> {
     let mut out = Vec::new();
     for (k, a) in s.attacks.iter().enumerate() {
@@ -65,7 +65,7 @@ pub(super) fn check(
                 if let Some(v) = a.velocity {
                     c.finite2(&field("velocity"), v);
                 }
-                match a.victim {
+                match &a.victim {
                     None => {
                         c.err(
                             InvalidValue,

@@ -1,7 +1,7 @@
 //! The graph: triangulated Laman (SPEC §3), no (nearly) collinear initial triangle, and
 //! every agent within the controller's capacity.
 
-use super::agents::agent_id;
+use super::agents::{agent_id, list};
 use super::checker::{interior_angle, Checker};
 use crate::model::graph::{laman_order, Graph, LamanError};
 use crate::model::{AgentModel, TriangleModel, MT, NB};
@@ -10,7 +10,8 @@ use crate::scenario::ScenarioFile;
 use std::f64::consts::PI;
 
 /// Checks that the triangles form a triangulated Laman graph and none is (nearly)
-/// collinear at the start (only when every id resolved: `ids_ok`).
+/// collinear at the start (only when every id resolved: `ids_ok`); returns a construction
+/// order of the triangles when they are one.
 pub(super) fn check(
     c: &mut Checker<'_>,
     s: &ScenarioFile,
@@ -18,41 +19,45 @@ pub(super) fn check(
     triangles: &[TriangleModel],
     ids_ok: bool,
     margin: f64,
-) {
+) -> Option<Vec<usize>> {
+    let mut order = None;
     let tri_idx: Vec<[usize; 3]> = triangles.iter().map(|t| t.vertices).collect();
     let n = agents.len();
     let id_of = |i: usize| agent_id(agents, i);
     if ids_ok && n >= 3 && c.errors.iter().all(|e| e.kind != ErrorKind::DuplicateId) {
-        if let Err(e) = laman_order(n, &tri_idx) {
-            let (field, reason) = match e {
-                LamanError::Empty => (
-                    "triangles".to_owned(),
-                    "no triangles: the graph must be built from triangles".to_owned(),
-                ),
-                LamanError::Isolated(i) => (
-                    format!("agents[{i}]"),
-                    format!("agent {} belongs to no triangle", id_of(i)),
-                ),
-                LamanError::Count { agents, triangles } => (
-                    "triangles".to_owned(),
-                    format!(
+        match laman_order(n, &tri_idx) {
+            Ok(o) => order = Some(o),
+            Err(e) => {
+                let (field, reason) = match e {
+                    LamanError::Empty => (
+                        "triangles".to_owned(),
+                        "no triangles: the graph must be built from triangles".to_owned(),
+                    ),
+                    LamanError::Isolated(i) => (
+                        format!("agents[{i}]"),
+                        format!("agent {} belongs to no triangle", id_of(i)),
+                    ),
+                    LamanError::Count { agents, triangles } => (
+                        "triangles".to_owned(),
+                        format!(
                         "{agents} agents need exactly {} triangles (N = M + 2), got {triangles}",
                         agents.saturating_sub(2)
                     ),
-                ),
-                LamanError::Unattached(rest) => {
-                    let first = rest.first().copied().unwrap_or(0);
-                    (
+                    ),
+                    LamanError::Unattached(rest) => {
+                        let first = rest.first().copied().unwrap_or(0);
+                        (
                         format!("triangles[{first}]"),
                         format!(
-                            "triangle {:?} does not join exactly one new agent to an edge of the triangles before it (triangles {:?} cannot be attached)",
-                            s.triangles.get(first).map(|t| t.vertices).unwrap_or_default(),
+                            "triangle {} does not join exactly one new agent to an edge of the triangles before it (triangles {:?} cannot be attached)",
+                            s.triangles.get(first).map_or_else(String::new, |t| list(&t.vertices)),
                             rest
                         ),
                     )
-                }
-            };
-            c.err(ErrorKind::NotLaman, &field, reason);
+                    }
+                };
+                c.err(ErrorKind::NotLaman, &field, reason);
+            }
         }
         // ---- collinear initial triangles
         for (ti, t) in triangles.iter().enumerate() {
@@ -74,8 +79,8 @@ pub(super) fn check(
                         ErrorKind::CollinearTriangle,
                         &format!("triangles[{ti}]"),
                         format!(
-                            "triangle {:?} is (nearly) collinear in the initial positions: {what}",
-                            t.vertices.map(id_of)
+                            "triangle {} is (nearly) collinear in the initial positions: {what}",
+                            list(&t.vertices.map(id_of))
                         ),
                     );
                     break;
@@ -83,37 +88,41 @@ pub(super) fn check(
             }
         }
     }
+    order
 }
 
 /// Checks every agent's triangles and radio neighbours against the controller's
-/// capacity (`MT`, `NB`).
-pub(super) fn capacity(
-    c: &mut Checker<'_>,
-    agents: &[AgentModel],
-    graph: &Graph,
-    tri_idx: &[[usize; 3]],
-) {
+/// capacity (`MT`, `NB`: `controller_core::{MAX_TRIANGLES, MAX_NEIGHBOURS}`).
+pub(super) fn capacity(c: &mut Checker<'_>, agents: &[AgentModel], graph: &Graph) {
     let id_of = |i: usize| agent_id(agents, i);
     for i in 0..agents.len() {
-        let tris = tri_idx.iter().filter(|t| t.contains(&i)).count();
-        if tris > MT {
+        let tris = graph.membership.of(i);
+        if tris.len() > MT {
+            let shown: Vec<String> = tris.iter().map(|k| format!("triangles[{k}]")).collect();
             c.err(
                 InvalidValue,
                 &format!("agents[{i}]"),
                 format!(
-                    "agent {} belongs to {tris} triangles; the controller holds at most {MT}",
-                    id_of(i)
+                    "agent {} belongs to {} triangles ({}); the controller holds at most {MT} (controller_core::MAX_TRIANGLES): move {} of them to other agents, e.g. regenerate with `host-sim design`",
+                    id_of(i),
+                    tris.len(),
+                    shown.join(", "),
+                    tris.len() - MT
                 ),
             );
         }
-        if graph.radio.of(i).len() > NB {
+        let nb = graph.radio.of(i);
+        if nb.len() > NB {
+            let shown: Vec<String> = nb.iter().map(|&j| id_of(j)).collect();
             c.err(
                 InvalidValue,
                 &format!("agents[{i}]"),
                 format!(
-                    "agent {} has {} neighbours; the controller holds at most {NB}",
+                    "agent {} has {} neighbours ({}); the controller holds at most {NB} (controller_core::MAX_NEIGHBOURS): remove triangles through it so that it has {} fewer",
                     id_of(i),
-                    graph.radio.of(i).len()
+                    nb.len(),
+                    shown.join(", "),
+                    nb.len() - NB
                 ),
             );
         }

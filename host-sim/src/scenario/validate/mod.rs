@@ -10,6 +10,7 @@ mod comm;
 mod graph;
 mod references;
 mod settings;
+mod target;
 mod triangles;
 
 use crate::model::{Graph, Model, RadioModel, SensorModel};
@@ -36,15 +37,19 @@ pub fn validate(s: &ScenarioFile, file: &str, default_name: &str) -> Result<Mode
     let comm_every = comm::comm_every(&mut c, s, period);
     let channel = comm::channel(&mut c, s, period);
     let auth_key = comm::auth_key(&mut c, s);
-    let (agents, index) = agents::check(&mut c, s);
+    let (mut agents, index) = agents::check(&mut c, s);
     let (triangles, ids_ok) = triangles::check(&mut c, s, &index, margin);
-    graph::check(&mut c, s, &agents, &triangles, ids_ok, margin);
+    let order = graph::check(&mut c, s, &agents, &triangles, ids_ok, margin);
     let leader = references::leader(&mut c, s, &index);
     let attacks = attacks::check(&mut c, s, &index);
     let velocity_reference = c.schedule("velocity_reference", &s.velocity_reference);
     let tri_idx: Vec<[usize; 3]> = triangles.iter().map(|t| t.vertices).collect();
     let graph = Graph::new(agents.len(), &tri_idx, leader.as_ref().map(|l| [l.a, l.b]));
-    graph::capacity(&mut c, &agents, &graph, &tri_idx);
+    graph::capacity(&mut c, &agents, &graph);
+    if c.errors.is_empty() {
+        agents::wire_ids(&mut c, s, &mut agents, &graph.radio);
+    }
+    let target = target::check(&mut c, s, &agents, &triangles, order.as_deref());
 
     if !c.errors.is_empty() {
         // A default gain used by several angles is reported once.
@@ -106,6 +111,7 @@ pub fn validate(s: &ScenarioFile, file: &str, default_name: &str) -> Result<Mode
         criteria: s.criteria.clone(),
         graph,
         attacks,
+        target,
     };
     // Last line of defence: the core's own checks (should agree with the above).
     let mut core_errors = Vec::new();

@@ -11,13 +11,13 @@ use std::collections::HashMap;
 pub(super) fn leader(
     c: &mut Checker<'_>,
     s: &ScenarioFile,
-    index: &HashMap<i64, usize>,
+    index: &HashMap<String, usize>,
 ) -> Option<LeaderModel> {
     match &s.leader {
         None => None,
         Some(l) => {
-            let a = lookup(c, index, "leader.agents", l.agents[0]);
-            let b = lookup(c, index, "leader.agents", l.agents[1]);
+            let a = lookup(c, index, "leader.agents", &l.agents[0]);
+            let b = lookup(c, index, "leader.agents", &l.agents[1]);
             if l.agents[0] == l.agents[1] {
                 c.err(
                     InvalidValue,

@@ -163,6 +163,7 @@ pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile) -> Timing {
         "criteria.velocity_tolerance",
         cr.velocity_tolerance,
     );
+    c.positive(InvalidValue, "criteria.shape_tolerance", cr.shape_tolerance);
     Timing {
         dt,
         steps_per_tick,

@@ -1,7 +1,7 @@
 //! `[gains]` and `[[triangles]]`: vertices, the two controlled angles of each, their
 //! desired values (feasible, within the margin) and gains.
 
-use super::agents::lookup;
+use super::agents::{list, lookup};
 use super::checker::Checker;
 use crate::model::{AngleModel, TriangleModel};
 use crate::scenario::error::ErrorKind::{self, InvalidValue, NonPositiveGain};
@@ -13,7 +13,7 @@ use std::f64::consts::PI;
 pub(super) fn check(
     c: &mut Checker<'_>,
     s: &ScenarioFile,
-    index: &HashMap<i64, usize>,
+    index: &HashMap<String, usize>,
     margin: f64,
 ) -> (Vec<TriangleModel>, bool) {
     let g = &s.gains;
@@ -23,7 +23,7 @@ pub(super) fn check(
         let tf = format!("triangles[{ti}]");
         let mut verts = [0usize; 3];
         let mut ok = true;
-        for (k, &id) in t.vertices.iter().enumerate() {
+        for (k, id) in t.vertices.iter().enumerate() {
             match lookup(c, index, &format!("{tf}.vertices"), id) {
                 Some(i) => verts[k] = i,
                 None => ok = false,
@@ -33,7 +33,7 @@ pub(super) fn check(
             c.err(
                 ErrorKind::NotLaman,
                 &format!("{tf}.vertices"),
-                format!("triangle {:?} repeats an agent", t.vertices),
+                format!("triangle {} repeats an agent", list(&t.vertices)),
             );
             ok = false;
         }
@@ -53,14 +53,15 @@ pub(super) fn check(
         for (ai, a) in t.angles.iter().enumerate() {
             let af = format!("{tf}.angles[{ai}]");
             let apex = if t.vertices.contains(&a.apex) {
-                index.get(&a.apex).copied()
+                index.get(&a.apex.to_string()).copied()
             } else {
                 c.err(
                     ErrorKind::UnknownId,
                     &format!("{af}.apex"),
                     format!(
-                        "apex {} is not a vertex of triangle {:?}",
-                        a.apex, t.vertices
+                        "apex {} is not a vertex of triangle {}",
+                        a.apex,
+                        list(&t.vertices)
                     ),
                 );
                 None

@@ -9,9 +9,11 @@
 //! `z ↦ a·conj(z)` has `a = Σ z_i·w_i / Σ|z_i|²`; the one with the smaller residual
 //! `Σ|w|² − |Σ…|² / Σ|z|²` wins.
 
-use super::geometry::cross;
-use super::points::Point;
+use super::target::cross;
 use thiserror::Error;
+
+/// A position `[x, y]` (m).
+pub type Point = [f64; 2];
 
 /// Why two point sets cannot be compared.
 #[derive(Clone, Debug, PartialEq, Error)]

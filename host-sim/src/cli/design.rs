@@ -1,0 +1,292 @@
+//! `host-sim design`: from a shape (a points file or a built-in generator) to a complete
+//! scenario TOML ([`crate::design`]); the quality figures go to stderr, the scenario to
+//! stdout or `-o FILE`.
+
+use crate::design::{
+    construct, read_points, render_scenario, DesignError, DesignOptions, Generator, Perturbation,
+    ScenarioOptions, Template,
+};
+use crate::exit_code;
+use crate::scenario::Source;
+use clap::{Args, ValueEnum};
+use std::path::PathBuf;
+
+/// A built-in shape of `host-sim design --shape`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Shape {
+    /// Regular polygon, `n` corners.
+    Polygon,
+    /// Regular polygon of `n − 1` corners and its centre.
+    PolygonCentre,
+    /// Square lattice, `⌈√n⌉` points wide.
+    RectLattice,
+    /// Triangular lattice, `⌈√n⌉` points wide.
+    TriLattice,
+    /// Zig-zag strip of equilateral triangles.
+    Strip,
+    /// Random points in a disc, no two closer than the spacing.
+    Disc,
+}
+
+/// Arguments of `host-sim design`.
+#[derive(Debug, Args)]
+pub struct DesignArgs {
+    /// Target points: a `.csv` (columns x, y) or a `.toml` (`points = [[x, y], …]`, or a
+    /// scenario's `[target]`). Give this or `--shape`.
+    #[arg(
+        value_name = "POINTS",
+        required_unless_present = "shape",
+        conflicts_with = "shape"
+    )]
+    pub points: Option<PathBuf>,
+    /// A built-in shape instead of a points file.
+    #[arg(long, value_enum, requires = "n")]
+    pub shape: Option<Shape>,
+    /// Number of agents of the built-in shape.
+    #[arg(short, long, value_name = "N")]
+    pub n: Option<usize>,
+    /// Side / lattice step / smallest distance of the built-in shape (m).
+    #[arg(long, value_name = "M", default_value_t = 1.0)]
+    pub spacing: f64,
+    /// Largest initial displacement of each agent, as a fraction of the mean edge length
+    /// of the constructed graph, in [0, 1] (local, so it means the same at any N).
+    #[arg(long, value_name = "F", default_value_t = 0.1)]
+    pub perturbation: f64,
+    /// Also rotate the initial formation by a random angle about its centroid.
+    #[arg(long)]
+    pub rotate: bool,
+    /// Seed of the random disc, of the initial displacements and of the run.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub seed: u64,
+    /// Leader edge as two agent ids `A,B` (agent i is point i − 1); default: the shortest
+    /// edge of the best triangle near the centroid.
+    #[arg(long, value_name = "A,B", value_parser = pair::<usize>)]
+    pub leader: Option<[usize; 2]>,
+    /// Write no `[leader]` section (no leader edge maneuver).
+    #[arg(long, conflicts_with = "leader")]
+    pub no_leader: bool,
+    /// Reference velocity v* (m/s) as `VX,VY`.
+    #[arg(long = "v-star", value_name = "VX,VY", value_parser = pair::<f64>, allow_hyphen_values = true)]
+    pub v_star: Option<[f64; 2]>,
+    /// Scenario (file or built-in name) whose gains and settings are copied. The default,
+    /// `formation-only` (c = 10, d = 1, c_e = 10), converges for lattices, strips and discs
+    /// of 200 agents (docs/design.md); the paper's gains (c = 1000) do not beyond a few
+    /// agents.
+    #[arg(long, value_name = "SCENARIO", default_value = "formation-only")]
+    pub template: String,
+    /// Every angle of every triangle stays this far from 0 and 180° (degrees) [default: the
+    /// template's `controller.angle_margin_deg`].
+    #[arg(long, value_name = "DEG")]
+    pub margin: Option<f64>,
+    /// Triangles per agent at most [default: the controller's capacity].
+    #[arg(long, value_name = "K", default_value_t = controller_core::MAX_TRIANGLES)]
+    pub max_triangles: usize,
+    /// Neighbours per agent at most [default: the controller's capacity].
+    #[arg(long, value_name = "K", default_value_t = controller_core::MAX_NEIGHBOURS)]
+    pub max_neighbours: usize,
+    /// Scenario name (output directory `out/<name>/`) [default: the shape or file stem].
+    #[arg(long)]
+    pub name: Option<String>,
+    /// Simulated duration (s) [default: the template's].
+    #[arg(long, value_name = "S")]
+    pub duration: Option<f64>,
+    /// Write the scenario here instead of stdout.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+}
+
+/// Parses `A,B`.
+fn pair<T: std::str::FromStr>(s: &str) -> Result<[T; 2], String> {
+    let parse = |x: &str| {
+        x.trim()
+            .parse::<T>()
+            .map_err(|_| format!("`{}` is not a number", x.trim()))
+    };
+    match s.split_once(',') {
+        Some((a, b)) => Ok([parse(a)?, parse(b)?]),
+        None => Err(format!(
+            "expected two numbers separated by a comma, got `{s}`"
+        )),
+    }
+}
+
+impl DesignArgs {
+    fn generator(&self, shape: Shape, n: usize) -> Generator {
+        let spacing = self.spacing;
+        match shape {
+            Shape::Polygon | Shape::PolygonCentre => Generator::Polygon {
+                n,
+                spacing,
+                centre: shape == Shape::PolygonCentre,
+            },
+            Shape::RectLattice => Generator::RectangularLattice { n, spacing },
+            Shape::TriLattice => Generator::TriangularLattice { n, spacing },
+            Shape::Strip => Generator::Strip { n, spacing },
+            Shape::Disc => Generator::RandomDisc {
+                n,
+                spacing,
+                seed: self.seed,
+            },
+        }
+    }
+}
+
+/// Runs `host-sim design`; returns the exit code.
+pub fn design_command(args: &DesignArgs, quiet: bool) -> u8 {
+    match design(args) {
+        Ok((text, figures)) => {
+            if !quiet {
+                eprint!("{figures}");
+            }
+            let written = match &args.output {
+                Some(path) => std::fs::write(path, text)
+                    .map_err(|e| format!("cannot write {}: {e}", path.display())),
+                None => {
+                    use std::io::Write;
+                    std::io::stdout()
+                        .write_all(text.as_bytes())
+                        .map_err(|e| format!("cannot write to stdout: {e}"))
+                }
+            };
+            match written {
+                Ok(()) => exit_code::CONVERGED,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    exit_code::IO
+                }
+            }
+        }
+        Err(e) => {
+            eprintln!("error: design refused: {e}");
+            exit_code::DESIGN_REFUSED
+        }
+    }
+}
+
+/// The scenario text and the figures to print.
+fn design(args: &DesignArgs) -> Result<(String, String), DesignError> {
+    let option = |name: &str, reason: String| DesignError::Option {
+        option: name.to_owned(),
+        reason,
+    };
+    let (points, source, default_name) = match (&args.points, args.shape) {
+        (Some(path), _) => {
+            let stem = path
+                .file_stem()
+                .map_or_else(|| "design".to_owned(), |s| s.to_string_lossy().into_owned());
+            (read_points(path)?, path.display().to_string(), stem)
+        }
+        (None, Some(shape)) => {
+            let n = args
+                .n
+                .ok_or_else(|| option("n", "a built-in shape needs --n".to_owned()))?;
+            let g = args.generator(shape, n);
+            let name = format!(
+                "{}-{n}",
+                shape
+                    .to_possible_value()
+                    .map_or_else(|| "shape".to_owned(), |v| v.get_name().to_owned())
+            );
+            (g.points()?, g.describe(), name)
+        }
+        (None, None) => return Err(option("points", "give a points file or --shape".to_owned())),
+    };
+    if !(0.0..=1.0).contains(&args.perturbation) {
+        return Err(option(
+            "perturbation",
+            format!(
+                "must be a fraction of the mean edge length in [0, 1], got {}",
+                args.perturbation
+            ),
+        ));
+    }
+    let src = Source::resolve(&args.template).map_err(|e| DesignError::Template {
+        file: args.template.clone(),
+        reason: e.to_string(),
+    })?;
+    let template = Some(Template::parse(&src.text, &src.label)?);
+    let margin_deg = args.margin.unwrap_or_else(|| {
+        template
+            .as_ref()
+            .map_or(crate::design::laman::DEFAULT_MARGIN_DEG, |t| {
+                t.angle_margin_deg()
+            })
+    });
+    let n = points.len();
+    let leader = match args.leader {
+        Some(ids) => {
+            let id = |k: usize| -> Result<usize, DesignError> {
+                let v = ids[k];
+                if (1..=n).contains(&v) {
+                    Ok(v - 1)
+                } else {
+                    Err(option(
+                        "leader",
+                        format!("agent id {v} is not in 1..={n} (agent i is point i − 1)"),
+                    ))
+                }
+            };
+            Some([id(0)?, id(1)?])
+        }
+        None => None,
+    };
+    let opts = DesignOptions {
+        margin_deg,
+        max_triangles: args.max_triangles,
+        max_neighbours: args.max_neighbours,
+        leader,
+    };
+    let c = construct(&points, &opts)?;
+    // The library's fraction is of the formation's size (RMS distance from the centroid).
+    let size = crate::design::initial::formation_size(&points);
+    let fraction = if size > 0.0 {
+        (args.perturbation * c.figures.mean_edge / size).min(1.0)
+    } else {
+        0.0
+    };
+    let v = args.v_star.unwrap_or([0.0, 0.0]);
+    if v.iter().any(|x| !x.is_finite()) {
+        return Err(option("v-star", format!("must be finite, got {v:?}")));
+    }
+    if let Some(d) = args.duration {
+        if !(d.is_finite() && d > 0.0) {
+            return Err(option("duration", format!("must be > 0 s, got {d}")));
+        }
+    }
+    let command: Vec<String> = std::env::args().collect();
+    let so = ScenarioOptions {
+        name: args.name.clone().unwrap_or(default_name),
+        description: None,
+        command: command.join(" "),
+        source,
+        velocity_reference: v,
+        duration: args.duration,
+        seed: args.seed,
+        leader: !args.no_leader,
+        perturbation: Perturbation {
+            fraction,
+            rotate: args.rotate,
+            seed: args.seed,
+        },
+        template,
+    };
+    let text = render_scenario(&points, &c, &opts, &so)?;
+    let f = &c.figures;
+    let figures = format!(
+        "design: {} agents, {} triangles, leader edge ({}, {})\n  smallest controlled angle {:.3}° (margin from 0 and 180°), smallest interior angle {:.3}°\n  largest triangles per agent {} (capacity {}), largest neighbours per agent {} (capacity {})\n  longest edge {:.4} m, mean edge {:.4} m, overlapping triangles {}\n",
+        f.agents,
+        f.triangles,
+        c.leader[0] + 1,
+        c.leader[1] + 1,
+        f.min_controlled_deg,
+        f.min_angle_deg,
+        f.max_triangles_per_agent,
+        opts.max_triangles,
+        f.max_neighbours_per_agent,
+        opts.max_neighbours,
+        f.longest_edge,
+        f.mean_edge,
+        f.overlapping
+    );
+    Ok((text, figures))
+}

@@ -1,0 +1,250 @@
+//! `host-sim design` on the command line: `design … | run -`, the figures on stderr, the
+//! refusals and their exit code; ids of any kind and number through the loader.
+
+use std::io::Write;
+use std::process::{Command, Output, Stdio};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_host-sim"))
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+/// Runs `host-sim args` with `input` on stdin.
+fn run_with_stdin(args: &[&str], input: &[u8]) -> Output {
+    let mut child = bin()
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn host-sim");
+    child
+        .stdin
+        .take()
+        .expect("stdin")
+        .write_all(input)
+        .expect("write stdin");
+    child.wait_with_output().expect("wait")
+}
+
+#[test]
+fn design_pipes_into_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = bin()
+        .args(["design", "--shape", "strip", "-n", "6", "--duration", "30"])
+        .output()
+        .unwrap();
+    assert_eq!(d.status.code(), Some(0), "{}", text(&d.stderr));
+    let err = text(&d.stderr);
+    for want in [
+        "smallest controlled angle 60.000°",
+        "largest triangles per agent 3 (capacity 8)",
+        "longest edge 1.0000 m",
+    ] {
+        assert!(err.contains(want), "missing {want:?} in {err}");
+    }
+    let out = dir.path().join("run");
+    let r = run_with_stdin(
+        &["run", "-", "--no-plots", "--out", out.to_str().unwrap()],
+        &d.stdout,
+    );
+    let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&summary).unwrap();
+    assert_eq!(v["source"], "<stdin>");
+    assert_eq!(v["agents"].as_array().unwrap().len(), 6);
+    // The run ends in a defined outcome (its exit code), not an error.
+    assert_eq!(
+        r.status.code(),
+        v["exit_code"].as_u64().map(|c| c as i32),
+        "{}",
+        text(&r.stderr)
+    );
+    // `validate -` reads stdin too.
+    let val = run_with_stdin(&["validate", "-"], &d.stdout);
+    assert_eq!(val.status.code(), Some(0), "{}", text(&val.stderr));
+    assert!(text(&val.stdout).contains("6 agents, 4 triangles"));
+}
+
+#[test]
+fn design_writes_a_file_and_refuses_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("poly.toml");
+    let d = bin()
+        .args(["design", "--shape", "polygon-centre", "-n", "7", "-o"])
+        .arg(&file)
+        .args(["--v-star", "0.5,-0.25", "--leader", "7,1"])
+        .output()
+        .unwrap();
+    assert_eq!(d.status.code(), Some(0), "{}", text(&d.stderr));
+    assert!(d.stdout.is_empty());
+    let t = std::fs::read_to_string(&file).unwrap();
+    assert!(t.contains("velocity_reference = [0.5, -0.25]"), "{t}");
+    assert!(t.contains("agents = [7, 1]"), "{t}");
+    let val = bin().arg("validate").arg(&file).output().unwrap();
+    assert_eq!(val.status.code(), Some(0), "{}", text(&val.stderr));
+
+    let points = dir.path().join("line.csv");
+    std::fs::write(&points, "x,y\n0,0\n1,1\n2,2\n3,3\n").unwrap();
+    for (args, want) in [
+        (
+            vec!["design", points.to_str().unwrap()],
+            "all 4 points lie on one line",
+        ),
+        (
+            vec![
+                "design",
+                "--shape",
+                "strip",
+                "-n",
+                "5",
+                "--perturbation",
+                "2",
+            ],
+            "option `perturbation`",
+        ),
+        (
+            vec!["design", "--shape", "strip", "-n", "5", "--leader", "1,9"],
+            "agent id 9 is not in 1..=5",
+        ),
+        (
+            vec![
+                "design",
+                "--shape",
+                "strip",
+                "-n",
+                "5",
+                "--template",
+                "nope",
+            ],
+            "template nope",
+        ),
+    ] {
+        let o = bin().args(&args).output().unwrap();
+        let err = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(29), "{args:?}: {err}");
+        assert!(err.contains(want), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
+
+/// A strip scenario with these ids, its triangles (i, i+1, i+2).
+fn strip_scenario(ids: &[String]) -> String {
+    let h = 3f64.sqrt() / 2.0;
+    let mut s = String::from(
+        "duration = 0.05\n[gains]\nstiffness = 10.0\ndamping = 1.0\nestimator_gain = 10.0\n",
+    );
+    for (i, id) in ids.iter().enumerate() {
+        s += &format!(
+            "[[agents]]\nid = {id}\nposition = [{}, {}]\n",
+            0.5 * i as f64,
+            h * (i % 2) as f64
+        );
+    }
+    for i in 0..ids.len() - 2 {
+        let (a, b, c) = (&ids[i], &ids[i + 1], &ids[i + 2]);
+        s += &format!(
+            "[[triangles]]\nvertices = [{a}, {b}, {c}]\nangles = [{{ apex = {a}, desired_deg = 60.0 }}, {{ apex = {b}, desired_deg = 60.0 }}]\n"
+        );
+    }
+    s
+}
+
+#[test]
+fn ids_are_any_integers_or_names_and_wire_ids_are_assigned() {
+    // Names.
+    let names: Vec<String> = ["alpha", "b-2", "c.3", "d", "e"]
+        .iter()
+        .map(|s| format!("\"{s}\""))
+        .collect();
+    let m = host_sim::load_toml(&strip_scenario(&names), "names", &[]).unwrap();
+    assert_eq!(m.agents[1].name, "b-2");
+    let run = host_sim::Simulation::new(&m).run().unwrap();
+    let json = run.summary_json(&m).to_string();
+    assert!(
+        json.contains("\"agents\":[\"alpha\",\"b-2\",\"c.3\",\"d\",\"e\"]"),
+        "{json}"
+    );
+    let series = run.series.expect("series");
+    assert!(series.index("x_c.3").is_some());
+
+    // 1,000 agents with ids 1000, 1001, …: wire ids repeat, but never within two hops.
+    let ids: Vec<String> = (0..1000).map(|i| (1000 + i).to_string()).collect();
+    let m = host_sim::load_toml(&strip_scenario(&ids), "big", &[]).unwrap();
+    assert_eq!(m.agents[999].name, "1999");
+    for i in 0..m.n() {
+        for &j in m.graph.radio.of(i) {
+            assert_ne!(m.agents[i].id, m.agents[j].id);
+            for &k in m.graph.radio.of(j) {
+                assert!(k == i || m.agents[i].id != m.agents[k].id, "{i} {k}");
+            }
+        }
+    }
+    assert!(m.agents.iter().map(|a| a.id).max().unwrap() < 8);
+
+    // Bad ids, named in the error.
+    let bad: Vec<String> = ["1", "2", "\"has space\"", "4"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let e = host_sim::load_toml(&strip_scenario(&bad), "bad", &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("agents[2].id") && e.contains("not a short name"),
+        "{e}"
+    );
+}
+
+#[test]
+fn capacity_errors_name_the_agent_and_the_fix() {
+    // A fan: agent 0 in every triangle (0, i, i+1).
+    let n = 12;
+    let mut s = String::from(
+        "duration = 0.05\n[gains]\nstiffness = 10.0\ndamping = 1.0\nestimator_gain = 10.0\n[[agents]]\nid = \"hub\"\nposition = [0.0, 0.0]\n",
+    );
+    let step = 2.0 * std::f64::consts::PI / 3.0 / (n - 1) as f64;
+    for i in 1..n {
+        let a = i as f64 * step;
+        s += &format!(
+            "[[agents]]\nid = {i}\nposition = [{}, {}]\n",
+            3.0 * a.cos(),
+            3.0 * a.sin()
+        );
+    }
+    for i in 1..n - 1 {
+        let half = (180.0 - step.to_degrees()) / 2.0;
+        s += &format!(
+            "[[triangles]]\nvertices = [\"hub\", {i}, {}]\nangles = [{{ apex = {i}, desired_deg = {half} }}, {{ apex = {}, desired_deg = {half} }}]\n",
+            i + 1,
+            i + 1
+        );
+    }
+    let e = host_sim::load_toml(&s, "fan", &[]).unwrap_err().to_string();
+    assert!(
+        e.contains("agent hub belongs to 10 triangles")
+            && e.contains("at most 8 (controller_core::MAX_TRIANGLES)")
+            && e.contains("move 2 of them"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_hundred_thousand_agents_load_with_wire_ids_unique_within_two_hops() {
+    let n = 100_000;
+    let ids: Vec<String> = (0..n).map(|i| format!("\"r{i}\"")).collect();
+    let m =
+        host_sim::load_toml(&strip_scenario(&ids), "huge", &[]).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(m.n(), n);
+    assert_eq!(m.agents[n - 1].name, format!("r{}", n - 1));
+    // The strip's square has degree 4 on each side: 5 wire ids do.
+    assert!(m.agents.iter().map(|a| a.id).max().unwrap() < 8);
+    for i in 0..n {
+        for &j in m.graph.radio.of(i) {
+            assert_ne!(m.agents[i].id, m.agents[j].id);
+        }
+    }
+    assert_eq!(m.target.positions.len(), n);
+}
