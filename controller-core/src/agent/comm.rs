@@ -77,7 +77,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 continue;
             };
             let q = |x: T| quant::encode(x.as_f32()).0;
-            let code = [q(gamma), q(sigma), q(rho[0]), q(rho[1])];
+            let code = [q(gamma), unit_code(q(sigma)), q(rho[0]), q(rho[1])];
             if !writer.push_angle(a.far, code) {
                 send(writer.finish());
                 count += 1;
@@ -278,6 +278,19 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 *age = T::zero();
             }
         }
+    }
+}
+
+/// The binary16 code `c` with its magnitude limited to 1: `σ = s_nv × s_nw` of
+/// bearings that are unit only within the tolerance can exceed 1 by a rounding, which
+/// receivers refuse (`|σ| ≤ 1`, see [`crate::wire`]). Found by the fuzz target.
+#[inline(always)]
+fn unit_code(c: u16) -> u16 {
+    const ONE: u16 = 0x3C00;
+    if c & 0x7FFF > ONE {
+        (c & 0x8000) | ONE
+    } else {
+        c
     }
 }
 
