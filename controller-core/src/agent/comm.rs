@@ -304,3 +304,20 @@ fn sent_angle<T: Real>(a: &AngleState<T>) -> Option<(T, T, [T; 2])> {
         _ => None,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::unit_code;
+
+    #[test]
+    fn sigma_codes_are_limited_to_one() {
+        // binary16: 0x3C00 = 1, 0x3C01 = 1 + 2⁻¹⁰, 0xBC01 = −(1 + 2⁻¹⁰), 0x3BFF < 1.
+        assert_eq!(unit_code(0x3C01), 0x3C00);
+        assert_eq!(unit_code(0xBC01), 0xBC00);
+        assert_eq!(unit_code(0x3C00), 0x3C00);
+        assert_eq!(unit_code(0xBC00), 0xBC00);
+        assert_eq!(unit_code(0x3BFF), 0x3BFF);
+        assert_eq!(unit_code(0x8001), 0x8001);
+        assert_eq!(unit_code(0), 0);
+    }
+}
