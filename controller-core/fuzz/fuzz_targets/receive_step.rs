@@ -125,7 +125,8 @@ fuzz_target!(|data: &[u8]| {
             let integrity = *integrity;
             a.frames(|f| {
                 assert!(f.len() <= 60);
-                assert!(decode_frame(f, integrity, EstimatorMode::Shared).is_ok());
+                let d = decode_frame(f, integrity, EstimatorMode::Shared);
+                assert!(d.is_ok(), "{integrity}: {d:?} {f:02x?}");
             });
         }
         rest = tail.get(40..).unwrap_or(&[]);

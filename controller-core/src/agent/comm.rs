@@ -77,7 +77,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 continue;
             };
             let q = |x: T| quant::encode(x.as_f32()).0;
-            let code = [q(gamma), q(sigma), q(rho[0]), q(rho[1])];
+            let code = [q(gamma), unit_code(q(sigma)), q(rho[0]), q(rho[1])];
             if !writer.push_angle(a.far, code) {
                 send(writer.finish());
                 count += 1;
@@ -281,6 +281,19 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     }
 }
 
+/// The binary16 code `c` with its magnitude limited to 1: `σ = s_nv × s_nw` of
+/// bearings that are unit only within the tolerance can exceed 1 by a rounding, which
+/// receivers refuse (`|σ| ≤ 1`, see [`crate::wire`]). Found by the fuzz target.
+#[inline(always)]
+fn unit_code(c: u16) -> u16 {
+    const ONE: u16 = 0x3C00;
+    if c & 0x7FFF > ONE {
+        (c & 0x8000) | ONE
+    } else {
+        c
+    }
+}
+
 /// What an apex sends of angle `a` (`γ`, `σ`, `ρ`): the values of its last sense, if it
 /// computed them (they are then finite: see `sensing::apex_part`).
 #[inline]
@@ -289,5 +302,22 @@ fn sent_angle<T: Real>(a: &AngleState<T>) -> Option<(T, T, [T; 2])> {
     match &a.side {
         Side::Apex { part, fault: None } => Some((part.gamma, part.sigma, part.rho)),
         _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::unit_code;
+
+    #[test]
+    fn sigma_codes_are_limited_to_one() {
+        // binary16: 0x3C00 = 1, 0x3C01 = 1 + 2⁻¹⁰, 0xBC01 = −(1 + 2⁻¹⁰), 0x3BFF < 1.
+        assert_eq!(unit_code(0x3C01), 0x3C00);
+        assert_eq!(unit_code(0xBC01), 0xBC00);
+        assert_eq!(unit_code(0x3C00), 0x3C00);
+        assert_eq!(unit_code(0xBC00), 0xBC00);
+        assert_eq!(unit_code(0x3BFF), 0x3BFF);
+        assert_eq!(unit_code(0x8001), 0x8001);
+        assert_eq!(unit_code(0), 0);
     }
 }
