@@ -4,7 +4,7 @@
 use host_sim::design::{
     adjacency_from_triangles, check_distance2, compare, construct, distance2_colouring,
     render_scenario, verify, Construction, DesignError, DesignOptions, Generator, Perturbation,
-    Point, ScenarioOptions, Template,
+    Point, Scale, ScenarioOptions, Template,
 };
 use std::f64::consts::PI;
 
@@ -366,6 +366,7 @@ fn rendered_scenarios_parse_and_load() {
                     fraction: 0.05,
                     rotate: true,
                     seed: 3,
+                    ..Perturbation::default()
                 },
                 ..Default::default()
             };
@@ -458,14 +459,14 @@ fn initial_positions_refuse_a_margin_the_construction_does_not_keep() {
     let opts = DesignOptions::default();
     let c = construct(&p, &opts).unwrap();
     let template =
-        Template::parse("agents = []\n[controller]\nangle_margin_deg = 10.0\n", "t").unwrap();
+        Template::parse("agents = []\n[controller]\nangle_margin_deg = 40.0\n", "t").unwrap();
     let so = ScenarioOptions {
         template: Some(template),
         ..Default::default()
     };
     let msg = render_scenario(&p, &c, &opts, &so).unwrap_err().to_string();
     assert!(
-        msg.contains("within the scenario's angle margin 10°"),
+        msg.contains("within the scenario's angle margin 40°"),
         "{msg}"
     );
 }
@@ -496,4 +497,85 @@ fn points_files() {
     .unwrap();
     std::fs::write(&toml_path, text).unwrap();
     assert_eq!(host_sim::design::read_points(&toml_path).unwrap(), p);
+}
+
+/// Points on a circle: grown with the default 5° margin the construction's smallest
+/// controlled angle is 180°/N-ish (7.2° for a 50-gon, which never converges); the margin is
+/// raised until it is well away from 0 and 180°. Shapes that are fine keep the default.
+#[test]
+fn thin_constructions_are_grown_again_with_a_higher_margin() {
+    let opts = DesignOptions::default();
+    for g in [
+        Generator::Polygon {
+            n: 50,
+            spacing: 1.0,
+            centre: false,
+        },
+        Generator::Polygon {
+            n: 200,
+            spacing: 1.0,
+            centre: true,
+        },
+    ] {
+        let c = construct(&g.points().unwrap(), &opts).unwrap();
+        assert!(
+            c.margin_deg >= 20.0,
+            "{}: margin {}",
+            g.describe(),
+            c.margin_deg
+        );
+        assert!(
+            c.figures.min_controlled_deg >= host_sim::design::laman::RAISE_BELOW_DEG,
+            "{}: {:?}",
+            g.describe(),
+            c.figures
+        );
+    }
+    let lattice = Generator::TriangularLattice {
+        n: 50,
+        spacing: 1.0,
+    };
+    let c = construct(&lattice.points().unwrap(), &opts).unwrap();
+    assert_eq!(c.margin_deg, opts.margin_deg);
+    assert!((c.figures.min_controlled_deg - 60.0).abs() < 1e-6);
+}
+
+/// `Scale::Spacing`: every agent moves at most the fraction of the median nearest-neighbour
+/// distance (a 1 m-sided 200-gon with its centre: 0.1 m, also for the centre, whose
+/// nearest neighbour is 32 m away), and some agent moves more than half of that.
+#[test]
+fn spacing_perturbation_is_local() {
+    let g = Generator::Polygon {
+        n: 200,
+        spacing: 1.0,
+        centre: true,
+    };
+    let p = g.points().unwrap();
+    let c = construct(&p, &DesignOptions::default()).unwrap();
+    let pert = Perturbation {
+        fraction: 0.1,
+        scale: Scale::Spacing,
+        rotate: false,
+        seed: 5,
+    };
+    let init = host_sim::design::initial_positions(&p, &c, &pert, 5.0, 0.05).unwrap();
+    assert!(
+        (init.max_displacement - 0.1).abs() < 1e-9,
+        "{}",
+        init.max_displacement
+    );
+    let moved: Vec<f64> = p
+        .iter()
+        .zip(&init.positions)
+        .map(|(a, b)| ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt())
+        .collect();
+    let most = moved.iter().copied().fold(0.0, f64::max);
+    assert!(most <= 0.1 + 1e-12 && most > 0.05, "{most}");
+    // The same fraction of the formation's size moves agents about 32× further.
+    let size = Perturbation {
+        scale: Scale::Size,
+        ..pert
+    };
+    let init = host_sim::design::initial_positions(&p, &c, &size, 5.0, 0.05).unwrap();
+    assert!(init.max_displacement > 3.0, "{}", init.max_displacement);
 }

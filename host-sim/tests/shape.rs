@@ -3,7 +3,7 @@
 //! whole-formation mirror; a folded triangle is `wrong_shape`, a fold onto a neighbour a
 //! `collision`; designed formations validate and converge.
 
-use host_sim::design::{construct, render_scenario, DesignOptions, Generator, Perturbation};
+use host_sim::design::{construct, render_scenario, DesignOptions, Generator, Perturbation, Scale};
 use host_sim::design::{ScenarioOptions, Template};
 use host_sim::{load_toml, Outcome, Simulation};
 
@@ -192,20 +192,20 @@ fn generators(n: usize) -> Vec<Generator> {
 }
 
 /// A designed scenario, gains of `formation-only`, every agent displaced by up to 10 % of
-/// the mean edge length (`rotate`: and the whole formation turned by a random angle).
+/// the spacing (the median nearest-neighbour distance; `rotate`: and the whole formation
+/// turned by a random angle), as `host-sim design` does by default.
 fn designed(g: &Generator, duration: f64, rotate: bool) -> (Vec<[f64; 2]>, String) {
     let p = g.points().unwrap();
     let opts = DesignOptions::default();
     let c = construct(&p, &opts).unwrap();
-    // `Perturbation::fraction` is relative to the formation's size; 10 % of an edge.
-    let fraction = 0.1 * c.figures.mean_edge / host_sim::design::initial::formation_size(&p);
     let template = host_sim::scenario::builtin("formation-only").unwrap();
     let so = ScenarioOptions {
         name: "designed".to_owned(),
         source: g.describe(),
         duration: Some(duration),
         perturbation: Perturbation {
-            fraction,
+            fraction: 0.1,
+            scale: Scale::Spacing,
             rotate,
             seed: 2,
         },
@@ -267,24 +267,15 @@ fn designed_formations_of_10_converge_from_a_10_percent_perturbation() {
     converge_all(generators(10), 200.0, true);
 }
 
-/// Lattices, strip and disc: every generator but the polygons.
-fn filled(n: usize) -> Vec<Generator> {
-    generators(n).into_iter().skip(2).collect()
-}
-
 #[test]
 fn designed_formations_of_50_converge_from_a_10_percent_perturbation() {
-    converge_all(filled(50), 100.0, false);
+    converge_all(generators(50), 100.0, false);
 }
 
+/// Regular polygons (with and without centre) are the hard case: near neighbours on a
+/// circle make angles of 180°/N, so the construction raises its margin and controls
+/// triangles across the ring (edges of 15–63 m for 1 m sides).
 #[test]
-#[ignore = "slow (about 5 s per run in the dev profile): run with --ignored"]
 fn designed_formations_of_200_converge_from_a_10_percent_perturbation() {
-    converge_all(filled(200), 150.0, false);
-}
-
-#[test]
-#[ignore = "known failing: 50-gons (with or without centre) end in collision or estimate collapse"]
-fn designed_polygons_of_50_converge() {
-    converge_all(generators(50).into_iter().take(2).collect(), 300.0, false);
+    converge_all(generators(200), 150.0, false);
 }

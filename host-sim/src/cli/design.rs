@@ -4,7 +4,7 @@
 
 use crate::design::{
     construct, read_points, render_scenario, DesignError, DesignOptions, Generator, Perturbation,
-    ScenarioOptions, Template,
+    Scale, ScenarioOptions, Template,
 };
 use crate::exit_code;
 use crate::scenario::Source;
@@ -48,8 +48,9 @@ pub struct DesignArgs {
     /// Side / lattice step / smallest distance of the built-in shape (m).
     #[arg(long, value_name = "M", default_value_t = 1.0)]
     pub spacing: f64,
-    /// Largest initial displacement of each agent, as a fraction of the mean edge length
-    /// of the constructed graph, in [0, 1] (local, so it means the same at any N).
+    /// Largest initial displacement of each agent, as a fraction of the formation's
+    /// spacing (the median nearest-neighbour distance), in [0, 1] (local, so it means the
+    /// same at any N and any shape).
     #[arg(long, value_name = "F", default_value_t = 0.1)]
     pub perturbation: f64,
     /// Also rotate the initial formation by a random angle about its centroid.
@@ -195,7 +196,7 @@ fn design(args: &DesignArgs) -> Result<(String, String), DesignError> {
         return Err(option(
             "perturbation",
             format!(
-                "must be a fraction of the mean edge length in [0, 1], got {}",
+                "must be a fraction of the spacing in [0, 1], got {}",
                 args.perturbation
             ),
         ));
@@ -237,13 +238,6 @@ fn design(args: &DesignArgs) -> Result<(String, String), DesignError> {
         leader,
     };
     let c = construct(&points, &opts)?;
-    // The library's fraction is of the formation's size (RMS distance from the centroid).
-    let size = crate::design::initial::formation_size(&points);
-    let fraction = if size > 0.0 {
-        (args.perturbation * c.figures.mean_edge / size).min(1.0)
-    } else {
-        0.0
-    };
     let v = args.v_star.unwrap_or([0.0, 0.0]);
     if v.iter().any(|x| !x.is_finite()) {
         return Err(option("v-star", format!("must be finite, got {v:?}")));
@@ -264,7 +258,8 @@ fn design(args: &DesignArgs) -> Result<(String, String), DesignError> {
         seed: args.seed,
         leader: !args.no_leader,
         perturbation: Perturbation {
-            fraction,
+            fraction: args.perturbation,
+            scale: Scale::Spacing,
             rotate: args.rotate,
             seed: args.seed,
         },
@@ -273,11 +268,12 @@ fn design(args: &DesignArgs) -> Result<(String, String), DesignError> {
     let text = render_scenario(&points, &c, &opts, &so)?;
     let f = &c.figures;
     let figures = format!(
-        "design: {} agents, {} triangles, leader edge ({}, {})\n  smallest controlled angle {:.3}° (margin from 0 and 180°), smallest interior angle {:.3}°\n  largest triangles per agent {} (capacity {}), largest neighbours per agent {} (capacity {})\n  longest edge {:.4} m, mean edge {:.4} m, overlapping triangles {}\n",
+        "design: {} agents, {} triangles, leader edge ({}, {}), angle margin {}°\n  smallest controlled angle {:.3}° (margin from 0 and 180°), smallest interior angle {:.3}°\n  largest triangles per agent {} (capacity {}), largest neighbours per agent {} (capacity {})\n  longest edge {:.4} m, mean edge {:.4} m, overlapping triangles {}\n",
         f.agents,
         f.triangles,
         c.leader[0] + 1,
         c.leader[1] + 1,
+        c.margin_deg,
         f.min_controlled_deg,
         f.min_angle_deg,
         f.max_triangles_per_agent,

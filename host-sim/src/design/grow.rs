@@ -20,7 +20,8 @@
 //! Before a point takes a thin triangle (smallest angle below 25°) it is *widened*: the
 //! edges at its 32 nearest attached points become candidates too, and it is registered to
 //! hear of later edges there. When the queue runs dry with points left (slivers on the
-//! hull, points on a circle), a *fallback round* widens every point left; when that finds
+//! hull, points on a circle), a *fallback round* widens every point left, first to its 32
+//! nearest attached points, then to its 4,096 nearest; when that finds
 //! nothing, the construction is refused with the points that could not be attached.
 //! Finally the worst triangles are repaired locally (`grow/repair.rs`).
 //!
@@ -58,6 +59,9 @@ const WIDEN: usize = 32;
 /// A point whose best candidate has a smallest angle below this (rad, 25°) is widened
 /// before that candidate is taken.
 const WIDEN_BELOW: f64 = 25.0 * std::f64::consts::PI / 180.0;
+/// Attached points whose edges are tried for a point left over when widening to [`WIDEN`]
+/// found nothing (bounds the cost of a refused construction).
+const DEEP_WIDEN: usize = 4096;
 /// Start vertices (nearest the centroid) examined before taking the best start triangle.
 const START_BATCH: usize = 32;
 
@@ -367,7 +371,7 @@ pub(crate) fn grow(
             continue;
         };
         if !s.widened[v] && min_angle(s.tri(a, b, v)) < WIDEN_BELOW {
-            s.widen(v);
+            s.widen(v, WIDEN);
             s.heap.push(e);
             continue;
         }

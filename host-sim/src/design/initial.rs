@@ -11,12 +11,29 @@ use rstar::primitives::GeomWithData;
 use rstar::RTree;
 use std::f64::consts::PI;
 
+/// What [`Perturbation::fraction`] is a fraction of.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Scale {
+    /// The formation's size (its RMS distance from the centroid), the same for every
+    /// agent: a global measure, as a basin-of-attraction sweep wants.
+    #[default]
+    Size,
+    /// The formation's spacing: the median over the points of the distance to the nearest
+    /// other point. A local measure that means the same at any N and for any shape (10 %
+    /// moves an agent of a 1 m-spaced ring 0.1 m, whatever the ring's diameter or the
+    /// length of its graph's diagonals; a lone centre point moves no further than the
+    /// others).
+    Spacing,
+}
+
 /// How the initial positions leave the target.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Perturbation {
-    /// Largest displacement as a fraction of the formation's size (its RMS distance from
-    /// the centroid), in `[0, 1]`. Each agent's displacement is uniform in that disc.
+    /// Largest displacement as a fraction of [`Perturbation::scale`], in `[0, 1]`. Each
+    /// agent's displacement is uniform in that disc.
     pub fraction: f64,
+    /// What the fraction is of.
+    pub scale: Scale,
     /// Rotate the whole formation by a random angle about its centroid.
     pub rotate: bool,
     /// Seed (the same seed gives the same positions on every machine).
@@ -27,6 +44,7 @@ impl Default for Perturbation {
     fn default() -> Self {
         Self {
             fraction: 0.05,
+            scale: Scale::Size,
             rotate: false,
             seed: 1,
         }
@@ -40,7 +58,7 @@ pub struct Initial {
     pub positions: Vec<Point>,
     /// Rotation applied about the centroid (rad).
     pub rotation: f64,
-    /// Largest displacement allowed (m).
+    /// Largest displacement allowed, over all agents (m).
     pub max_displacement: f64,
     /// Agents whose displacement was shortened (see [`initial_positions`]).
     pub shortened: usize,
@@ -96,7 +114,11 @@ pub fn initial_positions(
     let centre = points
         .iter()
         .fold([0.0, 0.0], |s, q| [s[0] + q[0] / n, s[1] + q[1] / n]);
-    let max_displacement = p.fraction * formation_size(points);
+    let reach: Vec<f64> = match p.scale {
+        Scale::Size => vec![p.fraction * formation_size(points); points.len()],
+        Scale::Spacing => vec![p.fraction * spacing(points); points.len()],
+    };
+    let max_displacement = reach.iter().copied().fold(0.0, f64::max);
     let mut rng = ChaCha8Rng::seed_from_u64(p.seed);
     let turn = rng.random::<f64>() * 2.0 * PI;
     let rotation = if p.rotate { turn } else { 0.0 };
@@ -111,10 +133,10 @@ pub fn initial_positions(
             ]
         })
         .collect();
-    let mut disp: Vec<Point> = points
+    let mut disp: Vec<Point> = reach
         .iter()
-        .map(|_| {
-            let r = max_displacement * rng.random::<f64>().sqrt();
+        .map(|&reach| {
+            let r = reach * rng.random::<f64>().sqrt();
             let a = rng.random::<f64>() * 2.0 * PI;
             [r * a.cos(), r * a.sin()]
         })
@@ -156,6 +178,32 @@ pub fn initial_positions(
     Err(DesignError::Initial(
         "no valid initial positions after shortening the displacements 64 times".to_owned(),
     ))
+}
+
+/// The median over the points of the distance to the nearest other point (0 for fewer
+/// than two points).
+pub fn spacing(points: &[Point]) -> f64 {
+    let tree: RTree<GeomWithData<Point, usize>> = RTree::bulk_load(
+        points
+            .iter()
+            .enumerate()
+            .map(|(i, &p)| GeomWithData::new(p, i))
+            .collect(),
+    );
+    let mut d: Vec<f64> = points
+        .iter()
+        .enumerate()
+        .filter_map(|(i, &p)| {
+            tree.nearest_neighbor_iter(p)
+                .find(|q| q.data != i)
+                .map(|q| dist(p, *q.geom()))
+        })
+        .collect();
+    if d.is_empty() {
+        return 0.0;
+    }
+    let mid = d.len() / 2;
+    *d.select_nth_unstable_by(mid, f64::total_cmp).1
 }
 
 /// Pairs of points closer than `d` (each pair once, `i < j`, sorted).

@@ -36,6 +36,17 @@ pub const DEFAULT_MARGIN_DEG: f64 = 5.0;
 pub const DEFAULT_MAX_TRIANGLES: usize = crate::model::MT;
 /// Default neighbours per agent: the controller-core capacity `NB`.
 pub const DEFAULT_MAX_NEIGHBOURS: usize = crate::model::NB;
+/// A construction whose smallest controlled angle is below this (degrees) is grown again
+/// with the margin raised in steps of [`RAISE_STEP_DEG`] up to [`RAISE_MAX_DEG`], keeping
+/// the last that succeeds. The controller acts on `cos α` (S4), whose slope `sin α` is
+/// 0.13 at 7.5°: points on a circle (a ring of agents) grown with the default 5° margin
+/// get angles of 180°/N between near neighbours and never converge (measured: 50-gons,
+/// docs/design.md), while a margin of 20–30° forces triangles across the ring that do.
+pub const RAISE_BELOW_DEG: f64 = 15.0;
+/// Step of the margin raise (degrees).
+pub const RAISE_STEP_DEG: f64 = 5.0;
+/// Highest margin tried by the raise (degrees).
+pub const RAISE_MAX_DEG: f64 = 30.0;
 /// Delaunay neighbours kept per point (nearest first; see `neighbours.rs`).
 const NEIGHBOUR_CAP: usize = 16;
 
@@ -116,6 +127,9 @@ pub struct Construction {
     pub triangles: Vec<DesignTriangle>,
     /// Leader edge (point indices): an edge of the first triangle.
     pub leader: [usize; 2],
+    /// The angle margin the growth ran with (degrees): the option's, or a higher one when
+    /// the option's gave thin angles ([`RAISE_BELOW_DEG`]).
+    pub margin_deg: f64,
     /// Figures of merit.
     pub figures: Figures,
 }
@@ -156,34 +170,50 @@ pub fn construct(points: &[Point], opts: &DesignOptions) -> Result<Construction,
     let tree = point_tree(points);
     check_points(points, &tree)?;
     let nb = delaunay_neighbours(points, NEIGHBOUR_CAP)?;
-    let grown = grow(
-        points,
-        &nb,
-        &tree,
-        Params {
-            margin: opts.margin_deg.to_radians(),
-            max_triangles: opts.max_triangles,
-            max_neighbours: opts.max_neighbours,
-            leader: opts.leader,
-        },
-    )?;
-    let triangles: Vec<DesignTriangle> = grown
-        .triangles
-        .iter()
-        .zip(&grown.overlapping)
-        .map(|(&t, &overlapping)| DesignTriangle {
-            vertices: t,
-            angles: controlled(points, t),
-            overlapping,
+    let attempt = |margin_deg: f64| -> Result<Construction, DesignError> {
+        let grown = grow(
+            points,
+            &nb,
+            &tree,
+            Params {
+                margin: margin_deg.to_radians(),
+                max_triangles: opts.max_triangles,
+                max_neighbours: opts.max_neighbours,
+                leader: opts.leader,
+            },
+        )?;
+        let triangles: Vec<DesignTriangle> = grown
+            .triangles
+            .iter()
+            .zip(&grown.overlapping)
+            .map(|(&t, &overlapping)| DesignTriangle {
+                vertices: t,
+                angles: controlled(points, t),
+                overlapping,
+            })
+            .collect();
+        let leader = [grown.triangles[0][0], grown.triangles[0][1]];
+        let figures = figures(points, &triangles);
+        Ok(Construction {
+            triangles,
+            leader,
+            margin_deg,
+            figures,
         })
-        .collect();
-    let leader = [grown.triangles[0][0], grown.triangles[0][1]];
-    let figures = figures(points, &triangles);
-    Ok(Construction {
-        triangles,
-        leader,
-        figures,
-    })
+    };
+    let mut best = attempt(opts.margin_deg)?;
+    if best.figures.min_controlled_deg < RAISE_BELOW_DEG {
+        let mut m = (opts.margin_deg / RAISE_STEP_DEG).floor() * RAISE_STEP_DEG + RAISE_STEP_DEG;
+        while m <= RAISE_MAX_DEG {
+            match attempt(m) {
+                Ok(c) if c.figures.min_controlled_deg > best.figures.min_controlled_deg => best = c,
+                Ok(_) => {}
+                Err(_) => break,
+            }
+            m += RAISE_STEP_DEG;
+        }
+    }
+    Ok(best)
 }
 
 /// The two angles of triangle `t` with the largest margins; ties prefer the new agent,

@@ -7,7 +7,7 @@
 //! and `damping`. Without a template, `host-sim/scenarios/paper.toml` is the template.
 
 use super::error::DesignError;
-use super::initial::{formation_size, initial_positions, Initial, Perturbation};
+use super::initial::{formation_size, initial_positions, Initial, Perturbation, Scale};
 use super::laman::{Construction, DesignOptions};
 use super::points::Point;
 use std::fmt::Write;
@@ -177,9 +177,18 @@ pub fn render_scenario(
     );
     let _ = writeln!(
         w,
-        "# Triangulated Laman graph (SPEC §3): {} triangles, angle margin {}°; gains from {}",
+        "# Triangulated Laman graph (SPEC §3): {} triangles, angle margin {}°{}; gains from {}",
         f.triangles,
-        design.margin_deg,
+        c.margin_deg,
+        if c.margin_deg > design.margin_deg {
+            format!(
+                " (raised from {}°, which gave a controlled angle below {}°)",
+                design.margin_deg,
+                super::laman::RAISE_BELOW_DEG
+            )
+        } else {
+            String::new()
+        },
         tpl.label()
     );
     let _ = writeln!(
@@ -207,9 +216,13 @@ pub fn render_scenario(
     );
     let _ = writeln!(
         w,
-        "#   displacements of at most {:.4} m ({} % of its size, seed {}); {} of them shortened",
+        "#   displacements of at most {:.4} m ({} % of {}, seed {}); {} of them shortened",
         init.max_displacement,
         100.0 * o.perturbation.fraction,
+        match o.perturbation.scale {
+            Scale::Size => "its size",
+            Scale::Spacing => "the spacing (median nearest-neighbour distance)",
+        },
         o.perturbation.seed,
         init.shortened
     );

@@ -5,7 +5,7 @@
 
 use super::plan::Perturb;
 use crate::design::{
-    initial_positions, Construction, ControlledAngle, DesignTriangle, Figures, Perturbation,
+    initial_positions, Construction, ControlledAngle, DesignTriangle, Figures, Perturbation, Scale,
 };
 use crate::model::Model;
 
@@ -62,6 +62,7 @@ pub fn positions(model: &Model, p: &Perturb, fraction: f64, seed: u64) -> Result
     let construction = Construction {
         triangles,
         leader: [0, 1],
+        margin_deg: 0.0,
         figures: Figures {
             agents: model.n(),
             triangles: model.triangles.len(),
@@ -80,6 +81,7 @@ pub fn positions(model: &Model, p: &Perturb, fraction: f64, seed: u64) -> Result
         &construction,
         &Perturbation {
             fraction,
+            scale: Scale::Size,
             rotate: p.rotate,
             seed,
         },

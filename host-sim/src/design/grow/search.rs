@@ -1,18 +1,18 @@
 //! Where the growth starts and where it looks when the Delaunay candidates run out.
 
-use super::{dist, Entry, Reject, State, START_BATCH, WIDEN};
+use super::{dist, Entry, Reject, State, DEEP_WIDEN, START_BATCH, WIDEN};
 use crate::design::error::DesignError;
 
 impl State<'_> {
-    /// Pushes the candidates of point `v` on the edges at its nearest attached points and
-    /// registers it to hear of later edges there. Returns the candidates pushed and those
-    /// refused for an angle and for capacity.
-    pub(super) fn widen(&mut self, v: usize) -> [usize; 3] {
+    /// Pushes the candidates of point `v` on the edges at its `reach` nearest attached
+    /// points and registers it to hear of later edges there. Returns the candidates pushed
+    /// and those refused for an angle and for capacity.
+    pub(super) fn widen(&mut self, v: usize, reach: usize) -> [usize; 3] {
         self.widened[v] = true;
         let near: Vec<usize> = self
             .placed_tree
             .nearest_neighbor_iter(self.pts[v])
-            .take(WIDEN)
+            .take(reach)
             .map(|q| q.data)
             .collect();
         let mut counts = [0usize; 3];
@@ -41,20 +41,29 @@ impl State<'_> {
         counts
     }
 
-    /// One fallback round (every point left is widened); `Err` when no point left can be
-    /// attached.
+    /// One fallback round: every point left is widened to its [`WIDEN`] nearest attached
+    /// points and, when that finds nothing and at most [`DEEP_WIDEN`] points are left, to
+    /// its [`DEEP_WIDEN`] nearest (points on a circle need edges a third of the way round: no triangle of near neighbours there
+    /// has an angle beyond a few degrees). `Err` when no point left can be attached.
     pub(super) fn fallback(&mut self) -> Result<(), DesignError> {
         let mut total = [0usize; 3];
-        for v in 0..self.pts.len() {
-            if !self.placed[v] {
-                let c = self.widen(v);
-                for k in 0..3 {
-                    total[k] += c[k];
+        let left = self.pts.len() - self.n_placed;
+        for reach in [WIDEN, DEEP_WIDEN] {
+            if reach == DEEP_WIDEN && left > DEEP_WIDEN {
+                break;
+            }
+            total = [0; 3];
+            for v in 0..self.pts.len() {
+                if !self.placed[v] {
+                    let c = self.widen(v, reach);
+                    for k in 0..3 {
+                        total[k] += c[k];
+                    }
                 }
             }
-        }
-        if total[0] > 0 {
-            return Ok(());
+            if total[0] > 0 {
+                return Ok(());
+            }
         }
         Err(DesignError::NoConstruction {
             placed: self.n_placed,
