@@ -43,7 +43,7 @@ fn paper(duration: Option<f64>) -> Model {
 
 fn fake(agents: &[u8], behaviour: FakeBehaviour, timeout_s: f64) -> HilOptions {
     HilOptions {
-        agents: agents.to_vec(),
+        agents: agents.iter().map(u8::to_string).collect(),
         launcher: Launcher::Fake(behaviour),
         timeout: Duration::from_secs_f64(timeout_s),
         pin: false,
@@ -99,9 +99,9 @@ fn stand_in_agents_converge_like_the_host() {
         assert_eq!(r.hil.len(), agents.len());
         for h in &r.hil {
             assert_eq!(h.ticks, 10_001, "agent {}", h.agent);
-            assert_eq!(h.estimates_from_target, estimates && h.agent != 4);
-            let source = match (h.agent, estimates) {
-                (4, _) => "none",
+            assert_eq!(h.estimates_from_target, estimates && h.agent != "4");
+            let source = match (h.agent.as_str(), estimates) {
+                ("4", _) => "none",
                 (_, true) => "estimates_message",
                 (_, false) => "radio_frames",
             };
@@ -112,7 +112,7 @@ fn stand_in_agents_converge_like_the_host() {
                 h.radio_to_target + h.ticks + 2,
                 "Configure + Finish"
             );
-            let per_tick = if estimates && h.agent != 4 { 2 } else { 1 };
+            let per_tick = if estimates && h.agent != "4" { 2 } else { 1 };
             assert_eq!(
                 h.frames_from_target,
                 h.radio_from_target + per_tick * h.ticks + 2,
@@ -201,7 +201,7 @@ fn corrupt_frame_is_an_error_naming_agent_tick_and_time() {
     assert_eq!(e.exit_code(), exit_code::HIL_CORRUPT);
     match &e {
         HilError::Corrupt { agent, when, what } => {
-            assert_eq!(*agent, 3);
+            assert_eq!(agent, "3");
             assert_eq!(
                 *when,
                 When::Tick {
@@ -246,7 +246,7 @@ fn silent_target_is_a_timeout_not_a_hang() {
             timeout_s,
             ..
         } => {
-            assert_eq!(*agent, 3, "the first agent collected");
+            assert_eq!(agent, "3", "the first agent collected");
             assert_eq!(
                 *when,
                 When::Tick {
@@ -322,6 +322,39 @@ angles = [{ apex = 0, desired_deg = 40.0 }, { apex = 5, desired_deg = 70.0 }]
     // Its neighbour in two triangles fits.
     let r = hil_run(&m, &fake(&[2], FakeBehaviour::default(), 5.0)).expect("agent 2 fits");
     assert_eq!(r.hil.len(), 1);
+}
+
+/// `--hil` takes the agent's id as the scenario writes it: the paper with agent 3 named
+/// `carol` (so every wire id is assigned by the colouring) runs `carol` on the stand-in
+/// target, the figures and messages name it, and the run matches the pure-host run.
+#[test]
+fn hil_agents_are_named_by_the_scenario_ids() {
+    let text = host_sim::scenario::builtin("paper")
+        .expect("paper")
+        .text
+        .replace("id = 3\n", "id = \"carol\"\n")
+        .replace("vertices = [1, 2, 3]", "vertices = [1, 2, \"carol\"]")
+        .replace("vertices = [2, 3, 4]", "vertices = [2, \"carol\", 4]")
+        .replace("apex = 3,", "apex = \"carol\",")
+        .replace("duration = 100.0", "duration = 3.0");
+    let m = host_sim::load_toml(&text, "named", &[]).expect("named paper");
+    assert_eq!(m.agents[2].name, "carol");
+    let named = |ids: &[&str]| HilOptions {
+        agents: ids.iter().map(|s| s.to_string()).collect(),
+        ..fake(&[], FakeBehaviour::default(), 10.0)
+    };
+    let r = hil_run(&m, &named(&["carol"])).expect("carol runs on the target");
+    assert_eq!(r.hil.len(), 1);
+    assert_eq!(r.hil[0].agent, "carol");
+    let host = host_run(&m);
+    assert_eq!(r.outcome, host.outcome);
+    assert!((r.final_max_angle_error - host.final_max_angle_error).abs() < 1e-3);
+    let e = hil_error(hil_run(&m, &named(&["3"])));
+    assert!(
+        e.to_string()
+            .contains("no agent 3 (its agents: 1, 2, carol, 4)"),
+        "{e}"
+    );
 }
 
 // ------------------------------------------------------------------ command line

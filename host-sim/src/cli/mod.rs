@@ -101,9 +101,10 @@ pub struct RunArgs {
     #[arg(long)]
     pub no_plots: bool,
     /// Run agent ID's controller as firmware on an emulated STM32F405 (QEMU), over an
-    /// emulated UART; repeat for more agents (see docs/hil.md).
+    /// emulated UART; ID is the agent's id as written in the scenario (an integer or a
+    /// short name); repeat for more agents (see docs/hil.md).
     #[arg(long = "hil", value_name = "ID")]
-    pub hil: Vec<u8>,
+    pub hil: Vec<String>,
     /// Firmware ELF for --hil [default: $HOST_SIM_FIRMWARE, else
     /// WORKSPACE/target/thumbv7em-none-eabihf/release/qemu-uart].
     #[arg(long, value_name = "PATH")]

@@ -158,7 +158,7 @@ pub fn summary_json(model: &Model, r: &RunResult, estimates: &[EstimateInfo]) ->
 
 fn hil_json(h: &LinkStats) -> Value {
     json!({
-        "agent": h.agent,
+        "agent": user_id(&h.agent),
         "frames_to_target": h.frames_to_target,
         "frames_from_target": h.frames_from_target,
         "bytes_to_target": h.bytes_to_target,

@@ -11,8 +11,11 @@ use controller_core::{Agent, AgentConfig};
 /// for every simulated agent) rounded to `f32`, checked against the firmware's capacity
 /// (`Agent<f32, TARGET_MT, TARGET_NB>`).
 pub fn target_config(model: &Model, i: usize) -> Result<AgentConfig<f32, TARGET_MT>, HilError> {
-    let id = model.agents.get(i).map_or(0, |a| a.id);
-    let refused = |reason: String| HilError::Refused { agent: id, reason };
+    let name = model.agents.get(i).map_or("?", |a| a.name.as_str());
+    let refused = |reason: String| HilError::Refused {
+        agent: name.to_owned(),
+        reason,
+    };
     let t = model.agent_config_f32::<TARGET_MT>(i).map_err(refused)?;
     Agent::<f32, TARGET_MT, TARGET_NB>::new(t.clone()).map_err(|e| {
         refused(format!(

@@ -70,16 +70,16 @@ pub enum HilError {
     /// QEMU could not be started or did not connect.
     #[error("agent {agent}: cannot start the emulated target: {reason}")]
     Start {
-        /// The agent's id.
-        agent: u8,
+        /// The agent's id as the scenario writes it.
+        agent: String,
         /// Why.
         reason: String,
     },
     /// The target closed the link or QEMU exited during the run.
     #[error("agent {agent}: the emulated target stopped {when}: {detail}")]
     Closed {
-        /// The agent's id.
-        agent: u8,
+        /// The agent's id as the scenario writes it.
+        agent: String,
         /// When.
         when: When,
         /// QEMU's exit status and messages.
@@ -88,8 +88,8 @@ pub enum HilError {
     /// No answer before the deadline.
     #[error("agent {agent}: the firmware did not answer within {timeout_s} s {when}: {detail}")]
     Timeout {
-        /// The agent's id.
-        agent: u8,
+        /// The agent's id as the scenario writes it.
+        agent: String,
         /// When.
         when: When,
         /// The timeout (s).
@@ -102,8 +102,8 @@ pub enum HilError {
     /// A frame that does not decode, or a message out of protocol.
     #[error("agent {agent}: corrupt link frame {when}: received {what}")]
     Corrupt {
-        /// The agent's id.
-        agent: u8,
+        /// The agent's id as the scenario writes it.
+        agent: String,
         /// When.
         when: When,
         /// What was received.
@@ -112,8 +112,8 @@ pub enum HilError {
     /// The agent's configuration does not fit the firmware, or the firmware refused it.
     #[error("agent {agent}: configuration refused: {reason}")]
     Refused {
-        /// The agent's id.
-        agent: u8,
+        /// The agent's id as the scenario writes it.
+        agent: String,
         /// Why.
         reason: String,
     },

@@ -45,13 +45,16 @@ use std::time::{Duration, Instant};
 
 /// Starts one target connected to a fresh loopback listener.
 fn launch(
-    agent: u8,
+    agent: &str,
     launcher: &Launcher,
     qemu_path: Option<&Path>,
     startup: Duration,
     cpu: Option<usize>,
 ) -> Result<(Link, TargetHandle, Instant, Instant), HilError> {
-    let start_err = |reason: String| HilError::Start { agent, reason };
+    let start_err = |reason: String| HilError::Start {
+        agent: agent.to_owned(),
+        reason,
+    };
     let listener = TcpListener::bind(("127.0.0.1", 0))
         .map_err(|e| start_err(format!("cannot listen on loopback: {e}")))?;
     let port = listener
@@ -153,13 +156,12 @@ pub fn controllers(
     };
     let mut launched = Vec::with_capacity(indices.len());
     for (k, &i) in indices.iter().enumerate() {
-        let id = model.agents[i].id;
         let cpu = match cpus.len() {
             0 | 1 => None,
             n => cpus.get(k % n).copied(),
         };
         launched.push(launch(
-            id,
+            &model.agents[i].name,
             &opts.launcher,
             qemu_path.as_deref(),
             startup,
@@ -171,7 +173,7 @@ pub fn controllers(
         indices.iter().zip(&configs).zip(launched)
     {
         let (layout, slots) = estimate_slots(model, i).map_err(|reason| HilError::Refused {
-            agent: config.id,
+            agent: model.agents[i].name.clone(),
             reason,
         })?;
         hil.push(Some(HilController::configure(
@@ -184,6 +186,7 @@ pub fn controllers(
             slots,
             model.initial_estimate,
             started,
+            &model.agents[i].name,
         )?));
     }
     let mut out: Vec<Box<dyn AgentController>> = Vec::with_capacity(model.n());
@@ -195,7 +198,7 @@ pub fn controllers(
             },
             None => out.push(Box::new(LocalCore::new(model.core_agent(i).map_err(
                 |reason| HilError::Refused {
-                    agent: model.agents[i].id,
+                    agent: model.agents[i].name.clone(),
                     reason,
                 },
             )?))),

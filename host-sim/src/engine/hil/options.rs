@@ -56,8 +56,9 @@ pub enum Launcher {
 /// What a host-in-the-loop run needs.
 #[derive(Clone, Debug, PartialEq)]
 pub struct HilOptions {
-    /// Ids of the agents to emulate (each once).
-    pub agents: Vec<u8>,
+    /// The user's ids of the agents to emulate (as written in the scenario: an integer or a
+    /// short name; each once).
+    pub agents: Vec<String>,
     /// How to start them.
     pub launcher: Launcher,
     /// Per-reply timeout.
@@ -71,7 +72,7 @@ impl HilOptions {
     /// Emulates `agents` in QEMU with `firmware` (`None`: [`default_firmware`]), logs
     /// into `log_dir`, with a per-reply `timeout_s`.
     pub fn qemu(
-        agents: Vec<u8>,
+        agents: Vec<String>,
         firmware: Option<PathBuf>,
         log_dir: &Path,
         timeout_s: f64,
@@ -102,7 +103,7 @@ pub fn timeout(seconds: f64) -> Result<Duration, HilError> {
 
 /// Checks the requested agents against the scenario; returns their indices (in agent
 /// order, each once).
-pub fn agent_indices(model: &Model, ids: &[u8]) -> Result<Vec<usize>, HilError> {
+pub fn agent_indices(model: &Model, ids: &[String]) -> Result<Vec<usize>, HilError> {
     if model.mode != Mode::Sampled {
         return Err(HilError::Usage(format!(
             "--hil needs mode = \"sampled\" (scenario {} is {})",
@@ -110,13 +111,13 @@ pub fn agent_indices(model: &Model, ids: &[u8]) -> Result<Vec<usize>, HilError> 
             model.mode.as_str()
         )));
     }
-    let known: Vec<String> = model.agents.iter().map(|a| a.id.to_string()).collect();
+    let known: Vec<&str> = model.agents.iter().map(|a| a.name.as_str()).collect();
     let mut idx = Vec::new();
-    for &id in ids {
+    for id in ids {
         let i = model
             .agents
             .iter()
-            .position(|a| a.id == id)
+            .position(|a| a.name == *id)
             .ok_or_else(|| {
                 HilError::Usage(format!(
                     "--hil {id}: scenario {} has no agent {id} (its agents: {})",

@@ -3,8 +3,8 @@
 /// One emulated agent's link figures (`summary.json` → `hil`).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct LinkStats {
-    /// The agent's id.
-    pub agent: u8,
+    /// The agent's id as the scenario writes it.
+    pub agent: String,
     /// QEMU's pid (none for the test stand-in).
     pub pid: Option<u32>,
     /// Link messages (COBS frames) sent to the target.

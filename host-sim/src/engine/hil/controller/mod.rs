@@ -36,6 +36,8 @@ pub struct EstimateSlot {
 #[derive(Debug)]
 pub struct HilController {
     id: u8,
+    /// The agent's id as the scenario writes it (messages and figures).
+    name: String,
     link: Link,
     target: TargetHandle,
     timeout: Duration,
@@ -64,7 +66,7 @@ impl HilController {
     /// with `config` and waits for `Ready` (within `timeout`). `layout` and `slots`
     /// describe the agent's owned estimates (as the host's own core agent of the same
     /// configuration orders them); `initial` is `r̂(0)`; `started` is when the target
-    /// was started.
+    /// was started; `name` is the agent's id as the scenario writes it (for messages).
     #[allow(clippy::too_many_arguments)]
     pub fn configure(
         config: &AgentConfig<f32, TARGET_MT>,
@@ -76,10 +78,13 @@ impl HilController {
         slots: Vec<EstimateSlot>,
         initial: f64,
         started: Instant,
+        name: &str,
     ) -> Result<Self, HilError> {
         let id = config.id;
+        let name = name.to_owned();
         let mut c = Self {
             id,
+            name: name.clone(),
             link,
             target,
             timeout,
@@ -103,7 +108,7 @@ impl HilController {
         c.link
             .set_write_timeout(timeout)
             .map_err(|e| HilError::Start {
-                agent: id,
+                agent: name.clone(),
                 reason: format!("cannot configure the connection: {e}"),
             })?;
         match c.link.wait_announcement(startup) {
@@ -111,7 +116,7 @@ impl HilController {
             Err(RecvError::Timeout { .. }) => {
                 let ended = c.target.ended(Duration::ZERO);
                 return Err(HilError::Start {
-                    agent: id,
+                    agent: name.clone(),
                     reason: format!(
                         "no start-up announcement (a 0x00 byte on USART1) within {:.1} s of starting{}{}",
                         started.elapsed().as_secs_f64(),
@@ -131,7 +136,7 @@ impl HilController {
         c.link
             .queue(&HostMsg::Configure(config.clone()))
             .map_err(|e| HilError::Start {
-                agent: id,
+                agent: name.clone(),
                 reason: format!("the configuration does not encode: {e}"),
             })?;
         if let Err(e) = c.link.flush() {
@@ -148,14 +153,14 @@ impl HilController {
             TargetMsg::Ready {
                 id: got, version, ..
             } => Err(HilError::Corrupt {
-                agent: id,
+                agent: name.clone(),
                 when: When::Configure,
                 what: format!(
                     "Ready {{ id: {got}, version: {version} }} (expected id {id}, link version {LINK_VERSION})"
                 ),
             }),
             TargetMsg::Error(e) => Err(HilError::Refused {
-                agent: id,
+                agent: name.clone(),
                 reason: format!(
                     "the firmware answered Configure with Error({e:?}){}",
                     match e {
@@ -165,7 +170,7 @@ impl HilController {
                 ),
             }),
             other => Err(HilError::Corrupt {
-                agent: id,
+                agent: name.clone(),
                 when: When::Configure,
                 what: format!("{other:?} (expected Ready)"),
             }),
@@ -187,7 +192,7 @@ impl HilController {
     fn io_error(&mut self, when: When, e: &str) -> HilError {
         let ended = self.target.ended(Duration::from_millis(500));
         HilError::Closed {
-            agent: self.id,
+            agent: self.name.clone(),
             when,
             detail: format!(
                 "{}{}",
@@ -216,7 +221,7 @@ impl HilController {
             RecvError::Timeout { partial } => {
                 if let Some(s) = self.target.ended(Duration::ZERO) {
                     return HilError::Closed {
-                        agent: self.id,
+                        agent: self.name.clone(),
                         when,
                         detail: format!("{s} while {waiting}{}", self.target.log_hint()),
                     };
@@ -227,7 +232,7 @@ impl HilController {
                     String::new()
                 };
                 HilError::Timeout {
-                    agent: self.id,
+                    agent: self.name.clone(),
                     when,
                     timeout_s: self.timeout.as_secs_f64(),
                     detail: format!("{waiting}{partial}{}", self.target.log_hint()),
@@ -237,7 +242,7 @@ impl HilController {
             RecvError::Closed => {
                 let ended = self.target.ended(Duration::from_secs(1));
                 HilError::Closed {
-                    agent: self.id,
+                    agent: self.name.clone(),
                     when,
                     detail: format!(
                         "the target closed the link while {waiting}{}{}",
@@ -247,7 +252,7 @@ impl HilController {
                 }
             }
             RecvError::Corrupt(what) => HilError::Corrupt {
-                agent: self.id,
+                agent: self.name.clone(),
                 when,
                 what,
             },
@@ -264,7 +269,7 @@ impl HilController {
             bytes_from_target,
         } = self.link.counters;
         LinkStats {
-            agent: self.id,
+            agent: self.name.clone(),
             pid: self.target.pid(),
             frames_to_target,
             frames_from_target,

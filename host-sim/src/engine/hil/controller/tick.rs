@@ -20,7 +20,7 @@ impl HilController {
         self.time = m.time;
         let when = self.when();
         let internal = |what: String| HilError::Corrupt {
-            agent: self.id,
+            agent: self.name.clone(),
             when,
             what,
         };
@@ -63,7 +63,7 @@ impl HilController {
                     std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
                 ) {
                     HilError::Timeout {
-                        agent: self.id,
+                        agent: self.name.clone(),
                         when,
                         timeout_s: write_limit.as_secs_f64(),
                         detail: format!(
@@ -84,7 +84,7 @@ impl HilController {
     fn receive_tick(&mut self, outbox: &mut Vec<RadioFrame>) -> Result<StepOutput<f64>, HilError> {
         let when = self.when();
         let start = self.sent_at.take().ok_or_else(|| HilError::Corrupt {
-            agent: self.id,
+            agent: self.name.clone(),
             when,
             what: "nothing (no tick was sent)".to_owned(),
         })?;
@@ -124,7 +124,7 @@ impl HilController {
                 TargetMsg::Error(LinkError::Frame(_)) => {}
                 TargetMsg::Error(e) => {
                     return Err(HilError::Corrupt {
-                        agent: self.id,
+                        agent: self.name.clone(),
                         when,
                         what: format!(
                             "Error({e:?}) from the firmware: it refused a message the host sent"
@@ -133,7 +133,7 @@ impl HilController {
                 }
                 other => {
                     return Err(HilError::Corrupt {
-                        agent: self.id,
+                        agent: self.name.clone(),
                         when,
                         what: format!("{other:?} (expected Radio, Estimates or Output)"),
                     })
@@ -143,7 +143,7 @@ impl HilController {
         };
         if usize::try_from(out.frames) != Ok(frames) {
             return Err(HilError::Corrupt {
-                agent: self.id,
+                agent: self.name.clone(),
                 when,
                 what: format!(
                     "an Output announcing {} radio frames after {frames} Radio messages",
@@ -274,7 +274,7 @@ impl AgentController for HilController {
         self.link
             .queue(&HostMsg::Finish)
             .map_err(|e| HilError::Corrupt {
-                agent: self.id,
+                agent: self.name.clone(),
                 when,
                 what: e,
             })?;
@@ -292,7 +292,7 @@ impl AgentController for HilController {
                 TargetMsg::Error(LinkError::Frame(_)) => {}
                 other => {
                     return Err(HilError::Corrupt {
-                        agent: self.id,
+                        agent: self.name.clone(),
                         when,
                         what: format!("{other:?} (expected Finished)"),
                     })
