@@ -76,7 +76,9 @@ pub struct DesignArgs {
     #[arg(long, value_name = "SCENARIO", default_value = "formation-only")]
     pub template: String,
     /// Every angle of every triangle stays this far from 0 and 180° (degrees) [default: the
-    /// template's `controller.angle_margin_deg`].
+    /// template's `controller.angle_margin_deg`]. A construction whose smallest controlled
+    /// angle is below 15° is grown again with the margin raised in 5° steps up to 30°
+    /// (points on a circle need it; docs/design.md).
     #[arg(long, value_name = "DEG")]
     pub margin: Option<f64>,
     /// Triangles per agent at most [default: the controller's capacity].
