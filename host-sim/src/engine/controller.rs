@@ -13,7 +13,7 @@ use crate::model::CoreAgent;
 use controller_core::{FrameStats, Measurements, OwnedEstimate, StepOutput};
 
 /// One agent's controller, as seen by the sampled simulator.
-pub trait AgentController {
+pub trait AgentController: Send {
     /// The agent's wire id.
     fn id(&self) -> u8;
 

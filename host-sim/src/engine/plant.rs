@@ -3,6 +3,7 @@
 
 use crate::model::Model;
 use controller_core::Vec2;
+use rayon::prelude::*;
 
 /// Positions and velocities of all agents, with their masses and friction.
 #[derive(Clone, Debug, PartialEq)]
@@ -60,18 +61,36 @@ impl Plant {
             .zip(forces)
             .zip(self.mass.iter().zip(&self.friction));
         for (((q, v), u), (&m, d)) in agents {
-            let a = |v: &Vec2<f64>| acceleration(v, u, m, d);
-            let k1v = a(v);
-            let v2 = *v + k1v * (0.5 * dt);
-            let k2v = a(&v2);
-            let v3 = *v + k2v * (0.5 * dt);
-            let k3v = a(&v3);
-            let v4 = *v + k3v * dt;
-            let k4v = a(&v4);
-            *q += (*v + v2 * 2.0 + v3 * 2.0 + v4) * (dt / 6.0);
-            *v += (k1v + k2v * 2.0 + k3v * 2.0 + k4v) * (dt / 6.0);
+            rk4(q, v, u, m, d, dt);
         }
     }
+
+    /// [`Self::step`] on every thread of the current rayon pool, `chunk` agents per work
+    /// item; the same result bit for bit (each agent's step is independent).
+    pub fn step_parallel(&mut self, forces: &[Vec2<f64>], dt: f64, chunk: usize) {
+        self.q
+            .par_iter_mut()
+            .zip(self.v.par_iter_mut())
+            .zip(forces.par_iter())
+            .zip(self.mass.par_iter().zip(self.friction.par_iter()))
+            .with_min_len(chunk)
+            .for_each(|(((q, v), u), (&m, d))| rk4(q, v, u, m, d, dt));
+    }
+}
+
+/// One RK4 step of S1 for one agent under the held force `u`.
+#[inline]
+fn rk4(q: &mut Vec2<f64>, v: &mut Vec2<f64>, u: &Vec2<f64>, m: f64, d: &[f64; 2], dt: f64) {
+    let a = |v: &Vec2<f64>| acceleration(v, u, m, d);
+    let k1v = a(v);
+    let v2 = *v + k1v * (0.5 * dt);
+    let k2v = a(&v2);
+    let v3 = *v + k2v * (0.5 * dt);
+    let k3v = a(&v3);
+    let v4 = *v + k3v * dt;
+    let k4v = a(&v4);
+    *q += (*v + v2 * 2.0 + v3 * 2.0 + v4) * (dt / 6.0);
+    *v += (k1v + k2v * 2.0 + k3v * 2.0 + k4v) * (dt / 6.0);
 }
 
 #[cfg(test)]

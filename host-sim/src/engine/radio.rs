@@ -248,6 +248,18 @@ impl Radio {
         }
     }
 
+    /// Counts a sender's `frames` broadcast to `receivers` radio neighbours when the
+    /// simulator delivers them itself (ideal radio, [`super::sampled::direct_radio`]).
+    pub fn count_direct(&mut self, frames: usize, receivers: usize) {
+        self.stats.broadcasts += frames as u64;
+        self.stats.sent += (frames * receivers) as u64;
+    }
+
+    /// Counts copies the simulator delivered itself ([`Self::count_direct`]).
+    pub fn count_delivered(&mut self, copies: u64) {
+        self.stats.delivered += copies;
+    }
+
     /// A frame from outside the swarm (an attacker, [`super::attack`]) at `now`: one link
     /// copy to each of `receivers`, with the per-link faults, outside the shared channel.
     pub fn inject(&mut self, now: f64, receivers: &[usize], bytes: &[u8]) {

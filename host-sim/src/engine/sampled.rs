@@ -1,5 +1,14 @@
 //! The sampled simulator: controllers at their rate with zero-order hold, frames over the
 //! radio model, the plant integrated by RK4 between ticks.
+//!
+//! Two delivery paths, with the same result: frames go through [`Radio`] (faults, delays,
+//! the shared channel, attacks), or, when the radio is ideal in timing and faults
+//! ([`direct_radio`]), each receiver reads its radio neighbours' frames of the previous
+//! tick straight from their outboxes, in sender order, which is exactly what the radio's
+//! queue would have delivered. Large runs with local controllers compute the agents'
+//! ticks and the plant in parallel ([`PARALLEL_MIN_AGENTS`]): the random streams are drawn
+//! in agent order in a sequential phase, so the result does not depend on the number of
+//! threads.
 
 use super::attack::{AttackCounts, Attacks};
 use super::channel::ChannelStats;
@@ -12,6 +21,29 @@ use super::sensors::Sensors;
 use super::stats::{add_frame_stats, ControlStats, FrameCounts};
 use crate::model::{resolve_estimates, BearingRate, EstimateInfo, Estimator, Model};
 use controller_core::{BearingMeasurement, FrameStats, Measurements, StepOutput, Vec2};
+use rayon::prelude::*;
+
+/// Runs of at least this many agents compute ticks and plant steps on every thread of the
+/// current rayon pool (below it the fork-join costs more than it saves).
+pub const PARALLEL_MIN_AGENTS: usize = 2048;
+/// Agents per parallel work item.
+const CHUNK: usize = 256;
+
+/// Whether every frame of a tick arrives, unchanged and in sender order, at the next tick:
+/// no loss, duplication, corruption, reordering, jitter, bandwidth limit or shared channel,
+/// a latency under half a control period, and no attacker.
+pub fn direct_radio(model: &Model) -> bool {
+    let r = &model.radio;
+    r.loss == 0.0
+        && r.duplication == 0.0
+        && r.corruption == 0.0
+        && (r.reordering == 0.0 || r.reorder_delay == 0.0)
+        && r.jitter == 0.0
+        && r.bandwidth == 0.0
+        && r.channel.is_none()
+        && r.latency < 0.5 * model.control_period()
+        && model.attacks.is_empty()
+}
 
 /// The sampled-data simulator.
 pub struct SampledSim<'m> {
@@ -35,6 +67,15 @@ pub struct SampledSim<'m> {
     info: Vec<EstimateInfo>,
     last_tick: Option<f64>,
     stats: ControlStats,
+    /// Frames bypass [`Radio`]'s queue ([`direct_radio`]).
+    direct: bool,
+    /// Every controller is a [`LocalCore`] (ticks may run in parallel).
+    local: bool,
+    /// Bearings of every agent (parallel path), at `bear_start[i]..bear_start[i + 1]`.
+    bear_all: Vec<BearingMeasurement<f64>>,
+    bear_start: Vec<usize>,
+    /// Velocity and partner offset measured for every agent (parallel path).
+    measured: Vec<(Vec2<f64>, Option<Vec2<f64>>)>,
 }
 
 /// Frames one agent emits per tick, at most (used to preallocate).
@@ -47,7 +88,9 @@ impl<'m> SampledSim<'m> {
         for i in 0..model.n() {
             controllers.push(Box::new(LocalCore::new(model.core_agent(i)?)));
         }
-        Self::with_controllers(model, controllers)
+        let mut sim = Self::with_controllers(model, controllers)?;
+        sim.local = true;
+        Ok(sim)
     }
 
     /// A sampled simulation with the given controllers (one per agent, in agent order).
@@ -113,6 +156,11 @@ impl<'m> SampledSim<'m> {
             info,
             last_tick: None,
             stats: ControlStats::default(),
+            direct: direct_radio(model),
+            local: false,
+            bear_all: Vec::with_capacity(model.graph.triangle.total()),
+            bear_start: Vec::with_capacity(n + 1),
+            measured: vec![(Vec2::zeros(), None); n],
         })
     }
 
@@ -147,6 +195,124 @@ impl<'m> SampledSim<'m> {
     }
 }
 
+impl SampledSim<'_> {
+    /// Whether this tick runs on every thread of the current rayon pool.
+    fn parallel(&self) -> bool {
+        self.local && self.model.n() >= PARALLEL_MIN_AGENTS && rayon::current_num_threads() > 1
+    }
+
+    /// Direct delivery: every receiver gets its radio neighbours' frames of the last tick,
+    /// in sender order (what [`Radio`]'s queue delivers when nothing delays or changes
+    /// them), and the radio counts them delivered.
+    fn gather(&mut self, parallel: bool) {
+        let radio = &self.model.graph.radio;
+        let out = &self.outboxes;
+        let fill = |(j, inbox): (usize, &mut Vec<RadioFrame>)| -> u64 {
+            let mut k = 0;
+            for &i in radio.of(j) {
+                if let Some(frames) = out.get(i) {
+                    inbox.extend_from_slice(frames);
+                    k += frames.len() as u64;
+                }
+            }
+            k
+        };
+        let delivered: u64 = if parallel {
+            self.inboxes
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(CHUNK)
+                .map(fill)
+                .sum()
+        } else {
+            self.inboxes.iter_mut().enumerate().map(fill).sum()
+        };
+        self.radio.count_delivered(delivered);
+    }
+
+    /// Measures agent `i` (drawing its noise from the sensors' stream) into `bearings`.
+    fn measure(
+        &mut self,
+        i: usize,
+        exact: bool,
+        ranged: bool,
+    ) -> (Vec2<f64>, Option<Vec2<f64>>) {
+        let (q, v) = (&self.plant.q, &self.plant.v);
+        for &j in self.model.graph.triangle.of(i) {
+            if let Some(b) =
+                self.sensors
+                    .bearing(self.ids[j], &q[i], &q[j], &v[i], &v[j], exact, ranged)
+            {
+                self.bearings.push(b);
+            }
+        }
+        let velocity = self.sensors.velocity(&v[i]);
+        let partner_offset = self.partner[i].map(|p| self.sensors.offset(&q[i], &q[p]));
+        (velocity, partner_offset)
+    }
+
+    /// Every agent measured and its tick started, in agent order.
+    fn tick_sequential(&mut self, t: f64, dt: f64) -> Result<(), HilError> {
+        let exact = self.model.sensors.bearing_rate == BearingRate::Exact;
+        let ranged = self.model.estimator == Estimator::Measured;
+        for i in 0..self.model.n() {
+            self.bearings.clear();
+            let (velocity, partner_offset) = self.measure(i, exact, ranged);
+            let m = Measurements {
+                time: t,
+                dt,
+                velocity,
+                bearings: &self.bearings,
+                partner_offset,
+            };
+            self.outboxes[i].clear();
+            self.outputs[i] =
+                self.controllers[i].start_tick(&self.inboxes[i], &m, &mut self.outboxes[i])?;
+            self.inboxes[i].clear();
+        }
+        Ok(())
+    }
+
+    /// Every agent measured in agent order (the random streams as in
+    /// [`Self::tick_sequential`]), then every local controller's tick in parallel.
+    fn tick_parallel(&mut self, t: f64, dt: f64) {
+        let exact = self.model.sensors.bearing_rate == BearingRate::Exact;
+        let ranged = self.model.estimator == Estimator::Measured;
+        let mut all = std::mem::take(&mut self.bear_all);
+        all.clear();
+        self.bear_start.clear();
+        for i in 0..self.model.n() {
+            self.bearings.clear();
+            self.bear_start.push(all.len());
+            self.measured[i] = self.measure(i, exact, ranged);
+            all.extend_from_slice(&self.bearings);
+        }
+        self.bear_start.push(all.len());
+        self.bear_all = all;
+        let (bear_all, bear_start, measured) = (&self.bear_all, &self.bear_start, &self.measured);
+        self.controllers
+            .par_iter_mut()
+            .zip(self.inboxes.par_iter_mut())
+            .zip(self.outboxes.par_iter_mut())
+            .zip(self.outputs.par_iter_mut())
+            .enumerate()
+            .with_min_len(CHUNK)
+            .for_each(|(i, (((c, inbox), outbox), output))| {
+                let (velocity, partner_offset) = measured[i];
+                let m = Measurements {
+                    time: t,
+                    dt,
+                    velocity,
+                    bearings: bear_all.get(bear_start[i]..bear_start[i + 1]).unwrap_or(&[]),
+                    partner_offset,
+                };
+                outbox.clear();
+                *output = Some(c.tick(inbox, &m, outbox));
+                inbox.clear();
+            });
+    }
+}
+
 impl Engine for SampledSim<'_> {
     /// Two phases: every agent is measured in agent order and its tick started (local
     /// controllers complete it at once, remote ones only send their inputs), then every
@@ -157,46 +323,24 @@ impl Engine for SampledSim<'_> {
             return;
         }
         let model = self.model;
-        self.radio.observe(&self.plant.q);
-        if !self.attacks.is_empty() {
-            let period = model.dt * model.steps_per_tick as f64;
-            self.attacks
-                .tick(t, period, &self.plant.q, model, &mut self.radio);
+        let parallel = self.parallel();
+        if self.direct {
+            self.gather(parallel);
+        } else {
+            self.radio.observe(&self.plant.q);
+            if !self.attacks.is_empty() {
+                let period = model.dt * model.steps_per_tick as f64;
+                self.attacks
+                    .tick(t, period, &self.plant.q, model, &mut self.radio);
+            }
+            self.radio.deliver(t, &mut self.inboxes);
         }
-        self.radio.deliver(t, &mut self.inboxes);
         let dt = self.last_tick.map_or(0.0, |p| t - p);
-        let exact = model.sensors.bearing_rate == BearingRate::Exact;
-        let ranged = model.estimator == Estimator::Measured;
-        let q = &self.plant.q;
-        let v = &self.plant.v;
-        for i in 0..model.n() {
-            self.bearings.clear();
-            for &j in model.graph.triangle.of(i) {
-                if let Some(b) =
-                    self.sensors
-                        .bearing(self.ids[j], &q[i], &q[j], &v[i], &v[j], exact, ranged)
-                {
-                    self.bearings.push(b);
-                }
-            }
-            let velocity = self.sensors.velocity(&v[i]);
-            let partner_offset = self.partner[i].map(|p| self.sensors.offset(&q[i], &q[p]));
-            let m = Measurements {
-                time: t,
-                dt,
-                velocity,
-                bearings: &self.bearings,
-                partner_offset,
-            };
-            self.outboxes[i].clear();
-            match self.controllers[i].start_tick(&self.inboxes[i], &m, &mut self.outboxes[i]) {
-                Ok(out) => self.outputs[i] = out,
-                Err(e) => {
-                    self.error = Some(e);
-                    return;
-                }
-            }
-            self.inboxes[i].clear();
+        if parallel {
+            self.tick_parallel(t, dt);
+        } else if let Err(e) = self.tick_sequential(t, dt) {
+            self.error = Some(e);
+            return;
         }
         for i in 0..model.n() {
             let out = match self.outputs[i].take() {
@@ -209,18 +353,23 @@ impl Engine for SampledSim<'_> {
                     }
                 },
             };
-            for f in &self.outboxes[i] {
+            let receivers = model.graph.radio.of(i);
+            if self.direct {
                 self.radio
-                    .broadcast(t, i, model.graph.radio.of(i), f.as_bytes());
-                if !self.attacks.is_empty() {
-                    self.attacks.overhear(
-                        t,
-                        i,
-                        f.as_bytes(),
-                        &self.plant.q,
-                        model,
-                        &mut self.radio,
-                    );
+                    .count_direct(self.outboxes[i].len(), receivers.len());
+            } else {
+                for f in &self.outboxes[i] {
+                    self.radio.broadcast(t, i, receivers, f.as_bytes());
+                    if !self.attacks.is_empty() {
+                        self.attacks.overhear(
+                            t,
+                            i,
+                            f.as_bytes(),
+                            &self.plant.q,
+                            model,
+                            &mut self.radio,
+                        );
+                    }
                 }
             }
             self.forces[i] = out.force;
@@ -237,7 +386,11 @@ impl Engine for SampledSim<'_> {
     }
 
     fn integrate(&mut self, _t: f64) {
-        self.plant.step(&self.forces, self.model.dt);
+        if self.parallel() {
+            self.plant.step_parallel(&self.forces, self.model.dt, CHUNK);
+        } else {
+            self.plant.step(&self.forces, self.model.dt);
+        }
     }
 
     fn view(&mut self) -> (&[Vec2<f64>], &[Vec2<f64>], &[f64]) {
