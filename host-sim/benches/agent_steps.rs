@@ -3,52 +3,90 @@
 //! One agent-step is one agent's control tick at 100 Hz (its sensors, its
 //! `controller-core` receive/step/frames, its frames through the radio) plus its share of
 //! the 10 RK4 plant steps (dt = 1 ms) until the next tick. Criterion reports it as
-//! elements/s ("Kelem/s" = thousand agent-steps per second).
+//! elements/s ("Melem/s" = million agent-steps per second).
 //!
-//! * `paper_n4`: the `paper` scenario (4 agents).
-//! * `strip_n1000`: a generated triangulated strip of 1,000 agents.
+//! * `agent_steps/paper_n4`: the `paper` scenario (4 agents), one thread.
+//! * `agent_steps/strip_nN`: a generated triangulated strip of N = 100 … 100,000 agents,
+//!   one thread (a one-thread rayon pool): the cost per agent-step should not grow with N.
+//! * `agent_steps_parallel/strip_nN`: the same on every core (rayon's global pool); the
+//!   result is bit-identical to one thread (`tests/scaling.rs`).
 //!
-//! `cargo bench -p host-sim -- --quick` runs both in well under a minute.
+//! `cargo bench -p host-sim --bench agent_steps -- --quick` runs all in a few minutes;
+//! docs/performance.md has the figures and the log-log slope.
 
 // `criterion_group!` generates an undocumented public function.
 #![allow(missing_docs)]
 
-use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion, Throughput};
 use host_sim::engine::SampledSim;
 use host_sim::load;
+use host_sim::model::Model;
 use host_sim::scenario::strip_model;
 use std::hint::black_box;
 use std::time::Duration;
 
-fn bench(c: &mut Criterion, name: &str, model: &host_sim::model::Model, ticks: usize) {
+/// Strip sizes and the ticks per iteration (about 10⁵ agent-steps per iteration).
+const STRIPS: [(usize, usize); 4] = [(100, 1000), (1000, 100), (10_000, 10), (100_000, 1)];
+
+fn bench(
+    group: &mut BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    name: &str,
+    model: &Model,
+    ticks: usize,
+    pool: Option<&rayon::ThreadPool>,
+) {
     let mut sim = SampledSim::new(model).expect("simulator");
     let period = model.control_period();
     let mut t = 0.0;
-    let mut group = c.benchmark_group("agent_steps");
     group.throughput(Throughput::Elements((ticks * model.n()) as u64));
     group.bench_function(name, |b| {
         b.iter(|| {
-            sim.advance_ticks(t, ticks);
-            t += ticks as f64 * period;
+            let mut step = || {
+                sim.advance_ticks(t, ticks);
+                t += ticks as f64 * period;
+            };
+            match pool {
+                Some(p) => p.install(step),
+                None => step(),
+            }
             black_box(&sim.plant.q);
         });
     });
-    group.finish();
 }
 
 fn agent_steps(c: &mut Criterion) {
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("pool");
     // 1,000 s of the paper run would drift far from the start but stays well-defined:
     // the formation converges and translates at v*.
     let paper = load("paper", &["duration=1000.0".to_owned()]).expect("paper");
-    bench(c, "paper_n4", &paper, 100);
-    let strip = strip_model(1000, 1000.0);
-    bench(c, "strip_n1000", &strip, 1);
+    let mut group = c.benchmark_group("agent_steps");
+    bench(&mut group, "paper_n4", &paper, 1000, Some(&one));
+    for (n, ticks) in STRIPS {
+        let strip = strip_model(n, 1000.0);
+        bench(
+            &mut group,
+            &format!("strip_n{n}"),
+            &strip,
+            ticks,
+            Some(&one),
+        );
+    }
+    group.finish();
+    let mut group = c.benchmark_group("agent_steps_parallel");
+    for (n, ticks) in STRIPS.into_iter().skip(2) {
+        let strip = strip_model(n, 1000.0);
+        bench(&mut group, &format!("strip_n{n}"), &strip, ticks, None);
+    }
+    group.finish();
 }
 
 criterion_group! {
     name = benches;
     config = Criterion::default()
-        .sample_size(20)
+        .sample_size(10)
         .warm_up_time(Duration::from_secs(1))
         .measurement_time(Duration::from_secs(3));
     targets = agent_steps

@@ -87,15 +87,16 @@ impl From<RunError> for Error {
 }
 
 /// Told how far a run has got, in simulated seconds; told once more when it is over
-/// (before any output is written). Any `FnMut(f64)` is one.
-pub trait Progress {
+/// (before any output is written). Any `FnMut(f64) + Send` is one (a run with
+/// [`Simulation::threads`] reports from a worker thread of its pool).
+pub trait Progress: Send {
     /// The run has simulated up to `t` (s).
     fn update(&mut self, t: f64);
     /// The simulation is over.
     fn finish(&mut self) {}
 }
 
-impl<F: FnMut(f64)> Progress for F {
+impl<F: FnMut(f64) + Send> Progress for F {
     fn update(&mut self, t: f64) {
         self(t);
     }
@@ -109,6 +110,8 @@ pub struct Simulation<'a> {
     out: Option<(PathBuf, bool)>,
     hil: Option<&'a HilOptions>,
     progress: Option<&'a mut dyn Progress>,
+    threads: Option<usize>,
+    csv: bool,
 }
 
 impl<'a> Simulation<'a> {
@@ -120,7 +123,26 @@ impl<'a> Simulation<'a> {
             out: None,
             hil: None,
             progress: None,
+            threads: None,
+            csv: true,
         }
+    }
+
+    /// Whether [`Self::write_to`] also writes `timeseries.csv` (default yes). Without it
+    /// only `summary.json` is written and no figure is drawn (they are drawn from the
+    /// CSV): for huge runs, whose rows (every agent's state every `log_interval`) would
+    /// cost more than the simulation.
+    pub fn csv(mut self, csv: bool) -> Self {
+        self.csv = csv;
+        self
+    }
+
+    /// Worker threads of a large run (default: rayon's global pool, one per core). Runs of
+    /// at least [`crate::engine::PARALLEL_MIN_AGENTS`] agents compute the agents' ticks and
+    /// the plant on them; the result is the same for any number of threads.
+    pub fn threads(mut self, threads: usize) -> Self {
+        self.threads = Some(threads);
+        self
     }
 
     /// Whether to keep the time series in memory ([`Run::series`]; default yes).
@@ -161,7 +183,11 @@ impl<'a> Simulation<'a> {
         }
         // The estimate layout (for the columns) comes from the agents' own configurations.
         let estimates = estimate_layout(model).map_err(RunError::Failed)?;
-        let csv_path = self.out.as_ref().map(|(d, _)| d.join("timeseries.csv"));
+        let csv_path = self
+            .out
+            .as_ref()
+            .filter(|_| self.csv)
+            .map(|(d, _)| d.join("timeseries.csv"));
         let csv = match &csv_path {
             Some(p) => Some(
                 CsvRecorder::create(p, model, &estimates)
@@ -176,9 +202,16 @@ impl<'a> Simulation<'a> {
             Some(p) => p,
             None => &mut silent,
         };
-        let result = match self.hil {
-            Some(h) => hil::run(model, h, &mut recorder, &mut |t| progress.update(t)),
-            None => engine::run(model, &mut recorder, &mut |t| progress.update(t)),
+        let result = match (self.hil, self.threads) {
+            (Some(h), _) => hil::run(model, h, &mut recorder, &mut |t| progress.update(t)),
+            (None, None) => engine::run(model, &mut recorder, &mut |t| progress.update(t)),
+            (None, Some(n)) => {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(n)
+                    .build()
+                    .map_err(|e| Error::Output(format!("cannot start {n} threads: {e}")))?;
+                pool.install(|| engine::run(model, &mut recorder, &mut |t| progress.update(t)))
+            }
         };
         progress.finish();
         let result = result?;
@@ -189,7 +222,7 @@ impl<'a> Simulation<'a> {
             files: Vec::new(),
             plot_error: None,
         };
-        if let (Some((dir, plots)), Some(csv_path)) = (&self.out, csv_path) {
+        if let Some((dir, plots)) = &self.out {
             run.write_outputs(model, dir, csv_path, *plots)?;
         }
         Ok(run)
@@ -233,14 +266,15 @@ impl Run {
         &mut self,
         model: &Model,
         dir: &Path,
-        csv_path: PathBuf,
+        csv_path: Option<PathBuf>,
         plots: bool,
     ) -> Result<(), Error> {
         let summary_path = dir.join("summary.json");
         report::write_summary(&summary_path, &self.summary_json(model))
             .map_err(|e| Error::Output(format!("cannot write {}: {e}", summary_path.display())))?;
-        self.files = vec![csv_path, summary_path];
-        if plots {
+        let has_csv = csv_path.is_some();
+        self.files = csv_path.into_iter().chain([summary_path]).collect();
+        if plots && has_csv {
             match report::plot_run(dir) {
                 Ok(p) => self.files.extend(p),
                 Err(e) => self.plot_error = Some(e),

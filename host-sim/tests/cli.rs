@@ -377,3 +377,51 @@ fn quiet_prints_nothing_and_failure_codes_are_distinct() {
     );
     assert_eq!(o.status.code(), Some(13), "diverged");
 }
+
+/// `-j N` changes only the speed: a run large enough for the parallel path writes the same
+/// bytes on one and two threads; `--summary-only` writes summary.json alone, with the same
+/// figures.
+#[test]
+fn jobs_do_not_change_the_outputs_and_summary_only_skips_the_series() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let scenario = d.join("big.toml");
+    let o = run_in(
+        d,
+        &[
+            "design",
+            "--shape",
+            "tri-lattice",
+            "-n",
+            "2200",
+            "--duration",
+            "0.2",
+            "-o",
+            scenario.to_str().expect("path"),
+        ],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let mut summaries = Vec::new();
+    for (name, extra) in [
+        ("j1", vec!["-j", "1"]),
+        ("j2", vec!["-j", "2"]),
+        ("so", vec!["--summary-only"]),
+    ] {
+        let mut args = vec!["-q", "run", "big.toml", "--no-plots", "--out", name];
+        args.extend(extra);
+        let o = run_in(d, &args);
+        no_panic(&o);
+        let s = std::fs::read_to_string(d.join(name).join("summary.json")).expect("summary");
+        let s: serde_json::Value = serde_json::from_str(&s).expect("json");
+        summaries.push(s);
+    }
+    let csv = |n: &str| std::fs::read(d.join(n).join("timeseries.csv")).expect("csv");
+    assert!(
+        csv("j1") == csv("j2"),
+        "timeseries.csv differs between -j 1 and -j 2"
+    );
+    assert_eq!(summaries[0], summaries[1]);
+    assert_eq!(summaries[0]["outcome"], summaries[2]["outcome"]);
+    assert_eq!(summaries[0]["V_final"], summaries[2]["V_final"]);
+    assert!(!d.join("so").join("timeseries.csv").exists());
+}

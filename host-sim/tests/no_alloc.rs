@@ -147,11 +147,15 @@ fn sampled_and_continuous_loops_do_not_allocate() {
         CsvRecorder::create(&dir.path().join("b.csv"), &m, sim.estimate_info()).expect("csv");
     full_loop(&m, &mut sim, 0, 100, &mut csv);
 
-    let m = strip_model(300, 10.0);
-    let mut sim = SampledSim::new(&m).expect("sim");
-    sim.advance_ticks(0.0, 20);
-    let n = allocations(|| sim.advance_ticks(0.2, 50));
-    assert_eq!(n, 0);
+    // Strips (ideal radio: frames straight from the senders' outboxes), one thread.
+    for n in [300, 1000] {
+        let m = strip_model(n, 10.0);
+        assert!(host_sim::engine::direct_radio(&m));
+        let mut sim = SampledSim::new(&m).expect("sim");
+        sim.advance_ticks(0.0, 20);
+        let n = allocations(|| sim.advance_ticks(0.2, 50));
+        assert_eq!(n, 0);
+    }
 }
 
 #[test]

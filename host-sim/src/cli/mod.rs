@@ -100,6 +100,14 @@ pub struct RunArgs {
     /// Do not draw the plots.
     #[arg(long)]
     pub no_plots: bool,
+    /// Write only summary.json: no timeseries.csv and no plots (for huge runs; to keep a
+    /// thinner series instead, `--set integration.log_interval=S`).
+    #[arg(long)]
+    pub summary_only: bool,
+    /// Worker threads of a large run (at least 2,048 agents; default one per core). The
+    /// results are the same for any number.
+    #[arg(short = 'j', long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    pub jobs: Option<u16>,
     /// Run agent ID's controller as firmware on an emulated STM32F405 (QEMU), over an
     /// emulated UART; ID is the agent's id as written in the scenario (an integer or a
     /// short name); repeat for more agents (see docs/hil.md).
@@ -149,6 +157,8 @@ pub fn execute(cli: Cli) -> u8 {
                 seed: None,
                 set: Vec::new(),
                 no_plots: false,
+                summary_only: false,
+                jobs: None,
                 hil: Vec::new(),
                 firmware: None,
                 hil_timeout: hil::DEFAULT_TIMEOUT_S,

@@ -83,7 +83,11 @@ pub(super) fn run_command(args: &RunArgs, quiet: bool) -> u8 {
     let mut sim = Simulation::new(&model)
         .keep_series(false)
         .write_to(&out, !args.no_plots)
+        .csv(!args.summary_only)
         .progress(&mut progress);
+    if let Some(n) = args.jobs {
+        sim = sim.threads(usize::from(n));
+    }
     if let Some(h) = &hil_options {
         sim = sim.hil(h);
     }

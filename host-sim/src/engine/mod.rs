@@ -29,5 +29,5 @@ pub use driver::{drive, run, Engine};
 pub use error::RunError;
 pub use record::{NullRecorder, Recorder, Row};
 pub use result::RunResult;
-pub use sampled::SampledSim;
+pub use sampled::{direct_radio, SampledSim, PARALLEL_MIN_AGENTS};
 pub use stats::{ControlStats, FrameCounts};

@@ -231,12 +231,7 @@ impl SampledSim<'_> {
     }
 
     /// Measures agent `i` (drawing its noise from the sensors' stream) into `bearings`.
-    fn measure(
-        &mut self,
-        i: usize,
-        exact: bool,
-        ranged: bool,
-    ) -> (Vec2<f64>, Option<Vec2<f64>>) {
+    fn measure(&mut self, i: usize, exact: bool, ranged: bool) -> (Vec2<f64>, Option<Vec2<f64>>) {
         let (q, v) = (&self.plant.q, &self.plant.v);
         for &j in self.model.graph.triangle.of(i) {
             if let Some(b) =
@@ -303,7 +298,9 @@ impl SampledSim<'_> {
                     time: t,
                     dt,
                     velocity,
-                    bearings: bear_all.get(bear_start[i]..bear_start[i + 1]).unwrap_or(&[]),
+                    bearings: bear_all
+                        .get(bear_start[i]..bear_start[i + 1])
+                        .unwrap_or(&[]),
                     partner_offset,
                 };
                 outbox.clear();
