@@ -4,11 +4,10 @@
 use super::error::DesignError;
 use super::geometry::{angles, cross, dist};
 use super::laman::Construction;
+use super::neighbours::point_tree;
 use super::points::Point;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rstar::primitives::GeomWithData;
-use rstar::RTree;
 use std::f64::consts::PI;
 
 /// What [`Perturbation::fraction`] is a fraction of.
@@ -183,13 +182,7 @@ pub fn initial_positions(
 /// The median over the points of the distance to the nearest other point (0 for fewer
 /// than two points).
 pub fn spacing(points: &[Point]) -> f64 {
-    let tree: RTree<GeomWithData<Point, usize>> = RTree::bulk_load(
-        points
-            .iter()
-            .enumerate()
-            .map(|(i, &p)| GeomWithData::new(p, i))
-            .collect(),
-    );
+    let tree = point_tree(points);
     let mut d: Vec<f64> = points
         .iter()
         .enumerate()
@@ -211,13 +204,7 @@ fn close_pairs(points: &[Point], d: f64) -> Vec<[usize; 2]> {
     if d <= 0.0 {
         return Vec::new();
     }
-    let tree: RTree<GeomWithData<Point, usize>> = RTree::bulk_load(
-        points
-            .iter()
-            .enumerate()
-            .map(|(i, &p)| GeomWithData::new(p, i))
-            .collect(),
-    );
+    let tree = point_tree(points);
     let mut out = Vec::new();
     for (i, &p) in points.iter().enumerate() {
         for q in tree.locate_within_distance(p, d * d) {
