@@ -2,47 +2,123 @@
 
 use controller_core::Vec2;
 
-/// Exact minimum pairwise distance by sort-and-sweep on `x`: the order is kept between
-/// calls (insertion sort on an almost sorted list), and the sweep stops as soon as the
-/// `x` gap exceeds the best distance. Expected cost O(N) for spread-out formations;
-/// worst case O(N²) when all agents share one `x`.
+/// Exact minimum pairwise distance on a uniform grid: agents are keyed by their cell
+/// `(⌊x/h⌋, ⌊y/h⌋)` and sorted (the order changes little between calls, and the key vector
+/// is reused: no allocation), and each agent is compared with the agents of its own and
+/// the next cells (the half-neighbourhood: every pair once). Two agents closer than `h`
+/// are in neighbouring cells, so when the closest pair found is within `h` it is the
+/// closest of all; otherwise `h` doubles and the search repeats. `h` follows the answer
+/// (1.5 × the last distance), so a call costs O(N) plus the pairs in neighbouring cells,
+/// for lines, lattices or any spread of the agents (a sweep along `x` alone costs
+/// O(N √N) on a 2-D lattice, whose columns share one `x`). Equal distances go to the
+/// smallest pair `(i, j)`, whatever the order of the search.
 #[derive(Clone, Debug, Default)]
 pub struct MinDistance {
-    order: Vec<usize>,
+    /// Cell size of the next call (0: not known yet).
+    h: f64,
+    /// `(cell x, cell y, agent)`, sorted.
+    keys: Vec<(i64, i64, usize)>,
 }
+
+/// The smallest cell size the grid uses (m): coincident agents would otherwise shrink it
+/// to zero.
+const MIN_CELL: f64 = 1e-6;
 
 impl MinDistance {
     /// For `n` agents.
     pub fn new(n: usize) -> Self {
         Self {
-            order: (0..n).collect(),
+            h: 0.0,
+            keys: Vec::with_capacity(n),
         }
     }
 
-    /// `(distance, i, j)` of the closest pair (`inf` with fewer than two agents).
+    /// `(distance, i, j)` of the closest pair, `i < j` (`inf` with fewer than two agents
+    /// or when no distance is a number).
     pub fn compute(&mut self, q: &[Vec2<f64>]) -> (f64, usize, usize) {
-        let x = |i: usize| q.get(i).map_or(f64::NAN, |p| p.x);
-        // Insertion sort by x (NaN sorts last through total_cmp).
-        for k in 1..self.order.len() {
-            let mut j = k;
-            while j > 0 && x(self.order[j - 1]).total_cmp(&x(self.order[j])).is_gt() {
-                self.order.swap(j - 1, j);
-                j -= 1;
-            }
+        let none = (f64::INFINITY, 0, 0);
+        if q.len() < 2 {
+            return none;
         }
+        let side = extent(q);
+        let mut h = self.h;
+        if !(h.is_finite() && h >= MIN_CELL) {
+            h = (side / (q.len() as f64).sqrt()).max(MIN_CELL);
+        }
+        loop {
+            let best = self.search(q, h);
+            // Within h: exact. With h beyond the extent every pair of finite agents was
+            // compared (they share neighbouring cells): exact too, or none is finite.
+            if best.0 <= h || !(h < side) {
+                self.h = (1.5 * best.0).max(MIN_CELL);
+                return if best.0.is_finite() { best } else { none };
+            }
+            h *= 2.0;
+        }
+    }
+
+    /// The closest pair among agents in neighbouring cells of size `h`.
+    fn search(&mut self, q: &[Vec2<f64>], h: f64) -> (f64, usize, usize) {
+        // `as` saturates (NaN → 0): such agents only give NaN distances, never the best.
+        let cell = |p: &Vec2<f64>| ((p.x / h).floor() as i64, (p.y / h).floor() as i64);
+        self.keys.clear();
+        self.keys.extend(q.iter().enumerate().map(|(i, p)| {
+            let (cx, cy) = cell(p);
+            (cx, cy, i)
+        }));
+        self.keys.sort_unstable();
+        let keys = &self.keys;
         let mut best = (f64::INFINITY, 0, 0);
-        for (a, &i) in self.order.iter().enumerate() {
-            for &j in self.order.iter().skip(a + 1) {
-                if x(j) - x(i) >= best.0 {
+        let mut consider = |i: usize, j: usize| {
+            let (a, b) = (i.min(j), i.max(j));
+            let d = (q[b] - q[a]).norm();
+            if d < best.0 || (d == best.0 && (a, b) < (best.1, best.2)) {
+                best = (d, a, b);
+            }
+        };
+        // Start of the next column's cells (cx + 1, ≥ cy − 1): only moves forward.
+        let mut next = 0;
+        for (k, &(cx, cy, i)) in keys.iter().enumerate() {
+            // Own column: this cell after agent i, and the cell above.
+            for &(ox, oy, j) in &keys[k + 1..] {
+                if ox != cx || oy > cy.saturating_add(1) {
                     break;
                 }
-                let d = (q[j] - q[i]).norm();
-                if d < best.0 {
-                    best = (d, i.min(j), i.max(j));
+                consider(i, j);
+            }
+            // Next column: cells cy − 1 ..= cy + 1.
+            let (nx, lo, hi) = (
+                cx.saturating_add(1),
+                cy.saturating_sub(1),
+                cy.saturating_add(1),
+            );
+            while next < keys.len() && (keys[next].0, keys[next].1) < (nx, lo) {
+                next += 1;
+            }
+            for &(ox, oy, j) in &keys[next..] {
+                if ox != nx || oy > hi {
+                    break;
                 }
+                consider(i, j);
             }
         }
         best
+    }
+}
+
+/// The larger side of the bounding box of the finite agents (0 for none, so that the
+/// search stops at once).
+fn extent(q: &[Vec2<f64>]) -> f64 {
+    let (mut lo, mut hi) = (Vec2::repeat(f64::INFINITY), Vec2::repeat(f64::NEG_INFINITY));
+    for p in q.iter().filter(|p| p.x.is_finite() && p.y.is_finite()) {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    let side = (hi - lo).max();
+    if side.is_finite() {
+        side
+    } else {
+        0.0
     }
 }
 
@@ -67,9 +143,53 @@ mod tests {
                 }
             }
             assert_eq!(md.compute(&q).0, best, "round {round}");
+            assert_eq!(brute(&q), md.compute(&q), "round {round}");
             for p in &mut q {
                 p.x += 0.3 * p.y.sin();
             }
         }
+    }
+
+    /// The closest pair by comparing every pair, ties to the smallest `(i, j)`.
+    fn brute(q: &[Vec2<f64>]) -> (f64, usize, usize) {
+        let mut best = (f64::INFINITY, 0, 0);
+        for i in 0..q.len() {
+            for j in i + 1..q.len() {
+                let d = (q[j] - q[i]).norm();
+                if d < best.0 {
+                    best = (d, i, j);
+                }
+            }
+        }
+        best
+    }
+
+    /// A lattice (columns share one x: the case a sweep along x is slow on), pushed around
+    /// over rounds so that the cell size must grow and shrink, with exact ties, a
+    /// coincident pair and a non-finite agent.
+    #[test]
+    fn lattices_spreads_ties_and_bad_positions() {
+        let mut md = MinDistance::new(0);
+        let mut q: Vec<Vec2<f64>> = (0..400)
+            .map(|k| Vec2::new(f64::from(k % 20), f64::from(k / 20)))
+            .collect();
+        assert_eq!(md.compute(&q), brute(&q));
+        assert_eq!(md.compute(&q), (1.0, 0, 1));
+        for p in &mut q {
+            *p *= 7.0;
+        }
+        assert_eq!(md.compute(&q), brute(&q));
+        q[399] = q[398] + Vec2::new(0.01, 0.0);
+        assert_eq!(md.compute(&q), (0.01_f64.max((q[399] - q[398]).norm()), 398, 399));
+        q[5] = q[6];
+        assert_eq!(md.compute(&q), (0.0, 5, 6));
+        for (k, p) in q.iter_mut().enumerate() {
+            *p *= 3.0 + (k as f64 * 0.37).sin();
+        }
+        assert_eq!(md.compute(&q), brute(&q));
+        q[7] = Vec2::new(f64::NAN, 1.0);
+        let (d, i, j) = md.compute(&q);
+        assert!(d.is_finite() && i != 7 && j != 7);
+        assert_eq!(md.compute(&[Vec2::zeros()]).0, f64::INFINITY);
     }
 }
