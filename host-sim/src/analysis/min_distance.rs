@@ -180,7 +180,10 @@ mod tests {
         }
         assert_eq!(md.compute(&q), brute(&q));
         q[399] = q[398] + Vec2::new(0.01, 0.0);
-        assert_eq!(md.compute(&q), (0.01_f64.max((q[399] - q[398]).norm()), 398, 399));
+        assert_eq!(
+            md.compute(&q),
+            (0.01_f64.max((q[399] - q[398]).norm()), 398, 399)
+        );
         q[5] = q[6];
         assert_eq!(md.compute(&q), (0.0, 5, 6));
         for (k, p) in q.iter_mut().enumerate() {

@@ -109,6 +109,7 @@ pub fn drive(
         let (q, _, _) = engine.view();
         tri.iter().map(|&t| signed_area(q, t)).collect()
     };
+    let rows = recorder.wants_rows();
     let mut steps = 0;
     for k in 0..=total {
         let t = model.time(k);
@@ -122,11 +123,16 @@ pub fn drive(
         }
         let log = k.is_multiple_of(log_every) || k == total;
         if tick || log {
-            let frames = engine.frame_counts();
+            // Only rows show the frame counters (summing them visits every agent).
+            let frames = if rows {
+                engine.frame_counts()
+            } else {
+                FrameCounts::default()
+            };
             let (q, v, est) = engine.view();
             diag.evaluate(model, t, q, v, est);
             let stop = monitor.observe(model, &diag, est);
-            if log || stop {
+            if (log || stop) && rows {
                 recorder
                     .record(&Row {
                         snap: &diag.snap,

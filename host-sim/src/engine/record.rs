@@ -25,6 +25,11 @@ pub struct Row<'a> {
 pub trait Recorder {
     /// Records one row.
     fn record(&mut self, row: &Row<'_>) -> io::Result<()>;
+    /// Whether [`Recorder::record`] keeps rows at all (a run skips assembling them, e.g.
+    /// summing every agent's frame counters, when no recorder does).
+    fn wants_rows(&self) -> bool {
+        true
+    }
     /// Flushes at the end of the run.
     fn finish(&mut self) -> io::Result<()> {
         Ok(())
@@ -39,6 +44,10 @@ impl Recorder for NullRecorder {
     fn record(&mut self, _row: &Row<'_>) -> io::Result<()> {
         Ok(())
     }
+
+    fn wants_rows(&self) -> bool {
+        false
+    }
 }
 
 /// Records into the recorder if there is one.
@@ -48,6 +57,10 @@ impl<R: Recorder> Recorder for Option<R> {
             Some(r) => r.record(row),
             None => Ok(()),
         }
+    }
+
+    fn wants_rows(&self) -> bool {
+        self.as_ref().is_some_and(R::wants_rows)
     }
 
     fn finish(&mut self) -> io::Result<()> {
@@ -63,6 +76,10 @@ impl<A: Recorder, B: Recorder> Recorder for (A, B) {
     fn record(&mut self, row: &Row<'_>) -> io::Result<()> {
         self.0.record(row)?;
         self.1.record(row)
+    }
+
+    fn wants_rows(&self) -> bool {
+        self.0.wants_rows() || self.1.wants_rows()
     }
 
     fn finish(&mut self) -> io::Result<()> {
