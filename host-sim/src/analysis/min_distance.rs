@@ -49,7 +49,7 @@ impl MinDistance {
             let best = self.search(q, h);
             // Within h: exact. With h beyond the extent every pair of finite agents was
             // compared (they share neighbouring cells): exact too, or none is finite.
-            if best.0 <= h || !(h < side) {
+            if best.0 <= h || h >= side || !h.is_finite() {
                 self.h = (1.5 * best.0).max(MIN_CELL);
                 return if best.0.is_finite() { best } else { none };
             }
