@@ -127,8 +127,22 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         result
     }
 
+    /// [`Agent::receive`] without the counting: one copy of [`Agent::receive_in`] for
+    /// `auth` and one for `crc16`/`link`, so that the integrity mode is tested once per
+    /// frame and the `crc16`/`link` path carries none of the `auth` path's work.
     fn receive_inner(&mut self, bytes: &[u8]) -> Result<(), FrameError> {
-        let frame = check_mode(bytes, self.config.integrity, self.mode)?;
+        match self.config.integrity {
+            Integrity::Auth(key) => self.receive_in(bytes, Integrity::Auth(key)),
+            Integrity::Crc16 => self.receive_in(bytes, Integrity::Crc16),
+            Integrity::Link => self.receive_in(bytes, Integrity::Link),
+        }
+    }
+
+    /// Checks and applies one frame for a receiver with `integrity` (its configured mode,
+    /// a constant where it is inlined).
+    #[inline(always)]
+    fn receive_in(&mut self, bytes: &[u8], integrity: Integrity) -> Result<(), FrameError> {
+        let frame = check_mode(bytes, integrity, self.mode)?;
         let sender = frame.header.sender;
         if sender == self.config.id {
             return Err(FrameError::OwnFrame);
@@ -140,7 +154,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             .get(slot)
             .ok_or(FrameError::UnknownSender(sender))?;
         let seq = frame.header.seq;
-        let accepted_counter = if let Integrity::Auth(key) = &self.config.integrity {
+        let accepted_counter = if let Integrity::Auth(key) = &integrity {
             // The replay check first (cheap), then the tag, with the counter as carried
             // or as reconstructed from the last accepted one.
             let last = n.last_counter.map(auth::load);
@@ -168,19 +182,17 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         // The whole frame is valid before anything is applied. With estimators, the
         // distances are estimates: at least r_min (as rounded: rounding is monotone).
         frame.validate(self.rho_min_code)?;
+        let [vx, vy] = frame.velocity;
         if let Some(n) = self.neighbours.get_mut(slot) {
             n.last_seq = Some(seq);
             if accepted_counter.is_some() {
                 n.last_counter = accepted_counter;
             }
             n.age = T::zero();
+            // The velocity item (as `apply` stores it, without a second look-up).
+            n.velocity = Some(Vec2::new(T::of_f32(vx), T::of_f32(vy)));
         }
         self.oldest = None;
-        let [vx, vy] = frame.velocity;
-        self.apply(
-            slot,
-            Item::Velocity(Vec2::new(T::of_f32(vx), T::of_f32(vy))),
-        );
         let me = self.config.id;
         for RawAngle { far, codes } in frame.raw_items() {
             // Only the items for angles of which this agent is a far vertex. Validated:

@@ -125,8 +125,8 @@ impl<'a> FrameView<'a> {
     /// finite `γ`, `|σ| ≤ 1`, and distances at least `rho_min` (a binary16 code of a
     /// positive value: the receiver's `r_min` as rounded, or 1 for any positive value).
     /// Reads nothing but bits (no float conversion: binary16 codes of positive values are
-    /// ordered like the values).
-    #[inline]
+    /// ordered like the values). Always inlined: the receiver's view stays in registers.
+    #[inline(always)]
     pub fn validate(&self, rho_min: u16) -> Result<(), FrameError> {
         let [vx, vy] = self.velocity;
         // `x·0` is ±0 for finite `x` and NaN otherwise: one comparison for both.
@@ -184,8 +184,9 @@ pub fn check_frame(
     check_mode(bytes, integrity, mode_byte(integrity, estimator))
 }
 
-/// [`check_frame`] against the receiver's mode byte (see [`super::mode_byte`]).
-#[inline]
+/// [`check_frame`] against the receiver's mode byte (see [`super::mode_byte`]). Always
+/// inlined: where `integrity` is a constant, the other modes' checks fold away.
+#[inline(always)]
 pub(crate) fn check_mode(
     bytes: &[u8],
     integrity: Integrity,
