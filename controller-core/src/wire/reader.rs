@@ -206,7 +206,10 @@ pub(crate) fn check_mode(
             return Err(FrameError::BadCrc);
         }
     }
-    let [mode, sender, q0, q1, v0, v1, v2, v3, w0, w1, w2, w3] = *head;
+    // The velocity as two 4-byte arrays: one (unaligned) word load each on target.
+    let [mode, sender, q0, q1, ref velocity @ ..] = *head;
+    let [ref vx @ .., _, _, _, _] = *velocity;
+    let [_, _, _, _, ref vy @ ..] = *velocity;
     if mode >> 4 != WIRE_VERSION {
         return Err(FrameError::UnknownVersion(mode >> 4));
     }
@@ -235,10 +238,7 @@ pub(crate) fn check_mode(
     };
     Ok(FrameView {
         header: FrameHeader { mode, sender, seq },
-        velocity: [
-            f32::from_le_bytes([v0, v1, v2, v3]),
-            f32::from_le_bytes([w0, w1, w2, w3]),
-        ],
+        velocity: [f32::from_le_bytes(*vx), f32::from_le_bytes(*vy)],
         items,
         signed,
     })
