@@ -51,11 +51,19 @@ const _: () = assert!(
 impl RawAngle {
     #[inline(always)]
     fn of(b: &[u8; ANGLE_ITEM_LEN]) -> Self {
-        let [v, w, g0, g1, s0, s1, a0, a1, b0, b1] = *b;
-        let code = |lo: u8, hi: u8| u16::from_le_bytes([lo, hi]);
+        // Five little-endian 16-bit words (half-word loads on target): the far vertices,
+        // then the codes.
+        let [far, g, s, r0, r1] = b.as_chunks::<2>().0 else {
+            // Unreachable: ten bytes are five pairs (the check folds away).
+            return Self {
+                far: [0; 2],
+                codes: [0; 4],
+            };
+        };
+        let code = |c: &[u8; 2]| u16::from_le_bytes(*c);
         Self {
-            far: [v, w],
-            codes: [code(g0, g1), code(s0, s1), code(a0, a1), code(b0, b1)],
+            far: *far,
+            codes: [code(g), code(s), code(r0), code(r1)],
         }
     }
 }
