@@ -190,7 +190,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             }
             n.age = T::zero();
             // The velocity item (as `apply` stores it, without a second look-up).
-            n.velocity = Some(Vec2::new(T::of_f32(vx), T::of_f32(vy)));
+            n.velocity = Vec2::new(T::of_f32(vx), T::of_f32(vy));
         }
         self.oldest = None;
         let me = self.config.id;
@@ -241,7 +241,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         match item {
             Item::Velocity(v) => {
                 if let Some(n) = self.neighbours.get_mut(slot) {
-                    n.velocity = Some(v);
+                    n.velocity = v;
                 }
             }
             Item::Angle {
