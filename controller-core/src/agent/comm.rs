@@ -147,7 +147,12 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         if sender == self.config.id {
             return Err(FrameError::OwnFrame);
         }
-        let slot = self.slot(sender).ok_or(FrameError::UnknownSender(sender))?;
+        let slot = self
+            .sender_slot(sender)
+            .ok_or(FrameError::UnknownSender(sender))?;
+        // The next frame is probably from the next slot (wrapping; a slot number that
+        // does not fit only makes the next look-up search).
+        self.next_slot = u8::try_from(slot + 1).unwrap_or(0);
         let timeout = self.config.limits.neighbour_timeout;
         let n = self
             .neighbours
