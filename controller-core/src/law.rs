@@ -72,10 +72,12 @@ pub fn far_angle<T: Real>(
     dv: &Vec2<T>,
 ) -> (T, Vec2<T>, Vec2<T>) {
     let sigma_k = if k == 0 { sigma } else { -sigma };
-    // n_k = J s_uk = −J s_ku.
-    let g = geometry::perp(s_to_apex) * -sigma_k;
-    let gamma_k = gamma + g.dot(&(delta * stiffness + dv * damping)) / r_k;
-    (gamma_k, g, g * (-gamma_k / r_k))
+    // n_k = J s_uk = −J s_ku, so g_k = −σ_k J s_ku and g_kᵀ x = −σ_k (s_ku × x).
+    let x = delta * stiffness + dv * damping;
+    let gamma_k = gamma - sigma_k * geometry::cross(s_to_apex, &x) / r_k;
+    // U_k = −(γ_k / r_k) g_k = (σ_k γ_k / r_k) J s_ku.
+    let j_s = geometry::perp(s_to_apex);
+    (gamma_k, j_s * -sigma_k, j_s * (sigma_k * gamma_k / r_k))
 }
 
 /// S7: port effort `γ_α = c_α ỹ_α + d_α ẏ_α`.
