@@ -43,7 +43,7 @@ pub fn apex_angle<T: Real>(
         gamma,
         t: geo.t,
         g: geo.g,
-        sigma: geometry::cross(&s[0], &s[1]),
+        sigma: geo.sigma,
         // S8.
         force: apex_force(gamma, &geo.g, r),
     }
