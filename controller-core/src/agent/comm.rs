@@ -7,7 +7,7 @@ use super::Agent;
 use crate::config::AgentId;
 use crate::wire::auth::{self, Counter};
 use crate::wire::{check_mode, quant, FrameError, Integrity, RawAngle};
-use crate::{Real, Vec2};
+use crate::{law, Real, Vec2};
 
 /// A broadcast item at full precision (the wire rounds the angle's values to binary16).
 #[derive(Clone, Copy, Debug)]
@@ -282,13 +282,14 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 .get_mut(flat / 2)
                 .and_then(|t| t.get_mut(flat % 2));
             if let Some(AngleState {
-                side: Side::Far { remote, age, .. },
+                side: Side::Far { k, remote, age },
                 ..
             }) = a
             {
                 *remote = Remote {
                     gamma,
-                    sigma,
+                    // S6: this far vertex's sign, once here rather than every step.
+                    sigma: law::far_sigma(sigma, *k),
                     rho,
                     v_ref,
                 };

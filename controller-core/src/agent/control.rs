@@ -200,7 +200,6 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     let (gamma_k, g_k, f) = law::far_angle(
                         remote.gamma,
                         remote.sigma,
-                        k,
                         r,
                         &s_ku,
                         a.stiffness,

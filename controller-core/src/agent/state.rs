@@ -54,7 +54,7 @@ pub(super) struct ApexPart<T: Real> {
 pub(super) struct Remote<T: Real> {
     /// `γ_α` (S7) as the apex computed it.
     pub gamma: T,
-    /// `σ_α`.
+    /// `σ_k = ±σ_α` for this far vertex ([`crate::law::far_sigma`], applied on receipt).
     pub sigma: T,
     /// The apex's distance to this agent (`ρ_k`).
     pub rho: T,
