@@ -56,10 +56,18 @@ pub fn cosine_rate_shares<T: Real>(s: &[Vec2<T>; 2], s_dot: &[Vec2<T>; 2]) -> [T
     [s[1].dot(&s_dot[0]), s[0].dot(&s_dot[1])]
 }
 
-/// S6: `g_{α,v} = P(s_uv) s_uw` and `g_{α,w} = P(s_uw) s_uv`.
+/// S6: `g_{α,v} = P(s_uv) s_uw` and `g_{α,w} = P(s_uw) s_uv`, as `σ J s_uv` and
+/// `−σ J s_uw` with `σ = s_uv × s_uw` (for unit `s`, `P(s) x = (J s)(J s)ᵀ x` and
+/// `(J s_uv)ᵀ s_uw = σ = −(J s_uw)ᵀ s_uv`: the same vectors in four multiplications).
 #[inline]
 pub fn jacobian_directions<T: Real>(s: &[Vec2<T>; 2]) -> [Vec2<T>; 2] {
-    [project(&s[0], &s[1]), project(&s[1], &s[0])]
+    directions_of(s, cross(&s[0], &s[1]))
+}
+
+/// [`jacobian_directions`] with `σ = s_uv × s_uw` already known.
+#[inline]
+fn directions_of<T: Real>(s: &[Vec2<T>; 2], sigma: T) -> [Vec2<T>; 2] {
+    [perp(&s[0]) * sigma, perp(&s[1]) * -sigma]
 }
 
 /// Everything S4–S6 give for one angle, from its apex's two bearings and their rates.
@@ -73,6 +81,8 @@ pub struct AngleGeometry<T: Real> {
     pub t: [T; 2],
     /// S6: `g_{α,v}`, `g_{α,w}`.
     pub g: [Vec2<T>; 2],
+    /// `σ = s_uv × s_uw = sin α` (signed): `g_{α,v} = σ J s_uv`, `g_{α,w} = −σ J s_uw`.
+    pub sigma: T,
 }
 
 impl<T: Real> AngleGeometry<T> {
@@ -80,11 +90,13 @@ impl<T: Real> AngleGeometry<T> {
     #[inline]
     pub fn new(s: &[Vec2<T>; 2], s_dot: &[Vec2<T>; 2]) -> Self {
         let t = cosine_rate_shares(s, s_dot);
+        let sigma = cross(&s[0], &s[1]);
         Self {
             y: cosine(s),
             y_dot: t[0] + t[1],
             t,
-            g: jacobian_directions(s),
+            g: directions_of(s, sigma),
+            sigma,
         }
     }
 }

@@ -43,27 +43,27 @@ pub fn apex_angle<T: Real>(
         gamma,
         t: geo.t,
         g: geo.g,
-        sigma: geometry::cross(&s[0], &s[1]),
+        sigma: geo.sigma,
         // S8.
         force: apex_force(gamma, &geo.g, r),
     }
 }
 
 /// The far vertex `k` of an angle `α = (u; v, w)` (`k = 0` for `v`, 1 for `w`): its S8 force
-/// and its port effort, from what the apex sent — `γ_α` (S7), `σ = s_uv × s_uw` — and its
-/// own fresh bearing to the apex `s_ku` (`s_uk = −s_ku`, SPEC §2), its distance `r_k` to
-/// the apex (the apex's shared estimate, its own copy, or its range: SPEC §6), and its own
-/// motion relative to the apex since the apex measured: displacement `δ` and change of
-/// own velocity `Δv`. With `n_k = J s_uk` and `σ_k = ±σ`, `g_{α,k} = σ_k n_k` (S6), so to
-/// first order `Δy = g_kᵀ δ / r_k` and `Δẏ = g_kᵀ Δv / r_k` (S4, S5), and
+/// and its port effort, from what the apex sent — `γ_α` (S7), `σ = s_uv × s_uw` as
+/// `σ_k = ±σ` ([`far_sigma`], applied when the item arrives) — and its own fresh bearing
+/// to the apex `s_ku` (`s_uk = −s_ku`, SPEC §2), its distance `r_k` to the apex (the
+/// apex's shared estimate, its own copy, or its range: SPEC §6), and its own motion
+/// relative to the apex since the apex measured: displacement `δ` and change of own
+/// velocity `Δv`. With `n_k = J s_uk`, `g_{α,k} = σ_k n_k` (S6), so to first order
+/// `Δy = g_kᵀ δ / r_k` and `Δẏ = g_kᵀ Δv / r_k` (S4, S5), and
 /// `γ_k = γ_α + c_α Δy + d_α Δẏ` (S7): the far vertex's own stiffness and damping act on
 /// fresh measurements. Returns `(γ_k, g_k, U_k)` with `U_k = −(γ_k / r_k) g_k` (S8).
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub fn far_angle<T: Real>(
     gamma: T,
-    sigma: T,
-    k: usize,
+    sigma_k: T,
     r_k: T,
     s_to_apex: &Vec2<T>,
     stiffness: T,
@@ -71,11 +71,23 @@ pub fn far_angle<T: Real>(
     delta: &Vec2<T>,
     dv: &Vec2<T>,
 ) -> (T, Vec2<T>, Vec2<T>) {
-    let sigma_k = if k == 0 { sigma } else { -sigma };
-    // n_k = J s_uk = −J s_ku.
-    let g = geometry::perp(s_to_apex) * -sigma_k;
-    let gamma_k = gamma + g.dot(&(delta * stiffness + dv * damping)) / r_k;
-    (gamma_k, g, g * (-gamma_k / r_k))
+    // n_k = J s_uk = −J s_ku, so g_k = −σ_k J s_ku and g_kᵀ x = −σ_k (s_ku × x).
+    let x = delta * stiffness + dv * damping;
+    let gamma_k = gamma - sigma_k * geometry::cross(s_to_apex, &x) / r_k;
+    // U_k = −(γ_k / r_k) g_k = (σ_k γ_k / r_k) J s_ku.
+    let j_s = geometry::perp(s_to_apex);
+    (gamma_k, j_s * -sigma_k, j_s * (sigma_k * gamma_k / r_k))
+}
+
+/// S6: the sign of far vertex `k`'s direction, `g_{α,v} = σ J s_uv` and
+/// `g_{α,w} = −σ J s_uw`: `σ_k = σ` for `k = 0`, `−σ` for `k = 1`.
+#[inline]
+pub fn far_sigma<T: Real>(sigma: T, k: usize) -> T {
+    if k == 0 {
+        sigma
+    } else {
+        -sigma
+    }
 }
 
 /// S7: port effort `γ_α = c_α ỹ_α + d_α ẏ_α`.

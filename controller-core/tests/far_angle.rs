@@ -59,7 +59,7 @@ proptest! {
         let s_to_apex = (q[0] - q[far]) / r;
         // Nothing moved: exactly S8 on the far vertex, and the apex's γ.
         let (gamma_k, g, f) =
-            law::far_angle(a.gamma, a.sigma, k, r, &s_to_apex, c, d, &Vec2::zeros(), &Vec2::zeros());
+            law::far_angle(a.gamma, law::far_sigma(a.sigma, k), r, &s_to_apex, c, d, &Vec2::zeros(), &Vec2::zeros());
         let s8 = a.g[k] * (-a.gamma / r);
         prop_assert!((f - s8).norm() <= 1e-9 * (1.0 + s8.norm()), "{:?} vs {:?}", f, s8);
         prop_assert!((g - a.g[k]).norm() <= 1e-12);
@@ -69,7 +69,7 @@ proptest! {
         vel1[far] += dv;
         let exact = apex(&q, &vel1, cos_d, c, d).gamma;
         let (approx, ..) =
-            law::far_angle(a.gamma, a.sigma, k, r, &s_to_apex, c, d, &Vec2::zeros(), &dv);
+            law::far_angle(a.gamma, law::far_sigma(a.sigma, k), r, &s_to_apex, c, d, &Vec2::zeros(), &dv);
         prop_assert!((approx - exact).abs() <= 1e-9 * (1.0 + exact.abs()), "{} vs {}", approx, exact);
         // The far vertex moved by ε·dir (everybody moving together): second order.
         let same = [vu; 3];
@@ -79,7 +79,7 @@ proptest! {
             q1[far] += dir * (0.01 * eps);
             let exact = apex(&q1, &same, cos_d, c, d).gamma;
             let (approx, ..) = law::far_angle(
-                a.gamma, a.sigma, k, r, &s_to_apex, c, d,
+                a.gamma, law::far_sigma(a.sigma, k), r, &s_to_apex, c, d,
                 &(dir * (0.01 * eps)), &Vec2::zeros(),
             );
             ((approx - exact).abs(), (a.gamma - exact).abs())

@@ -77,7 +77,7 @@
 /**
  * Bytes of agent memory (`sizeof` the agent, for 32-bit targets such as Cortex-M).
  */
-#define PH_AGENT_SIZE 3452
+#define PH_AGENT_SIZE 3404
 #endif
 
 #if defined(PH_PTR64)

@@ -7,7 +7,7 @@ use super::Agent;
 use crate::config::AgentId;
 use crate::wire::auth::{self, Counter};
 use crate::wire::{check_mode, quant, FrameError, Integrity, RawAngle};
-use crate::{Real, Vec2};
+use crate::{law, Real, Vec2};
 
 /// A broadcast item at full precision (the wire rounds the angle's values to binary16).
 #[derive(Clone, Copy, Debug)]
@@ -127,20 +127,39 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         result
     }
 
+    /// [`Agent::receive`] without the counting: one copy of [`Agent::receive_in`] for
+    /// `auth` and one for `crc16`/`link`, so that the integrity mode is tested once per
+    /// frame and the `crc16`/`link` path carries none of the `auth` path's work.
     fn receive_inner(&mut self, bytes: &[u8]) -> Result<(), FrameError> {
-        let frame = check_mode(bytes, self.config.integrity, self.mode)?;
+        match self.config.integrity {
+            Integrity::Auth(key) => self.receive_in(bytes, Integrity::Auth(key)),
+            Integrity::Crc16 => self.receive_in(bytes, Integrity::Crc16),
+            Integrity::Link => self.receive_in(bytes, Integrity::Link),
+        }
+    }
+
+    /// Checks and applies one frame for a receiver with `integrity` (its configured mode,
+    /// a constant where it is inlined).
+    #[inline(always)]
+    fn receive_in(&mut self, bytes: &[u8], integrity: Integrity) -> Result<(), FrameError> {
+        let frame = check_mode(bytes, integrity, self.mode)?;
         let sender = frame.header.sender;
         if sender == self.config.id {
             return Err(FrameError::OwnFrame);
         }
-        let slot = self.slot(sender).ok_or(FrameError::UnknownSender(sender))?;
+        let slot = self
+            .sender_slot(sender)
+            .ok_or(FrameError::UnknownSender(sender))?;
+        // The next frame is probably from the next slot (wrapping; a slot number that
+        // does not fit only makes the next look-up search).
+        self.next_slot = u8::try_from(slot + 1).unwrap_or(0);
         let timeout = self.config.limits.neighbour_timeout;
         let n = self
             .neighbours
             .get(slot)
             .ok_or(FrameError::UnknownSender(sender))?;
         let seq = frame.header.seq;
-        let accepted_counter = if let Integrity::Auth(key) = &self.config.integrity {
+        let accepted_counter = if let Integrity::Auth(key) = &integrity {
             // The replay check first (cheap), then the tag, with the counter as carried
             // or as reconstructed from the last accepted one.
             let last = n.last_counter.map(auth::load);
@@ -168,19 +187,17 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         // The whole frame is valid before anything is applied. With estimators, the
         // distances are estimates: at least r_min (as rounded: rounding is monotone).
         frame.validate(self.rho_min_code)?;
+        let [vx, vy] = frame.velocity;
         if let Some(n) = self.neighbours.get_mut(slot) {
             n.last_seq = Some(seq);
             if accepted_counter.is_some() {
                 n.last_counter = accepted_counter;
             }
             n.age = T::zero();
+            // The velocity item (as `apply` stores it, without a second look-up).
+            n.velocity = Vec2::new(T::of_f32(vx), T::of_f32(vy));
         }
         self.oldest = None;
-        let [vx, vy] = frame.velocity;
-        self.apply(
-            slot,
-            Item::Velocity(Vec2::new(T::of_f32(vx), T::of_f32(vy))),
-        );
         let me = self.config.id;
         for RawAngle { far, codes } in frame.raw_items() {
             // Only the items for angles of which this agent is a far vertex. Validated:
@@ -229,7 +246,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         match item {
             Item::Velocity(v) => {
                 if let Some(n) = self.neighbours.get_mut(slot) {
-                    n.velocity = Some(v);
+                    n.velocity = v;
                 }
             }
             Item::Angle {
@@ -265,13 +282,14 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 .get_mut(flat / 2)
                 .and_then(|t| t.get_mut(flat % 2));
             if let Some(AngleState {
-                side: Side::Far { remote, age, .. },
+                side: Side::Far { k, remote, age },
                 ..
             }) = a
             {
                 *remote = Remote {
                     gamma,
-                    sigma,
+                    // S6: this far vertex's sign, once here rather than every step.
+                    sigma: law::far_sigma(sigma, *k),
                     rho,
                     v_ref,
                 };

@@ -163,10 +163,8 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     force += p.force;
                     if mode != EstimatorMode::Measured {
                         let (nv, nw) = (nb(a.slots[1])?, nb(a.slots[2])?);
-                        let (Some(vv), Some(vw)) = (nv.velocity, nw.velocity) else {
-                            let missing = if nv.velocity.is_none() { nv.id } else { nw.id };
-                            return Err(Fault::MissingData(missing));
-                        };
+                        // Broadcast velocities: every neighbour was heard (`check_fresh`).
+                        let (vv, vw) = (nv.velocity, nw.velocity);
                         let gain = a.estimator_gain;
                         // S3 with the own bearings s_uv, s_uw and the far vertices' velocities.
                         let rr = [
@@ -195,14 +193,13 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     // Own motion relative to the apex since it measured (taken as the tick
                     // before the frame arrived): displacement at the current relative
                     // velocity, change of own velocity since the frame arrived.
-                    let v_apex = n.velocity()?;
+                    let v_apex = n.velocity;
                     let delta = (v - v_apex) * age;
                     let dv = v - remote.v_ref;
                     // S6–S8 on this far vertex.
                     let (gamma_k, g_k, f) = law::far_angle(
                         remote.gamma,
                         remote.sigma,
-                        k,
                         r,
                         &s_ku,
                         a.stiffness,
@@ -227,7 +224,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         if let Some(l) = &c.leader {
             // S11 with z = q_a − q_b; the partner offset p = q_partner − q_self.
             let p = self.partner_offset.ok_or(Fault::MissingPartnerOffset)?;
-            let v_p = self.neighbour(self.partner_slot)?.velocity()?;
+            let v_p = self.neighbour(self.partner_slot)?.velocity;
             let z_star = vec2(l.displacement.at(self.time));
             force += match l.role {
                 LeaderRole::A => {

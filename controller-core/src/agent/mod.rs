@@ -72,6 +72,10 @@ pub struct Agent<T: Real, const MT: usize, const NB: usize> {
     rho_min_code: u16,
     /// The mode byte of this agent's frames (and of the frames it accepts).
     mode: u8,
+    /// The neighbour slot after the sender of the last frame received: where
+    /// [`Agent::receive`] looks for the next sender first (neighbours are usually heard
+    /// in the same order every tick, so the look-up takes one comparison).
+    next_slot: u8,
     stats: FrameStats,
 }
 
@@ -107,6 +111,17 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
 
     fn slot(&self, id: AgentId) -> Option<usize> {
         self.neighbours.iter().position(|n| n.id == id)
+    }
+
+    /// [`Agent::slot`] of a frame's sender: [`Agent::next_slot`] first, the search only
+    /// if that is not it.
+    #[inline(always)]
+    fn sender_slot(&self, id: AgentId) -> Option<usize> {
+        let hint = usize::from(self.next_slot);
+        match self.neighbours.get(hint) {
+            Some(n) if n.id == id => Some(hint),
+            _ => self.slot(id),
+        }
     }
 
     fn neighbour(&self, slot: usize) -> Result<&Neighbour<T, MT>, Fault> {

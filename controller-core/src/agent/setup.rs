@@ -109,6 +109,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             writer,
             rho_min_code,
             mode,
+            next_slot: 0,
             stats: FrameStats::default(),
         })
     }

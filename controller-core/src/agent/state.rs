@@ -54,7 +54,7 @@ pub(super) struct ApexPart<T: Real> {
 pub(super) struct Remote<T: Real> {
     /// `γ_α` (S7) as the apex computed it.
     pub gamma: T,
-    /// `σ_α`.
+    /// `σ_k = ±σ_α` for this far vertex ([`crate::law::far_sigma`], applied on receipt).
     pub sigma: T,
     /// The apex's distance to this agent (`ρ_k`).
     pub rho: T,
@@ -103,7 +103,10 @@ pub(super) struct Neighbour<T: Real, const MT: usize> {
     pub last_seq: Option<u16>,
     /// `auth`: the counter of the last frame accepted from it (see [`crate::wire::auth`]).
     pub last_counter: Option<crate::wire::auth::StoredCounter>,
-    pub velocity: Option<Vec2<T>>,
+    /// The velocity it last broadcast (zero before its first frame). Every accepted frame
+    /// carries one, and the law reads it only after `check_fresh` passed (every neighbour
+    /// heard within the timeout): no `Option` to test at each use.
+    pub velocity: Vec2<T>,
     /// The last bearing `s` to it (zero before the first).
     pub s: Vec2<T>,
     /// The bearing rate `ṡ` that goes with `s`.
@@ -124,7 +127,7 @@ impl<T: Real, const MT: usize> Neighbour<T, MT> {
             age: T::lit(f64::INFINITY),
             last_seq: None,
             last_counter: None,
-            velocity: None,
+            velocity: Vec2::zeros(),
             s: Vec2::zeros(),
             rate: Vec2::zeros(),
             bearing_age: T::lit(f64::NEG_INFINITY),
@@ -141,12 +144,6 @@ impl<T: Real, const MT: usize> Neighbour<T, MT> {
         } else {
             Err(Fault::MissingBearing(self.id))
         }
-    }
-
-    /// The last velocity it broadcast, or [`Fault::MissingData`].
-    #[inline]
-    pub(super) fn velocity(&self) -> Result<Vec2<T>, Fault> {
-        self.velocity.ok_or(Fault::MissingData(self.id))
     }
 
     /// This tick's range measurement, or [`Fault::MissingRange`].

@@ -61,9 +61,10 @@ pub enum Fault {
     MissingBearing(AgentId),
     /// Nothing heard from this neighbour for longer than the timeout (or ever).
     Stale(AgentId),
-    /// This neighbour's frames lacked something the step needs: its velocity, or (as the
-    /// apex of an angle this agent is a far vertex of) the angle's effort, or that effort
-    /// is older than the neighbour timeout.
+    /// This neighbour's frames lacked something the step needs: as the apex of an angle
+    /// this agent is a far vertex of, the angle's effort, or that effort is older than the
+    /// neighbour timeout. (A neighbour never heard is [`Fault::Stale`] first, and every
+    /// frame carries the sender's velocity.)
     MissingData(AgentId),
     /// A leader without the partner's relative position.
     MissingPartnerOffset,

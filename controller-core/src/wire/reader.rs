@@ -51,11 +51,19 @@ const _: () = assert!(
 impl RawAngle {
     #[inline(always)]
     fn of(b: &[u8; ANGLE_ITEM_LEN]) -> Self {
-        let [v, w, g0, g1, s0, s1, a0, a1, b0, b1] = *b;
-        let code = |lo: u8, hi: u8| u16::from_le_bytes([lo, hi]);
+        // Five little-endian 16-bit words (half-word loads on target): the far vertices,
+        // then the codes.
+        let [far, g, s, r0, r1] = b.as_chunks::<2>().0 else {
+            // Unreachable: ten bytes are five pairs (the check folds away).
+            return Self {
+                far: [0; 2],
+                codes: [0; 4],
+            };
+        };
+        let code = |c: &[u8; 2]| u16::from_le_bytes(*c);
         Self {
-            far: [v, w],
-            codes: [code(g0, g1), code(s0, s1), code(a0, a1), code(b0, b1)],
+            far: *far,
+            codes: [code(g), code(s), code(r0), code(r1)],
         }
     }
 }
@@ -125,8 +133,8 @@ impl<'a> FrameView<'a> {
     /// finite `γ`, `|σ| ≤ 1`, and distances at least `rho_min` (a binary16 code of a
     /// positive value: the receiver's `r_min` as rounded, or 1 for any positive value).
     /// Reads nothing but bits (no float conversion: binary16 codes of positive values are
-    /// ordered like the values).
-    #[inline]
+    /// ordered like the values). Always inlined: the receiver's view stays in registers.
+    #[inline(always)]
     pub fn validate(&self, rho_min: u16) -> Result<(), FrameError> {
         let [vx, vy] = self.velocity;
         // `x·0` is ±0 for finite `x` and NaN otherwise: one comparison for both.
@@ -184,8 +192,9 @@ pub fn check_frame(
     check_mode(bytes, integrity, mode_byte(integrity, estimator))
 }
 
-/// [`check_frame`] against the receiver's mode byte (see [`super::mode_byte`]).
-#[inline]
+/// [`check_frame`] against the receiver's mode byte (see [`super::mode_byte`]). Always
+/// inlined: where `integrity` is a constant, the other modes' checks fold away.
+#[inline(always)]
 pub(crate) fn check_mode(
     bytes: &[u8],
     integrity: Integrity,
@@ -205,7 +214,10 @@ pub(crate) fn check_mode(
             return Err(FrameError::BadCrc);
         }
     }
-    let [mode, sender, q0, q1, v0, v1, v2, v3, w0, w1, w2, w3] = *head;
+    // The velocity as two 4-byte arrays: one (unaligned) word load each on target.
+    let [mode, sender, q0, q1, ref velocity @ ..] = *head;
+    let [ref vx @ .., _, _, _, _] = *velocity;
+    let [_, _, _, _, ref vy @ ..] = *velocity;
     if mode >> 4 != WIRE_VERSION {
         return Err(FrameError::UnknownVersion(mode >> 4));
     }
@@ -234,10 +246,7 @@ pub(crate) fn check_mode(
     };
     Ok(FrameView {
         header: FrameHeader { mode, sender, seq },
-        velocity: [
-            f32::from_le_bytes([v0, v1, v2, v3]),
-            f32::from_le_bytes([w0, w1, w2, w3]),
-        ],
+        velocity: [f32::from_le_bytes(*vx), f32::from_le_bytes(*vy)],
         items,
         signed,
     })

@@ -78,17 +78,20 @@ impl FrameWriter {
         if end + self.integrity.trailer_len() > MAX_FRAME_LEN {
             return false;
         }
-        let [g0, g1] = codes[0].to_le_bytes();
-        let [s0, s1] = codes[1].to_le_bytes();
-        let [a0, a1] = codes[2].to_le_bytes();
-        let [b0, b1] = codes[3].to_le_bytes();
+        // The item as five little-endian 16-bit words (far vertices, then the codes):
+        // five half-word stores on target rather than ten byte stores.
+        let [g, s, a, b] = codes;
+        let words = [u16::from_le_bytes(far), g, s, a, b];
         let slot = self
             .buf
             .get_mut(self.len..)
             .and_then(|b| b.first_chunk_mut::<ANGLE_ITEM_LEN>());
         match slot {
             Some(d) => {
-                *d = [far[0], far[1], g0, g1, s0, s1, a0, a1, b0, b1];
+                let (pairs, _) = d.as_chunks_mut::<2>();
+                for (pair, w) in pairs.iter_mut().zip(words) {
+                    *pair = w.to_le_bytes();
+                }
                 self.len = end;
                 true
             }
