@@ -46,19 +46,22 @@ fn state(n: usize, ticks: usize, threads: usize) -> (Vec<u64>, [u64; 4]) {
         .num_threads(threads)
         .build()
         .expect("pool");
-    pool.install(|| {
-        let mut sim = SampledSim::new(&m).expect("sim");
-        sim.advance_ticks(0.0, ticks);
-        let (q, v, est) = sim.view();
-        let bits = q
-            .iter()
-            .chain(v)
-            .flat_map(|p| [p.x.to_bits(), p.y.to_bits()])
-            .chain(est.iter().map(|e| e.to_bits()))
-            .collect();
-        let c = sim.frame_counts();
-        (bits, [c.broadcasts, c.sent, c.delivered, c.accepted])
-    })
+    pool.install(|| snapshot(&m, ticks))
+}
+
+/// Bits of the plant state and estimates, and the frame counters, after `ticks` ticks.
+fn snapshot(m: &host_sim::Model, ticks: usize) -> (Vec<u64>, [u64; 4]) {
+    let mut sim = SampledSim::new(m).expect("sim");
+    sim.advance_ticks(0.0, ticks);
+    let (q, v, est) = sim.view();
+    let bits = q
+        .iter()
+        .chain(v)
+        .flat_map(|p| [p.x.to_bits(), p.y.to_bits()])
+        .chain(est.iter().map(|e| e.to_bits()))
+        .collect();
+    let c = sim.frame_counts();
+    (bits, [c.broadcasts, c.sent, c.delivered, c.accepted])
 }
 
 #[test]
@@ -82,21 +85,8 @@ fn direct_delivery_is_what_the_queue_delivers() {
         let mut m = strip_model(60, 10.0);
         m.radio.latency = latency;
         let direct = host_sim::engine::direct_radio(&m);
-        let mut sim = SampledSim::new(&m).expect("sim");
-        sim.advance_ticks(0.0, 200);
-        let (q, v, est) = sim.view();
-        let bits: Vec<u64> = q
-            .iter()
-            .chain(v)
-            .flat_map(|p| [p.x.to_bits(), p.y.to_bits()])
-            .chain(est.iter().map(|e| e.to_bits()))
-            .collect();
-        let c = sim.frame_counts();
-        (
-            direct,
-            bits,
-            [c.broadcasts, c.sent, c.delivered, c.accepted],
-        )
+        let (bits, counts) = snapshot(&m, 200);
+        (direct, bits, counts)
     };
     let (direct, a, ca) = run(0.0);
     let (queued, b, cb) = run(0.006);
