@@ -7,9 +7,13 @@
 //! * a large run computed on two threads is bit-identical to one thread (the parallel
 //!   path of `SampledSim` draws its random numbers in agent order).
 //!
+//! * each in-process agent's capacity class (`LOCAL_CAPACITIES`) never changes a result.
+//!
 //! That the inner loop allocates nothing per tick is `tests/no_alloc.rs`.
 
-use host_sim::engine::{Engine, SampledSim, PARALLEL_MIN_AGENTS};
+use host_sim::design::{construct, render_scenario, DesignOptions, Generator, ScenarioOptions};
+use host_sim::engine::PARALLEL_MIN_AGENTS;
+use host_sim::engine::{AgentController, Engine, LocalCore, SampledSim, LOCAL_CAPACITIES};
 use host_sim::scenario::strip_model;
 
 /// Frames broadcast, copies sent and copies delivered per agent-tick over `ticks` ticks.
@@ -51,7 +55,11 @@ fn state(n: usize, ticks: usize, threads: usize) -> (Vec<u64>, [u64; 4]) {
 
 /// Bits of the plant state and estimates, and the frame counters, after `ticks` ticks.
 fn snapshot(m: &host_sim::Model, ticks: usize) -> (Vec<u64>, [u64; 4]) {
-    let mut sim = SampledSim::new(m).expect("sim");
+    snapshot_of(SampledSim::new(m).expect("sim"), ticks)
+}
+
+/// [`snapshot`] of a given simulation.
+fn snapshot_of(mut sim: SampledSim<'_>, ticks: usize) -> (Vec<u64>, [u64; 4]) {
     sim.advance_ticks(0.0, ticks);
     let (q, v, est) = sim.view();
     let bits = q
@@ -93,4 +101,57 @@ fn direct_delivery_is_what_the_queue_delivers() {
     assert!(direct && !queued);
     assert_eq!(ca, cb);
     assert!(a == b, "direct and queued delivery differ");
+}
+
+/// A designed formation from `g` (default design and scenario options).
+fn designed(g: Generator) -> host_sim::Model {
+    let p = g.points().expect("points");
+    let opts = DesignOptions::default();
+    let c = construct(&p, &opts).expect("construct");
+    let text = render_scenario(&p, &c, &opts, &ScenarioOptions::default()).expect("render");
+    host_sim::load_toml(&text, "designed", &[]).expect("load")
+}
+
+/// Agents in the smallest capacity that holds them compute what agents of the standard
+/// capacity compute, bit for bit: formations whose agents are in 1 to 8 triangles, so that
+/// every class of `LOCAL_CAPACITIES` is used.
+#[test]
+fn the_capacity_class_of_an_agent_never_changes_a_result() {
+    let models = [
+        strip_model(30, 10.0),
+        designed(Generator::TriangularLattice {
+            n: 40,
+            spacing: 1.0,
+        }),
+        designed(Generator::Polygon {
+            n: 9,
+            spacing: 1.0,
+            centre: true,
+        }),
+    ];
+    let mut used = [false; LOCAL_CAPACITIES.len()];
+    for m in &models {
+        for i in 0..m.n() {
+            let t = m.triangles_of(i).count();
+            let class = LOCAL_CAPACITIES
+                .iter()
+                .position(|c| t <= c.0)
+                .expect("fits");
+            used[class] = true;
+        }
+        let standard: Vec<Box<dyn AgentController>> = (0..m.n())
+            .map(|i| Box::new(LocalCore::new(m.core_agent(i).expect("agent"))) as _)
+            .collect();
+        let reference = snapshot_of(SampledSim::with_controllers(m, standard).expect("sim"), 300);
+        assert!(
+            snapshot(m, 300) == reference,
+            "{}: the classes differ",
+            m.name
+        );
+    }
+    assert_eq!(
+        used,
+        [true; LOCAL_CAPACITIES.len()],
+        "a class is not exercised"
+    );
 }

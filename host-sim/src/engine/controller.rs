@@ -9,8 +9,8 @@
 
 use crate::engine::hil::{HilError, LinkStats};
 use crate::engine::radio::RadioFrame;
-use crate::model::CoreAgent;
-use controller_core::{FrameStats, Measurements, OwnedEstimate, StepOutput};
+use crate::model::{Model, MT, NB};
+use controller_core::{Agent, FrameStats, Measurements, OwnedEstimate, StepOutput};
 
 /// One agent's controller, as seen by the sampled simulator.
 pub trait AgentController: Send {
@@ -76,25 +76,57 @@ pub trait AgentController: Send {
     }
 }
 
-/// A `controller-core` agent running in the simulator's process.
+/// A `controller-core` agent running in the simulator's process, with capacity `M`
+/// triangles and `N` neighbours (by default the core's standard capacity; [`local_core`]
+/// picks the smallest that holds an agent).
 #[derive(Clone, Debug)]
-pub struct LocalCore {
-    agent: CoreAgent,
+pub struct LocalCore<const M: usize = MT, const N: usize = NB> {
+    agent: Agent<f64, M, N>,
 }
 
-impl LocalCore {
+impl<const M: usize, const N: usize> LocalCore<M, N> {
     /// Wraps a core agent.
-    pub fn new(agent: CoreAgent) -> Self {
+    pub fn new(agent: Agent<f64, M, N>) -> Self {
         Self { agent }
     }
 
     /// The wrapped agent.
-    pub fn agent(&self) -> &CoreAgent {
+    pub fn agent(&self) -> &Agent<f64, M, N> {
         &self.agent
     }
 }
 
-impl AgentController for LocalCore {
+/// The capacities (triangles, neighbours) of the in-process agents, smallest first; the
+/// last is the core's standard capacity. An agent takes the smallest that holds it: a
+/// strip's agent (3 triangles, 4 neighbours) is 2.6 KB instead of the standard 6 KB, which
+/// is what a 100,000-agent run walks through every tick (`docs/performance.md`).
+pub const LOCAL_CAPACITIES: [(usize, usize); 4] = [(2, 4), (3, 6), (6, 8), (MT, NB)];
+
+/// Agent `i`'s in-process controller in the smallest of [`LOCAL_CAPACITIES`] that holds
+/// its triangles and neighbours. Every capacity runs the same code on the same data, so
+/// the choice never changes a result (`tests/scaling.rs`).
+pub fn local_core(model: &Model, i: usize) -> Result<Box<dyn AgentController>, String> {
+    let triangles = model.triangles_of(i).count();
+    // One arm per capacity (const generics need literal indices); a refusal (more
+    // neighbours than the class holds) moves on to the next class.
+    macro_rules! try_class {
+        ($k:literal) => {
+            if triangles <= LOCAL_CAPACITIES[$k].0 {
+                const M: usize = LOCAL_CAPACITIES[$k].0;
+                const N: usize = LOCAL_CAPACITIES[$k].1;
+                if let Ok(a) = model.core_agent_in::<M, N>(i) {
+                    return Ok(Box::new(LocalCore::new(a)));
+                }
+            }
+        };
+    }
+    try_class!(0);
+    try_class!(1);
+    try_class!(2);
+    Ok(Box::new(LocalCore::new(model.core_agent(i)?)))
+}
+
+impl<const M: usize, const N: usize> AgentController for LocalCore<M, N> {
     fn id(&self) -> u8 {
         self.agent.id()
     }

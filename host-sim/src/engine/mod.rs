@@ -24,7 +24,7 @@ pub mod sensors;
 mod stats;
 
 pub use continuous::ContinuousSim;
-pub use controller::{AgentController, LocalCore};
+pub use controller::{local_core, AgentController, LocalCore, LOCAL_CAPACITIES};
 pub use driver::{drive, run, Engine};
 pub use error::RunError;
 pub use record::{NullRecorder, Recorder, Row};

@@ -12,7 +12,7 @@
 
 use super::attack::{AttackCounts, Attacks};
 use super::channel::ChannelStats;
-use super::controller::{AgentController, LocalCore};
+use super::controller::{local_core, AgentController};
 use super::driver::Engine;
 use super::hil::{HilError, LinkStats};
 use super::plant::Plant;
@@ -69,7 +69,7 @@ pub struct SampledSim<'m> {
     stats: ControlStats,
     /// Frames bypass [`Radio`]'s queue ([`direct_radio`]).
     direct: bool,
-    /// Every controller is a [`LocalCore`] (ticks may run in parallel).
+    /// Every controller is a [`LocalCore`](super::LocalCore) (ticks may run in parallel).
     local: bool,
     /// Bearings of every agent (parallel path), at `bear_start[i]..bear_start[i + 1]`.
     bear_all: Vec<BearingMeasurement<f64>>,
@@ -82,11 +82,12 @@ pub struct SampledSim<'m> {
 const FRAMES_PER_TICK: usize = 4;
 
 impl<'m> SampledSim<'m> {
-    /// A sampled simulation with a [`LocalCore`] for every agent.
+    /// A sampled simulation with a [`LocalCore`](super::LocalCore) for every agent, each
+    /// in the smallest capacity that holds it ([`local_core`]).
     pub fn new(model: &'m Model) -> Result<Self, String> {
         let mut controllers: Vec<Box<dyn AgentController>> = Vec::with_capacity(model.n());
         for i in 0..model.n() {
-            controllers.push(Box::new(LocalCore::new(model.core_agent(i)?)));
+            controllers.push(local_core(model, i)?);
         }
         let mut sim = Self::with_controllers(model, controllers)?;
         sim.local = true;

@@ -28,6 +28,12 @@ impl Model {
 
     /// Agent `i`'s controller-core configuration. Fails only beyond the capacity `MT`.
     pub fn agent_config(&self, i: usize) -> Result<AgentConfig<f64, MT>, String> {
+        self.agent_config_in::<MT>(i)
+    }
+
+    /// Agent `i`'s controller-core configuration with triangle capacity `M`. Fails when
+    /// the agent belongs to more than `M` triangles, naming the agent.
+    pub fn agent_config_in<const M: usize>(&self, i: usize) -> Result<AgentConfig<f64, M>, String> {
         let a = self
             .agents
             .get(i)
@@ -48,7 +54,7 @@ impl Model {
             };
             c.triangles.push(tc).map_err(|_| {
                 format!(
-                    "agent {} belongs to more than {MT} triangles (controller capacity)",
+                    "agent {} belongs to more than {M} triangles (controller capacity)",
                     a.name
                 )
             })?;
@@ -143,8 +149,19 @@ impl Model {
 
     /// Builds agent `i`'s controller-core agent.
     pub fn core_agent(&self, i: usize) -> Result<CoreAgent, String> {
-        let c = self.agent_config(i)?;
-        CoreAgent::new(c).map_err(|e| format!("controller-core refused agent index {i}: {e:?}"))
+        self.core_agent_in::<MT, NB>(i)
+    }
+
+    /// Builds agent `i`'s controller-core agent with capacity `M` triangles and `N`
+    /// neighbours (same behaviour as [`Model::core_agent`] whenever it fits: the core
+    /// walks only the triangles and neighbours it has).
+    pub fn core_agent_in<const M: usize, const N: usize>(
+        &self,
+        i: usize,
+    ) -> Result<controller_core::Agent<f64, M, N>, String> {
+        let c = self.agent_config_in::<M>(i)?;
+        controller_core::Agent::new(c)
+            .map_err(|e| format!("controller-core refused agent index {i}: {e:?}"))
     }
 }
 

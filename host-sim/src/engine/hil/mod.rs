@@ -34,7 +34,7 @@ pub use options::{
 };
 pub use stats::LinkStats;
 
-use crate::engine::controller::{AgentController, LocalCore};
+use crate::engine::controller::{local_core, AgentController};
 use crate::engine::{drive, Recorder, RunError, RunResult, SampledSim};
 use crate::model::{resolve_estimates, Model};
 use controller::{EstimateSlot, HilController, TargetHandle};
@@ -196,12 +196,10 @@ pub fn controllers(
                 Some(c) => out.push(Box::new(c)),
                 None => return Err(HilError::Usage(format!("agent index {i} twice"))),
             },
-            None => out.push(Box::new(LocalCore::new(model.core_agent(i).map_err(
-                |reason| HilError::Refused {
-                    agent: model.agents[i].name.clone(),
-                    reason,
-                },
-            )?))),
+            None => out.push(local_core(model, i).map_err(|reason| HilError::Refused {
+                agent: model.agents[i].name.clone(),
+                reason,
+            })?),
         }
     }
     Ok(out)
