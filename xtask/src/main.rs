@@ -5,7 +5,7 @@
 //!   `firmware-example/budgets.toml` (sizes, instructions per step, stack, no f64,
 //!   handler self-tests, the demo and UART QEMU tests).
 //! * `cargo xtask test`: everything `scripts/test.sh` runs after installing: rustfmt,
-//!   clippy (host and thumbv7em), builds, `cargo test`, firmware-check, host-sim's
+//!   clippy (host and thumbv7em), rustdoc, builds, `cargo test`, firmware-check, host-sim's
 //!   host-in-the-loop tests; then the duration of each phase.
 //! * `cargo xtask firmware-profile [REGION] [TOP]`: where the instructions of one
 //!   measured step go (by file and function).

@@ -73,6 +73,13 @@ fn phases(
                 .args(deny),
         )
     })?;
+    phase("rustdoc (host, warnings denied)", &mut || {
+        tools::run(
+            cargo()
+                .args(["doc", "--workspace", "--no-deps"])
+                .env("RUSTDOCFLAGS", "-D warnings"),
+        )
+    })?;
     phase("clippy and builds (thumbv7em-none-eabihf)", &mut || {
         let core = ["-p", "controller-core"];
         tools::run(cargo().arg("clippy").args(core).args(thumb).args(deny))?;

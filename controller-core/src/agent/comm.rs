@@ -54,7 +54,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// returns 0) on the steps that [`crate::AgentConfig::comm_every`] skips.
     ///
     /// `auth`: every frame carries the next counter; a broadcast of full frames only is
-    /// followed by a sync frame now and then (see [`SYNC_EVERY`]); after `2³² − 1` frames
+    /// followed by a sync frame now and then (every `SYNC_EVERY` frames); after `2³² − 1` frames
     /// in one boot epoch the agent sends nothing more (a counter is never reused).
     pub fn frames(&mut self, mut send: impl FnMut(&[u8])) -> usize {
         if !self.comm_due {

@@ -15,7 +15,7 @@ pub struct BearingMeasurement<T: Real> {
     /// Measured bearing rate `ṡ`, if the sensor gives one. Without it the agent uses the
     /// finite difference of successive bearings (zero on the first step).
     pub rate: Option<Vec2<T>>,
-    /// Measured distance, for [`EstimatorMode::Measured`].
+    /// Measured distance, for [`EstimatorMode::Measured`](crate::EstimatorMode::Measured).
     pub range: Option<T>,
 }
 
@@ -68,7 +68,7 @@ pub enum Fault {
     MissingData(AgentId),
     /// A leader without the partner's relative position.
     MissingPartnerOffset,
-    /// [`EstimatorMode::Measured`] without a range to this neighbour.
+    /// [`EstimatorMode::Measured`](crate::EstimatorMode::Measured) without a range to this neighbour.
     MissingRange(AgentId),
     /// The computed force was not finite.
     NonFinite,

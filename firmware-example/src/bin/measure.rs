@@ -5,7 +5,7 @@
 //! neighbours' frames of the measured tick), then measures, as regions of the
 //! QEMU instruction-count plugin (`tools/qemu-insn/`):
 //!
-//! * `<name>`: the whole control step ([`Bench::control_step`]: decode and
+//! * `<name>`: the whole control step ([`StepCtx::control_step`]: decode and
 //!   receive the neighbours' frames, `Agent::step`, encode the own frames),
 //!   [`REPEATS`] times, each on a freshly built bench (same state);
 //! * `<name>-rx`, `<name>-step`, `<name>-tx`: the three parts separately, on
@@ -29,7 +29,7 @@
 //!
 //! [`STEP_CONFIGS`]: firmware_example::workload::STEP_CONFIGS
 //! [`Bench`]: firmware_example::workload::Bench
-//! [`Bench::control_step`]: firmware_example::workload::Bench::control_step
+//! [`StepCtx::control_step`]: firmware_example::workload::StepCtx::control_step
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
 /// Times the whole step of each configuration is measured (the script

@@ -2,7 +2,7 @@
 //!
 //! The simulator gives a controller what the agent's own sensors measured and the frames
 //! its radio received since the last tick; the controller returns a force and the frames
-//! to broadcast. [`LocalCore`] runs a `controller-core` [`Agent`](controller_core::Agent)
+//! to broadcast. [`LocalCore`] runs a `controller-core` [`Agent`]
 //! in process; [`crate::engine::hil::controller::HilController`] runs it on an emulated target
 //! behind a UART. Remote controllers answer in two phases ([`AgentController::start_tick`],
 //! [`AgentController::finish_tick`]) so that several compute at once.

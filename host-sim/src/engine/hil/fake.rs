@@ -4,7 +4,7 @@
 //! with optional misbehaviour injected on the line (stop answering, corrupt an answer,
 //! answer out of protocol).
 //!
-//! The misbehaviour lives in the serial port ([`FakePort`]), not in a second copy of the
+//! The misbehaviour lives in the serial port (`FakePort`), not in a second copy of the
 //! protocol: the port sees every message the session writes (one COBS frame per write)
 //! and counts the `Output`s to know which tick an answer belongs to.
 
