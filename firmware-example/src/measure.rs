@@ -30,7 +30,7 @@ use core::hint::black_box;
 use core::mem::MaybeUninit;
 
 /// Number of distinct region ids (`0..MAX_REGIONS`).
-pub const MAX_REGIONS: usize = 32;
+pub const MAX_REGIONS: usize = 64;
 
 /// Marker table watched by the instruction-counting plugin.
 ///

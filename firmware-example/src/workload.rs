@@ -57,8 +57,9 @@ pub struct StepConfig {
 const AUTH: Integrity = Integrity::Auth(crate::keys::PLACEHOLDER_SWARM_KEY);
 
 /// The configurations measured by the `measure` binary, in order: `crc16`
-/// integrity (`triN`), and `auth` (`triN_auth`).
-pub const STEP_CONFIGS: [StepConfig; 6] = [
+/// integrity (`triN`), `link` (`triN_link`: no trailer, the radio checks its own
+/// CRC) and `auth` (`triN_auth`).
+pub const STEP_CONFIGS: [StepConfig; 8] = [
     StepConfig {
         name: "tri1",
         triangles: 1,
@@ -78,6 +79,16 @@ pub const STEP_CONFIGS: [StepConfig; 6] = [
         name: "tri8",
         triangles: 8,
         integrity: Integrity::Crc16,
+    },
+    StepConfig {
+        name: "tri2_link",
+        triangles: 2,
+        integrity: Integrity::Link,
+    },
+    StepConfig {
+        name: "tri8_link",
+        triangles: 8,
+        integrity: Integrity::Link,
     },
     StepConfig {
         name: "tri2_auth",

@@ -12,9 +12,9 @@
  * to and including the end store, and <k> numbers the occurrences of that id
  * (0, 1, …). At exit it prints `qemu-insn total=<all executed instructions>`.
  *
- * Arguments (-plugin libqemu-insn.so,marker=0x20000000,regions=32,out=FILE):
+ * Arguments (-plugin libqemu-insn.so,marker=0x20000000,regions=64,out=FILE):
  *   marker=ADDR   address of the marker table (required; hex or decimal)
- *   regions=N     number of region ids in the table (default 32)
+ *   regions=N     number of region ids in the table (default 64, the firmware's MAX_REGIONS)
  *   out=FILE      write the lines to FILE instead of QEMU's log (stderr)
  *   profile=ID    also count, per instruction address, the instructions
  *                 executed inside region ID (all its occurrences), and print
@@ -41,7 +41,7 @@ QEMU_PLUGIN_EXPORT int qemu_plugin_version = QEMU_INSN_API_VERSION;
 #define MAX_REGIONS_LIMIT 1024
 
 static uint64_t marker_base;
-static uint64_t n_regions = 32;
+static uint64_t n_regions = 64;
 static FILE *out_file;
 
 static uint64_t executed;                       /* all instructions so far */
