@@ -325,7 +325,69 @@ fn sent_angle<T: Real>(a: &AngleState<T>) -> Option<(T, T, [T; 2])> {
 
 #[cfg(test)]
 mod tests {
+    extern crate std;
     use super::unit_code;
+    use crate::wire::auth::{self, Counter};
+    use crate::wire::{Integrity, SwarmKey};
+    use crate::{Agent, AgentConfig, AngleConfig, TriangleConfig};
+
+    /// An `auth` agent `id` in the triangle (1, 2, 3).
+    fn auth_agent(id: u8) -> Agent<f32, 1, 2> {
+        let mut c = AgentConfig::new(id);
+        let angle = |apex| AngleConfig {
+            apex,
+            cos_desired: 0.5,
+            stiffness: 1.0,
+            damping: 0.5,
+            estimator_gain: 1.0,
+        };
+        c.triangles
+            .push(TriangleConfig {
+                vertices: [1, 2, 3],
+                angles: [angle(1), angle(2)],
+            })
+            .expect("capacity 1");
+        c.integrity = Integrity::Auth(SwarmKey::new([7; 16]));
+        Agent::new(c).expect("valid configuration")
+    }
+
+    /// Frames of one call of `frames`.
+    fn broadcast(a: &mut Agent<f32, 1, 2>) -> std::vec::Vec<std::vec::Vec<u8>> {
+        let mut out = std::vec::Vec::new();
+        a.frames(|f| out.push(f.to_vec()));
+        out
+    }
+
+    /// A boot epoch's last counters: frames up to number 2³² − 2 go out and are heard;
+    /// then the agent is silent (counter 2³² − 1 is never used, the epoch never spills
+    /// into the next one) until it starts a new boot epoch, whose frames are heard again.
+    #[test]
+    fn an_exhausted_boot_epoch_sends_nothing_until_the_next_epoch() {
+        let epoch: Counter = 7 << 32;
+        let mut sender = auth_agent(1);
+        let mut receiver = auth_agent(2);
+        sender.counter = auth::store(epoch + u64::from(u32::MAX) - 2);
+        for last in [2, 1] {
+            let frames = broadcast(&mut sender);
+            assert_eq!(frames.len(), 1);
+            receiver.receive(&frames[0]).expect("authentic and newer");
+            assert_eq!(
+                sender.next_counter(),
+                epoch + u64::from(u32::MAX) - last + 1
+            );
+        }
+        for _ in 0..3 {
+            assert!(broadcast(&mut sender).is_empty(), "a counter was reused");
+            assert_eq!(sender.next_counter(), epoch + u64::from(u32::MAX));
+        }
+        sender.set_boot_epoch(8);
+        let frames = broadcast(&mut sender);
+        assert_eq!(frames.len(), 1);
+        receiver
+            .receive(&frames[0])
+            .expect("the new epoch is newer");
+        assert_eq!(sender.next_counter(), (8 << 32) + 1);
+    }
 
     #[test]
     fn sigma_codes_are_limited_to_one() {
