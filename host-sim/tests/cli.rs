@@ -378,9 +378,10 @@ fn quiet_prints_nothing_and_failure_codes_are_distinct() {
     assert_eq!(o.status.code(), Some(13), "diverged");
 }
 
-/// `-j N` changes only the speed: a run large enough for the parallel path writes the same
-/// bytes on one and two threads; `--summary-only` writes summary.json alone, with the same
-/// figures.
+/// `-j N` changes only the speed: a run large enough for the parallel paths (agents' ticks,
+/// plant, reading the estimates: ≥ 2,048 agents; the diagnostics' angle terms: ≥ 2,048
+/// triangles) writes the same bytes on one and two threads; `--summary-only` writes
+/// summary.json alone, with the same figures.
 #[test]
 fn jobs_do_not_change_the_outputs_and_summary_only_skips_the_series() {
     let dir = tempfile::tempdir().expect("tempdir");

@@ -3,8 +3,16 @@
 //! from what the agents measured.
 
 use super::min_distance::MinDistance;
-use crate::model::{EstimateInfo, Model};
+use crate::model::{EstimateInfo, Model, TriangleModel};
 use controller_core::{energy, Vec2};
+use rayon::prelude::*;
+
+/// From this many triangles on, the per-angle and per-estimate terms are computed on every
+/// thread of the current rayon pool; the sums and maxima are then taken in model order, so
+/// the result is the same bits on any number of threads.
+pub const PARALLEL_MIN_TRIANGLES: usize = 2048;
+/// Triangles per parallel work item.
+const CHUNK: usize = 512;
 
 /// Everything the diagnostics know about one instant.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -49,6 +57,8 @@ pub struct Diagnostics {
     /// The latest snapshot.
     pub snap: Snapshot,
     min_distance: MinDistance,
+    /// Scratch: `½ c ỹ²` of every angle, model order.
+    angle_energy: Vec<f64>,
 }
 
 fn unit(d: Vec2<f64>) -> Vec2<f64> {
@@ -72,6 +82,7 @@ impl Diagnostics {
             estimates,
             snap,
             min_distance: MinDistance::new(model.n()),
+            angle_energy: vec![0.0; 2 * model.triangles.len()],
         }
     }
 
@@ -100,25 +111,42 @@ impl Diagnostics {
             s.finite &=
                 qi.x.is_finite() && qi.y.is_finite() && vi.x.is_finite() && vi.y.is_finite();
         }
-        s.v_ang = 0.0;
-        s.max_angle_err = 0.0;
-        for (t_i, tri) in model.triangles.iter().enumerate() {
-            for (a_i, a) in tri.angles.iter().enumerate() {
+        // Each angle's error and energy (independent: in parallel for large formations),
+        // then the sum and the maximum in model order.
+        let angles = |(tri, (err, en)): (&TriangleModel, (&mut [f64], &mut [f64]))| {
+            for ((a, err), en) in tri.angles.iter().zip(err).zip(en) {
                 let su = unit(q[a.far[0]] - q[a.apex]);
                 let sw = unit(q[a.far[1]] - q[a.apex]);
                 let y = su.dot(&sw);
-                s.v_ang += energy::angle(a.stiffness, y - a.desired.cos());
-                let err = y.clamp(-1.0, 1.0).acos() - a.desired;
-                if let Some(slot) = s.angle_err.get_mut(2 * t_i + a_i) {
-                    *slot = err;
-                }
-                // NaN propagates as "not settled".
-                s.max_angle_err = if err.is_nan() {
-                    f64::NAN
-                } else {
-                    s.max_angle_err.max(err.abs())
-                };
+                *en = energy::angle(a.stiffness, y - a.desired.cos());
+                *err = y.clamp(-1.0, 1.0).acos() - a.desired;
             }
+        };
+        let (errs, energies) = (&mut s.angle_err, &mut self.angle_energy);
+        if model.triangles.len() >= PARALLEL_MIN_TRIANGLES && rayon::current_num_threads() > 1 {
+            model
+                .triangles
+                .par_iter()
+                .zip(errs.par_chunks_mut(2).zip(energies.par_chunks_mut(2)))
+                .with_min_len(CHUNK)
+                .for_each(angles);
+        } else {
+            model
+                .triangles
+                .iter()
+                .zip(errs.chunks_mut(2).zip(energies.chunks_mut(2)))
+                .for_each(angles);
+        }
+        s.v_ang = 0.0;
+        s.max_angle_err = 0.0;
+        for (err, en) in s.angle_err.iter().zip(&self.angle_energy) {
+            s.v_ang += en;
+            // NaN propagates as "not settled".
+            s.max_angle_err = if err.is_nan() {
+                f64::NAN
+            } else {
+                s.max_angle_err.max(err.abs())
+            };
         }
         s.v_lead = 0.0;
         s.disp_err = 0.0;
