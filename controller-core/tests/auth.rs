@@ -7,9 +7,7 @@ mod testkit;
 
 use controller_core::wire::auth::{self, counter, reconstruct, COUNTER_EXT_LEN, TAG_LEN};
 use controller_core::wire::{decode_frame, mode_byte, FrameWriter, Integrity, SwarmKey};
-use controller_core::{
-    Agent, AgentConfig, AgentId, AngleConfig, EstimatorMode, FrameError, TriangleConfig,
-};
+use controller_core::{Agent, AgentConfig, AgentId, EstimatorMode, FrameError};
 use testkit::{fan, fan_positions, rng, sense_and_exchange, Formation, HostAgent, State};
 
 /// SipHash-2-4 with key `00 01 … 0f` of the messages `00 01 … (n−1)`, `n = 0..63`: the
@@ -190,22 +188,7 @@ type Receiver = Agent<f32, 1, 2>;
 
 /// Agent `id` of triangle (1, 2, 3) with angles at 1 and 2, `auth` integrity.
 fn config(id: AgentId) -> AgentConfig<f32, 1> {
-    let mut c = AgentConfig::new(id);
-    let angle = |apex| AngleConfig {
-        apex,
-        cos_desired: 0.5,
-        stiffness: 1.0,
-        damping: 0.5,
-        estimator_gain: 1.0,
-    };
-    c.triangles
-        .push(TriangleConfig {
-            vertices: [1, 2, 3],
-            angles: [angle(1), angle(2)],
-        })
-        .expect("capacity 1");
-    c.integrity = Integrity::Auth(KEY);
-    c
+    testkit::one_triangle(id, Integrity::Auth(KEY))
 }
 
 fn broadcast<const MT: usize, const NB: usize>(a: &mut Agent<f32, MT, NB>) -> Vec<Vec<u8>> {

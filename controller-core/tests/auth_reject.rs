@@ -10,12 +10,12 @@
 
 use controller_core::wire::auth::{counter, Counter};
 use controller_core::wire::{mode_byte, FrameWriter, Integrity, SwarmKey, MAX_FRAME_LEN};
-use controller_core::{
-    Agent, AgentConfig, AgentId, AngleConfig, EstimatorMode, FrameError, FrameStats, TriangleConfig,
-};
+use controller_core::{Agent, AgentConfig, AgentId, EstimatorMode, FrameError, FrameStats};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::collections::BTreeMap;
+
+mod testkit;
 
 /// Attempts per campaign.
 const N: usize = 1_000_000;
@@ -30,22 +30,7 @@ const OTHER: AgentId = 2;
 type Receiver = Agent<f32, 1, 2>;
 
 fn config(id: AgentId, key: SwarmKey) -> AgentConfig<f32, 1> {
-    let mut c = AgentConfig::new(id);
-    let angle = |apex| AngleConfig {
-        apex,
-        cos_desired: 0.5,
-        stiffness: 1.0,
-        damping: 0.5,
-        estimator_gain: 1.0,
-    };
-    c.triangles
-        .push(TriangleConfig {
-            vertices: [1, 2, 3],
-            angles: [angle(1), angle(2)],
-        })
-        .expect("capacity 1");
-    c.integrity = Integrity::Auth(key);
-    c
+    testkit::one_triangle(id, Integrity::Auth(key))
 }
 
 fn mode() -> u8 {

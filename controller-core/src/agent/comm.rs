@@ -327,26 +327,14 @@ fn sent_angle<T: Real>(a: &AngleState<T>) -> Option<(T, T, [T; 2])> {
 mod tests {
     extern crate std;
     use super::unit_code;
+    use crate::agent::test_support::one_triangle;
     use crate::wire::auth::{self, Counter};
     use crate::wire::{Integrity, SwarmKey};
-    use crate::{Agent, AgentConfig, AngleConfig, TriangleConfig};
+    use crate::Agent;
 
     /// An `auth` agent `id` in the triangle (1, 2, 3).
     fn auth_agent(id: u8) -> Agent<f32, 1, 2> {
-        let mut c = AgentConfig::new(id);
-        let angle = |apex| AngleConfig {
-            apex,
-            cos_desired: 0.5,
-            stiffness: 1.0,
-            damping: 0.5,
-            estimator_gain: 1.0,
-        };
-        c.triangles
-            .push(TriangleConfig {
-                vertices: [1, 2, 3],
-                angles: [angle(1), angle(2)],
-            })
-            .expect("capacity 1");
+        let mut c = one_triangle(id, [1, 2], 0.5);
         c.integrity = Integrity::Auth(SwarmKey::new([7; 16]));
         Agent::new(c).expect("valid configuration")
     }

@@ -245,30 +245,15 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
 
 #[cfg(test)]
 mod tests {
-    use crate::{
-        Agent, AgentConfig, AngleConfig, BearingMeasurement, Fault, Measurements, TriangleConfig,
-        Vec2,
-    };
+    use crate::agent::test_support::one_triangle;
+    use crate::{Agent, BearingMeasurement, Fault, Measurements, Vec2};
 
     /// A neighbour slot that does not exist (impossible by construction) is reported as
     /// `Fault::Internal`, not as a non-finite force or a panic.
     #[test]
     fn an_impossible_neighbour_slot_is_an_internal_fault() {
-        let angle = |apex| AngleConfig {
-            apex,
-            cos_desired: 0.5,
-            stiffness: 1.0,
-            damping: 0.0,
-            estimator_gain: 1.0,
-        };
-        let mut c = AgentConfig::<f64, 1>::new(1);
+        let mut c = one_triangle::<f64>(1, [2, 3], 0.0);
         c.limits.neighbour_timeout = 1e9;
-        c.triangles
-            .push(TriangleConfig {
-                vertices: [1, 2, 3],
-                angles: [angle(2), angle(3)],
-            })
-            .unwrap();
         let mut a = Agent::<f64, 1, 2>::new(c).unwrap();
         for n in a.neighbours.iter_mut() {
             n.age = 0.0;

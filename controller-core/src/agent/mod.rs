@@ -22,6 +22,8 @@ mod estimates;
 mod sensing;
 mod setup;
 mod state;
+#[cfg(test)]
+mod test_support;
 mod types;
 
 pub use types::{

@@ -4,6 +4,7 @@
 //!
 //! Agent `i` (index) has id `i + 1`.
 
+use controller_core::wire::Integrity;
 use controller_core::{
     geometry, AgentConfig, AgentId, AngleConfig, BearingMeasurement, EstimatorMode, LeaderConfig,
     LeaderRole, Measurements, Schedule, TriangleConfig, Vec2,
@@ -64,6 +65,27 @@ pub struct State {
     pub q: Vec<Vec2<f64>>,
     /// Velocities.
     pub v: Vec<Vec2<f64>>,
+}
+
+/// Agent `id` of the triangle (1, 2, 3) with controlled angles at 1 and 2 (desired
+/// cosine 0.5, c = 1, d = 0.5, c_e = 1) and `integrity`: the smallest formation.
+pub fn one_triangle(id: AgentId, integrity: Integrity) -> AgentConfig<f32, 1> {
+    let angle = |apex| AngleConfig {
+        apex,
+        cos_desired: 0.5,
+        stiffness: 1.0,
+        damping: 0.5,
+        estimator_gain: 1.0,
+    };
+    let mut c = AgentConfig::new(id);
+    c.triangles
+        .push(TriangleConfig {
+            vertices: [1, 2, 3],
+            angles: [angle(1), angle(2)],
+        })
+        .expect("capacity 1");
+    c.integrity = integrity;
+    c
 }
 
 /// Id of agent index `i`.
