@@ -140,6 +140,11 @@ impl<'a> Simulation<'a> {
     /// Worker threads of a large run (default: rayon's global pool, one per core). Runs of
     /// at least [`crate::engine::PARALLEL_MIN_AGENTS`] agents compute the agents' ticks and
     /// the plant on them; the result is the same for any number of threads.
+    ///
+    /// The run then happens on a worker of a private rayon pool. For one huge run per
+    /// process, sizing rayon's global pool instead (`rayon::ThreadPoolBuilder::build_global`,
+    /// as `host-sim run -j N` does) keeps it on the calling thread, whose allocator can
+    /// reuse what loading the scenario freed (0.6 GB less at 100,000 agents).
     pub fn threads(mut self, threads: usize) -> Self {
         self.threads = Some(threads);
         self
