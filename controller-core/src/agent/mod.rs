@@ -92,7 +92,11 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         &self.config
     }
 
-    /// Ids of all neighbours (triangle neighbours and leader partner).
+    /// Ids of all neighbours in slot order: the triangle neighbours in order of first
+    /// appearance in the configuration (per triangle, per angle: apex, then the far
+    /// vertices in vertex order), then the leader partner if it is not one of them.
+    /// Bearings given to [`Agent::step`] in this order (a prefix of it) are taken in one
+    /// pass; any other order gives the same result after a search per bearing.
     pub fn neighbours(&self) -> impl Iterator<Item = AgentId> + '_ {
         self.neighbours.iter().map(|n| n.id)
     }

@@ -9,6 +9,7 @@
 use super::driver::Engine;
 use super::plant::acceleration;
 use super::sensors::Sensors;
+use super::slot_order::SlotOrder;
 use super::stats::{ControlStats, FrameCounts};
 use crate::model::{
     resolve_estimates, BearingRate, CoreAgent, EstimateInfo, Estimator, Model, SensorModel,
@@ -36,6 +37,10 @@ struct Rhs {
     agents: Vec<CoreAgent>,
     sensors: Sensors,
     bearings: Vec<BearingMeasurement<f64>>,
+    /// Each agent's bearings go to its core in slot order ([`SlotOrder`]).
+    slot_order: SlotOrder,
+    /// Scratch of [`SlotOrder::apply`].
+    reordered: Vec<BearingMeasurement<f64>>,
     partner: Vec<Option<usize>>,
     ids: Vec<u8>,
     info: Vec<EstimateInfo>,
@@ -67,6 +72,8 @@ impl Rhs {
                     self.bearings.push(b);
                 }
             }
+            self.slot_order
+                .apply(i, &mut self.bearings, &mut self.reordered);
             let m = Measurements {
                 time: t,
                 dt: 0.0,
@@ -163,14 +170,22 @@ impl<'m> ContinuousSim<'m> {
         }
         y.extend(info.iter().map(|_| model.initial_estimate));
         let partner = model.partners();
+        let ids: Vec<u8> = model.agents.iter().map(|a| a.id).collect();
+        let slot_order = SlotOrder::new(
+            n,
+            |i| model.graph.triangle.of(i).iter().map(|&j| ids[j]).collect(),
+            |i| agents.get(i).map(|a| a.neighbours().collect()),
+        );
         let mut sim = Self {
             model,
             rhs: Rhs {
                 agents,
                 sensors: Sensors::new(&SensorModel::ideal(BearingRate::Exact), model.seed),
                 bearings: Vec::with_capacity(model.graph.triangle.max_degree()),
+                slot_order,
+                reordered: Vec::with_capacity(model.graph.triangle.max_degree()),
                 partner,
-                ids: model.agents.iter().map(|a| a.id).collect(),
+                ids,
                 est_start,
                 info,
                 sense_fault: vec![None; n],

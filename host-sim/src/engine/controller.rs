@@ -37,6 +37,13 @@ pub trait AgentController: Send {
     /// Counters of received frames.
     fn frame_stats(&self) -> FrameStats;
 
+    /// The wire ids of the agent's neighbours in its core's slot order
+    /// (`controller_core::Agent::neighbours`), if known: the simulator hands it its
+    /// bearings in that order. The default (`None`) keeps the measurement order.
+    fn neighbour_order(&self) -> Option<Vec<u8>> {
+        None
+    }
+
     /// First phase of a tick: like [`Self::tick`], but a remote controller only sends
     /// its inputs and returns `Ok(None)`; the simulator then collects the output with
     /// [`Self::finish_tick`] after starting every other agent's tick. The default runs
@@ -162,5 +169,9 @@ impl<const M: usize, const N: usize> AgentController for LocalCore<M, N> {
 
     fn frame_stats(&self) -> FrameStats {
         *self.agent.stats()
+    }
+
+    fn neighbour_order(&self) -> Option<Vec<u8>> {
+        Some(self.agent.neighbours().collect())
     }
 }

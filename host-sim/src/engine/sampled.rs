@@ -18,6 +18,7 @@ use super::hil::{HilError, LinkStats};
 use super::plant::Plant;
 use super::radio::{Radio, RadioFrame};
 use super::sensors::Sensors;
+use super::slot_order::SlotOrder;
 use super::stats::{add_frame_stats, ControlStats, FrameCounts};
 use crate::model::{resolve_estimates, BearingRate, EstimateInfo, Estimator, Model};
 use controller_core::{BearingMeasurement, FrameStats, Measurements, StepOutput, Vec2};
@@ -60,6 +61,10 @@ pub struct SampledSim<'m> {
     error: Option<HilError>,
     forces: Vec<Vec2<f64>>,
     bearings: Vec<BearingMeasurement<f64>>,
+    /// Each agent's bearings go to its core in slot order ([`SlotOrder`]).
+    slot_order: SlotOrder,
+    /// Scratch of [`SlotOrder::apply`].
+    reordered: Vec<BearingMeasurement<f64>>,
     partner: Vec<Option<usize>>,
     ids: Vec<u8>,
     estimates: Vec<f64>,
@@ -133,6 +138,12 @@ impl<'m> SampledSim<'m> {
             .map(|i| Vec::with_capacity(model.graph.radio.of(i).len() * FRAMES_PER_TICK * 4 + 8))
             .collect();
         let partner = model.partners();
+        let ids: Vec<u8> = model.agents.iter().map(|a| a.id).collect();
+        let slot_order = SlotOrder::new(
+            n,
+            |i| model.graph.triangle.of(i).iter().map(|&j| ids[j]).collect(),
+            |i| controllers[i].neighbour_order(),
+        );
         let mut radio = Radio::new(&model.radio, n, model.seed, capacity);
         radio.attach_channel(&model.graph.radio, period);
         Ok(Self {
@@ -150,8 +161,10 @@ impl<'m> SampledSim<'m> {
             error: None,
             forces: vec![Vec2::zeros(); n],
             bearings: Vec::with_capacity(model.graph.triangle.max_degree()),
+            slot_order,
+            reordered: Vec::with_capacity(model.graph.triangle.max_degree()),
             partner,
-            ids: model.agents.iter().map(|a| a.id).collect(),
+            ids,
             estimates: vec![model.initial_estimate; info.len()],
             est_start,
             info,
@@ -231,7 +244,8 @@ impl SampledSim<'_> {
         self.radio.count_delivered(delivered);
     }
 
-    /// Measures agent `i` (drawing its noise from the sensors' stream) into `bearings`.
+    /// Measures agent `i` (drawing its noise from the sensors' stream) into `bearings`,
+    /// in its core's slot order.
     fn measure(&mut self, i: usize, exact: bool, ranged: bool) -> (Vec2<f64>, Option<Vec2<f64>>) {
         let (q, v) = (&self.plant.q, &self.plant.v);
         for &j in self.model.graph.triangle.of(i) {
@@ -242,6 +256,8 @@ impl SampledSim<'_> {
                 self.bearings.push(b);
             }
         }
+        self.slot_order
+            .apply(i, &mut self.bearings, &mut self.reordered);
         let velocity = self.sensors.velocity(&v[i]);
         let partner_offset = self.partner[i].map(|p| self.sensors.offset(&q[i], &q[p]));
         (velocity, partner_offset)

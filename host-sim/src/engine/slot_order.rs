@@ -1,0 +1,177 @@
+//! Bearings in the order each agent's core keeps its neighbours (its slots,
+//! `controller_core::Agent::neighbours`). A core takes bearings in slot order in one pass;
+//! in any other order it searches for each one (same result, more work). The sensors
+//! measure in graph order, the order their random stream is drawn in (which fixes every
+//! noisy run's result), so the measurements are put in slot order afterwards. A strip or
+//! lattice agent's slots are not sorted by agent index; the paper's are.
+
+use controller_core::BearingMeasurement;
+
+/// Per agent, the permutation from measurement order to slot order (empty: already in
+/// slot order, or unknown).
+#[derive(Clone, Debug, Default)]
+pub struct SlotOrder {
+    start: Vec<usize>,
+    /// `perm[start[i] + s]`: the measurement index of agent `i`'s slot `s`.
+    perm: Vec<u8>,
+}
+
+impl SlotOrder {
+    /// For each agent `i`: `measured(i)`, the wire ids of its triangle neighbours in the
+    /// order they are measured, and `slots(i)`, the wire ids of its core's neighbours in
+    /// slot order (`None` when the controller does not say, e.g. a remote target: the
+    /// measurement order is kept).
+    pub fn new(
+        n: usize,
+        measured: impl Fn(usize) -> Vec<u8>,
+        slots: impl Fn(usize) -> Option<Vec<u8>>,
+    ) -> Self {
+        let mut start = Vec::with_capacity(n + 1);
+        let mut perm = Vec::new();
+        for i in 0..n {
+            start.push(perm.len());
+            let ids = measured(i);
+            let Some(order) = slots(i) else { continue };
+            // The triangle neighbours come first among the slots (the partner last).
+            let p: Option<Vec<u8>> = order
+                .iter()
+                .take(ids.len())
+                .map(|id| {
+                    let k = ids.iter().position(|m| m == id)?;
+                    u8::try_from(k).ok()
+                })
+                .collect();
+            match p {
+                Some(p)
+                    if p.len() == ids.len()
+                        && p.iter().enumerate().any(|(s, &k)| usize::from(k) != s) =>
+                {
+                    perm.extend_from_slice(&p);
+                }
+                // Already in slot order, or the slots do not start with the measured
+                // neighbours (not a core this simulator built): keep the order.
+                _ => {}
+            }
+        }
+        start.push(perm.len());
+        Self { start, perm }
+    }
+
+    /// Puts agent `i`'s bearings (measured in measurement order) in slot order, using
+    /// `scratch` (both keep their capacity: no allocation once warm). When a bearing is
+    /// missing (coincident agents) the order is left as measured: the core then searches.
+    #[inline]
+    pub fn apply(
+        &self,
+        i: usize,
+        bearings: &mut Vec<BearingMeasurement<f64>>,
+        scratch: &mut Vec<BearingMeasurement<f64>>,
+    ) {
+        let perm = match (self.start.get(i), self.start.get(i + 1)) {
+            (Some(&a), Some(&b)) => self.perm.get(a..b).unwrap_or(&[]),
+            _ => &[],
+        };
+        if perm.is_empty() || perm.len() != bearings.len() {
+            return;
+        }
+        scratch.clear();
+        scratch.extend(
+            perm.iter()
+                .filter_map(|&k| bearings.get(usize::from(k)).copied()),
+        );
+        std::mem::swap(bearings, scratch);
+    }
+
+    /// Agents whose bearings are reordered.
+    #[cfg(test)]
+    pub fn reordered(&self) -> usize {
+        self.start.windows(2).filter(|w| w[1] > w[0]).count()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use controller_core::Vec2;
+
+    fn b(id: u8) -> BearingMeasurement<f64> {
+        BearingMeasurement {
+            neighbour: id,
+            bearing: Vec2::new(1.0, 0.0),
+            rate: None,
+            range: None,
+        }
+    }
+
+    fn ids(v: &[BearingMeasurement<f64>]) -> Vec<u8> {
+        v.iter().map(|x| x.neighbour).collect()
+    }
+
+    #[test]
+    fn bearings_go_to_slot_order_and_sorted_agents_are_left_alone() {
+        // Agent 0 measures [3, 5, 7], its core's slots are [5, 7, 3, 9 (partner)];
+        // agent 1 is already in slot order; agent 2's controller does not say.
+        let measured = |i: usize| match i {
+            0 => vec![3, 5, 7],
+            1 => vec![1, 2],
+            _ => vec![4, 6],
+        };
+        let slots = |i: usize| match i {
+            0 => Some(vec![5, 7, 3, 9]),
+            1 => Some(vec![1, 2]),
+            _ => None,
+        };
+        let o = SlotOrder::new(3, measured, slots);
+        assert_eq!(o.reordered(), 1);
+        let mut scratch = Vec::new();
+        let mut v = vec![b(3), b(5), b(7)];
+        o.apply(0, &mut v, &mut scratch);
+        assert_eq!(ids(&v), [5, 7, 3]);
+        // A missing bearing: left as measured.
+        let mut v = vec![b(3), b(7)];
+        o.apply(0, &mut v, &mut scratch);
+        assert_eq!(ids(&v), [3, 7]);
+        for i in [1, 2] {
+            let mut v: Vec<_> = measured(i).into_iter().map(b).collect();
+            o.apply(i, &mut v, &mut scratch);
+            assert_eq!(ids(&v), measured(i));
+        }
+    }
+
+    /// A designed lattice (whose cores' slots are mostly not sorted by agent index) and the
+    /// built-in strip (whose are): every agent's bearings, measured in graph order, reach
+    /// its core as a prefix of its slots.
+    #[test]
+    fn every_agents_bearings_reach_its_core_in_slot_order() {
+        use crate::design::{
+            construct, render_scenario, DesignOptions, Generator, ScenarioOptions,
+        };
+        let g = Generator::TriangularLattice {
+            n: 40,
+            spacing: 1.0,
+        };
+        let p = g.points().expect("points");
+        let opts = DesignOptions::default();
+        let c = construct(&p, &opts).expect("construct");
+        let text = render_scenario(&p, &c, &opts, &ScenarioOptions::default()).expect("render");
+        let lattice = crate::load_toml(&text, "designed", &[]).expect("load");
+        let strip = crate::scenario::strip_model(40, 1.0);
+        for (m, reordered) in [(lattice, true), (strip, false)] {
+            let wire: Vec<u8> = m.agents.iter().map(|a| a.id).collect();
+            let measured =
+                |i: usize| -> Vec<u8> { m.graph.triangle.of(i).iter().map(|&j| wire[j]).collect() };
+            let cores: Vec<_> = (0..m.n())
+                .map(|i| crate::engine::local_core(&m, i).expect("core"))
+                .collect();
+            let o = SlotOrder::new(m.n(), measured, |i| cores[i].neighbour_order());
+            assert_eq!(o.reordered() > m.n() / 4, reordered, "{}", o.reordered());
+            let mut scratch = Vec::new();
+            for (i, core) in cores.iter().enumerate() {
+                let mut v: Vec<_> = measured(i).into_iter().map(b).collect();
+                o.apply(i, &mut v, &mut scratch);
+                let slots = core.neighbour_order().expect("local core");
+                assert_eq!(ids(&v), slots[..v.len()], "agent {i}");
+            }
+        }
+    }
+}
