@@ -117,6 +117,19 @@ fn a_flood_on_the_shared_channel_costs_frames_to_collisions() {
         summary["channel"]["collided_copies"].as_u64(),
         Some(c1.collided)
     );
+    // The flood's 40,000 frames of 60 bytes are on the air too, counted apart from the
+    // swarm's: 10 s at 4 kHz of (60 + overhead) bytes at 2 Mbit/s.
+    assert_eq!(c0.external_transmissions, 0);
+    assert_eq!(c1.external_transmissions, 40_000);
+    let air = m.radio.channel.as_ref().expect("channel").air_time(60);
+    assert!((c1.external_air_time - 40_000.0 * air).abs() < 1e-9 * c1.external_air_time);
+    assert!((c1.air_time - c0.air_time).abs() < 0.05 * c0.air_time);
+    let total = summary["channel"]["total_utilisation"]
+        .as_f64()
+        .expect("total");
+    let own = summary["channel"]["utilisation"].as_f64().expect("own");
+    assert!((total - own - c1.external_air_time / r.final_time).abs() < 1e-12);
+    assert_eq!(summary["channel"]["external_transmissions"], 40_000);
 }
 
 #[test]

@@ -51,6 +51,21 @@ pub(super) fn add_json(obj: &mut Map<String, Value>, m: &Model, r: &RunResult) {
             "max_neighbour_age_s": fin(s.max_age),
         }),
     );
+    // Transmitters outside the swarm (a flood): only for scenarios with attackers, so
+    // other summaries keep their bytes.
+    if !m.attacks.is_empty() {
+        if let Some(Value::Object(ch)) = obj.get_mut("channel") {
+            ch.insert(
+                "external_transmissions".to_owned(),
+                json!(s.external_transmissions),
+            );
+            ch.insert("external_air_time_s".to_owned(), fin(s.external_air_time));
+            ch.insert(
+                "total_utilisation".to_owned(),
+                fin(s.total_utilisation(r.final_time)),
+            );
+        }
+    }
 }
 
 /// Rows of the summary table (none without a channel or a reduced broadcast rate).
@@ -88,6 +103,17 @@ pub(super) fn rows(m: &Model, r: &RunResult) -> Vec<(&'static str, String)> {
                 100.0 * s.utilisation(r.final_time)
             ),
         ));
+        if s.external_transmissions > 0 {
+            rows.push((
+                "outside transmitters",
+                format!(
+                    "{} frames, {:.4} s on the air; total utilisation {:.2} %",
+                    s.external_transmissions,
+                    s.external_air_time,
+                    100.0 * s.total_utilisation(r.final_time)
+                ),
+            ));
+        }
         rows.push((
             "lost to collisions",
             format!(

@@ -146,6 +146,8 @@ impl Channel {
             }
         };
         let air = self.model.air_time(len);
+        self.stats.external_transmissions += 1;
+        self.stats.external_air_time += air;
         self.order += 1;
         self.pending.push(Transmission {
             start,

@@ -7,6 +7,10 @@ pub struct ChannelStats {
     pub transmissions: u64,
     /// Total time on the air of those frames (s), overhead included, turnaround not.
     pub air_time: f64,
+    /// Transmissions from outside the swarm (a `flood` attacker's frames).
+    pub external_transmissions: u64,
+    /// Their total time on the air (s), overhead included.
+    pub external_air_time: f64,
     /// Link copies lost to collisions (an overlapping transmission the receiver hears,
     /// or its own).
     pub collided: u64,
@@ -33,13 +37,23 @@ pub struct ChannelStats {
 }
 
 impl ChannelStats {
-    /// Air time over `elapsed` seconds: the offered load (can exceed 1 when
+    /// The swarm's air time over `elapsed` seconds: the offered load (can exceed 1 when
     /// transmissions overlap).
     pub fn utilisation(&self, elapsed: f64) -> f64 {
-        if elapsed > 0.0 {
-            self.air_time / elapsed
-        } else {
-            0.0
-        }
+        per(self.air_time, elapsed)
+    }
+
+    /// The swarm's and the outside transmitters' air time over `elapsed` seconds.
+    pub fn total_utilisation(&self, elapsed: f64) -> f64 {
+        per(self.air_time + self.external_air_time, elapsed)
+    }
+}
+
+/// `x / elapsed`, 0 for an empty interval.
+fn per(x: f64, elapsed: f64) -> f64 {
+    if elapsed > 0.0 {
+        x / elapsed
+    } else {
+        0.0
     }
 }
