@@ -3,7 +3,8 @@
 //! estimator flows S9/S10, saturation and the safe output.
 
 use super::estimates::owns;
-use super::state::{AngleState, Side};
+use super::sensing::sense_angle;
+use super::state::{AngleState, ApexPart, Neighbour, Remote, Side};
 use super::{
     finite_vec, pick, vec2, within, Agent, Evaluation, Fault, Measurements, Status, StepOutput,
 };
@@ -43,9 +44,20 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// estimates integrated over `dt` (sampled S10), saturation. On any fault the output
     /// is the documented safe command `U = −safe_damping · v` (no formation force) and the
     /// estimates hold still.
+    ///
+    /// The angles are walked once: each angle's sensing and then its law, the same
+    /// per-angle functions that `sense` and `evaluate` run in two walks, in the same
+    /// order on the same data (the same result bit for bit).
     pub fn step(&mut self, m: &Measurements<'_, T>) -> StepOutput<T> {
-        let result = match self.sense(m) {
-            Ok(()) => self.law(Some(m.dt)),
+        let result = match self.sense_own(m) {
+            Ok(()) => {
+                let mut done = 0;
+                let result = self.sense_and_law(m.dt, &mut done);
+                if result.is_err() {
+                    self.roll_back(done);
+                }
+                result
+            }
             Err(fault) => Err(fault),
         };
         self.comm_due = self.comm_countdown == 0;
@@ -93,26 +105,44 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         let mut done = 0;
         let result = self.law_pass(integrate, &mut done);
         if result.is_err() && integrate.is_some() {
-            // Roll back the angles the pass integrated (their `flow` holds the estimates
-            // from before; the others are untouched).
-            let mode = self.config.estimator;
-            for a in self
-                .angles
-                .as_mut_slice()
-                .as_flattened_mut()
-                .iter_mut()
-                .take(done)
-            {
-                for e in 0..2 {
-                    if owns(mode, a, e) {
-                        if let (Some(est), Some(before)) = (a.estimate.get_mut(e), a.flow.get(e)) {
-                            *est = *before;
-                        }
+            self.roll_back(done);
+        }
+        result
+    }
+
+    /// Puts back the estimates of the first `done` angles from before the step (their
+    /// `flow` holds them; the others are untouched).
+    #[cold]
+    fn roll_back(&mut self, done: usize) {
+        let mode = self.config.estimator;
+        for a in self
+            .angles
+            .as_mut_slice()
+            .as_flattened_mut()
+            .iter_mut()
+            .take(done)
+        {
+            for e in 0..2 {
+                if owns(mode, a, e) {
+                    if let (Some(est), Some(before)) = (a.estimate.get_mut(e), a.flow.get(e)) {
+                        *est = *before;
                     }
                 }
             }
         }
-        result
+    }
+
+    /// What every angle's law reads of this tick.
+    #[inline(always)]
+    fn law_context(&self, integrate: Option<T>) -> LawContext<T> {
+        let c = &self.config;
+        LawContext {
+            v: self.velocity,
+            mode: c.estimator,
+            r_min: c.min_estimate,
+            timeout: c.limits.neighbour_timeout,
+            integrate,
+        }
     }
 
     /// [`Agent::law`] without the roll-back: with `integrate`, `flow` keeps the estimates
@@ -124,103 +154,56 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         done: &mut usize,
     ) -> Result<(Vec2<T>, bool), Fault> {
         self.check_fresh()?;
-        let c = &self.config;
-        let v = self.velocity;
-        let v_star = vec2(c.velocity_reference.at(self.time));
-        let (mode, r_min) = (c.estimator, c.min_estimate);
-        let timeout = c.limits.neighbour_timeout;
-        let zero = T::zero();
+        let cx = self.law_context(integrate);
+        let mut sum = LawSum::new(self.velocity_force());
         let nbs = self.neighbours.as_slice();
-        let nb = |slot: usize| nbs.get(slot).ok_or(Fault::Internal);
-        // S9 with S3 for ṙ, then (stepping) S10 on the estimate, or (evaluating) the flow
-        // kept in `flow`.
-        let settle = |a: &mut AngleState<T>, e: usize, flow: T| {
-            if let (Some(est), Some(f)) = (a.estimate.get_mut(e), a.flow.get_mut(e)) {
-                match integrate {
-                    Some(dt) => {
-                        *f = *est;
-                        *est = law::estimator_step(*est, flow, dt, r_min);
-                    }
-                    None => *f = flow,
-                }
-            }
-        };
-        // S12.
-        let mut force = law::velocity_force(&c.friction, &c.velocity_damping, &v, &v_star);
-        // Largest |y| (NaN ignored): degenerate iff above the margin.
-        let mut y_max = zero;
         for a in self.angles.as_mut_slice().as_flattened_mut() {
-            match a.side {
-                Side::Apex { part: p, fault } => {
-                    if let Some(fault) = fault {
-                        return Err(fault);
-                    }
-                    let y_abs = p.y.abs();
-                    if y_abs > y_max {
-                        y_max = y_abs;
-                    }
-                    // S8 on the apex (computed when sensing).
-                    force += p.force;
-                    if mode != EstimatorMode::Measured {
-                        let (nv, nw) = (nb(a.slots[1])?, nb(a.slots[2])?);
-                        // Broadcast velocities: every neighbour was heard (`check_fresh`).
-                        let (vv, vw) = (nv.velocity, nw.velocity);
-                        let gain = a.estimator_gain;
-                        // S3 with the own bearings s_uv, s_uw and the far vertices' velocities.
-                        let rr = [
-                            geometry::range_rate(&nv.s, &(vv - v)),
-                            geometry::range_rate(&nw.s, &(vw - v)),
-                        ];
-                        let [r0, r1] = a.estimate;
-                        let f0 = law::estimator_rate(rr[0], p.gamma, p.share[0], gain, r0);
-                        let f1 = law::estimator_rate(rr[1], p.gamma, p.share[1], gain, r1);
-                        settle(a, 0, f0);
-                        settle(a, 1, f1);
-                    }
-                }
-                Side::Far { k, remote, age } => {
-                    let n = nb(a.slots[0])?;
-                    let (s_ku, _) = n.bearing()?;
-                    if !within(age, timeout) {
-                        return Err(Fault::MissingData(a.apex));
-                    }
-                    // SPEC §6: the apex's shared estimate, the own copy, or the range.
-                    let r = match mode {
-                        EstimatorMode::Shared => remote.rho,
-                        EstimatorMode::PerAgent => pick(&a.estimate, k),
-                        EstimatorMode::Measured => n.range()?,
-                    };
-                    // Own motion relative to the apex since it measured (taken as the tick
-                    // before the frame arrived): displacement at the current relative
-                    // velocity, change of own velocity since the frame arrived.
-                    let v_apex = n.velocity;
-                    let delta = (v - v_apex) * age;
-                    let dv = v - remote.v_ref;
-                    // S6–S8 on this far vertex.
-                    let (gamma_k, g_k, f) = law::far_angle(
-                        remote.gamma,
-                        remote.sigma,
-                        r,
-                        &s_ku,
-                        a.stiffness,
-                        a.damping,
-                        &delta,
-                        &dv,
-                    );
-                    force += f;
-                    if mode == EstimatorMode::PerAgent {
-                        // S9 on the own copy r̂^k (SPEC §6): ṙ_uk = s_ukᵀ(v_k − v_u) with
-                        // s_uk = −s_ku (S3), and the share f^k = +g_kᵀ v_k / r̂^k.
-                        let rr = geometry::range_rate(&-s_ku, &(v - v_apex));
-                        let share = law::own_share(&g_k, &v, r, true);
-                        let flow = law::estimator_rate(rr, gamma_k, share, a.estimator_gain, r);
-                        settle(a, k, flow);
-                    }
-                }
-            }
+            angle_law(&cx, nbs, a, &mut sum)?;
             // Every fault of an angle comes before its estimates are settled.
             *done += 1;
         }
+        self.finish_law(sum)
+    }
+
+    /// [`Agent::sense`]'s walk over the angles and [`Agent::law_pass`] (integrating over
+    /// `dt`) in one walk: each angle is sensed, then (until the first fault) its law runs.
+    /// Every angle is sensed whatever the law finds, as `sense` then `law` would. `done`:
+    /// the angles the law went through (to roll back after a fault).
+    #[inline]
+    fn sense_and_law(&mut self, dt: T, done: &mut usize) -> Result<(Vec2<T>, bool), Fault> {
+        let mut fault = self.check_fresh().err();
+        let cx = self.law_context(Some(dt));
+        let mut sum = LawSum::new(self.velocity_force());
+        let nbs = self.neighbours.as_slice();
+        for a in self.angles.as_mut_slice().as_flattened_mut() {
+            sense_angle(nbs, cx.mode, &cx.v, a, dt);
+            if fault.is_none() {
+                match angle_law(&cx, nbs, a, &mut sum) {
+                    Ok(()) => *done += 1,
+                    Err(f) => fault = Some(f),
+                }
+            }
+        }
+        match fault {
+            Some(f) => Err(f),
+            None => self.finish_law(sum),
+        }
+    }
+
+    /// S12: `U^v_n = D^r_n v* − D^v_n (v_n − v*)`.
+    #[inline(always)]
+    fn velocity_force(&self) -> Vec2<T> {
+        let c = &self.config;
+        let v_star = vec2(c.velocity_reference.at(self.time));
+        law::velocity_force(&c.friction, &c.velocity_damping, &self.velocity, &v_star)
+    }
+
+    /// The end of the law after the angles: S11, the finiteness of the force, degeneracy.
+    #[inline(always)]
+    fn finish_law(&self, sum: LawSum<T>) -> Result<(Vec2<T>, bool), Fault> {
+        let c = &self.config;
+        let v = self.velocity;
+        let mut force = sum.force;
         if let Some(l) = &c.leader {
             // S11 with z = q_a − q_b; the partner offset p = q_partner − q_self.
             let p = self.partner_offset.ok_or(Fault::MissingPartnerOffset)?;
@@ -239,7 +222,160 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         if !finite_vec(&force) {
             return Err(Fault::NonFinite);
         }
-        Ok((force, y_max > c.limits.margin_cos))
+        Ok((force, sum.y_max > c.limits.margin_cos))
+    }
+}
+
+/// What every angle's law reads of this tick ([`Agent::law_context`]).
+struct LawContext<T: Real> {
+    /// Own velocity.
+    v: Vec2<T>,
+    mode: EstimatorMode,
+    r_min: T,
+    timeout: T,
+    /// `Some(dt)`: integrate the owned estimates (sampled S10); `None`: keep the flows.
+    integrate: Option<T>,
+}
+
+/// The law's running sums over the angles.
+struct LawSum<T: Real> {
+    /// S12 plus the S8 forces so far.
+    force: Vec2<T>,
+    /// Largest `|y|` of the apex angles (NaN ignored): degenerate iff above the margin.
+    y_max: T,
+}
+
+impl<T: Real> LawSum<T> {
+    #[inline(always)]
+    fn new(force: Vec2<T>) -> Self {
+        Self {
+            force,
+            y_max: T::zero(),
+        }
+    }
+}
+
+/// One angle's law: its S8 force into `sum` and the S9 flow (stepped by S10 with
+/// `integrate`) of the estimates it owns, or the angle's fault.
+#[inline(always)]
+fn angle_law<T: Real, const MT: usize>(
+    cx: &LawContext<T>,
+    nbs: &[Neighbour<T, MT>],
+    a: &mut AngleState<T>,
+    sum: &mut LawSum<T>,
+) -> Result<(), Fault> {
+    match a.side {
+        Side::Apex { part, fault } => {
+            if let Some(fault) = fault {
+                return Err(fault);
+            }
+            apex_law(cx, nbs, a, &part, sum)
+        }
+        Side::Far { k, remote, age } => far_law(cx, nbs, a, k, &remote, age, sum),
+    }
+}
+
+/// The law on the apex of an angle: its S8 force (computed when sensing) and the S9 flow
+/// of both estimates with S3 for `ṙ` from the far vertices' broadcast velocities.
+#[inline(always)]
+fn apex_law<T: Real, const MT: usize>(
+    cx: &LawContext<T>,
+    nbs: &[Neighbour<T, MT>],
+    a: &mut AngleState<T>,
+    p: &ApexPart<T>,
+    sum: &mut LawSum<T>,
+) -> Result<(), Fault> {
+    let y_abs = p.y.abs();
+    if y_abs > sum.y_max {
+        sum.y_max = y_abs;
+    }
+    // S8 on the apex (computed when sensing).
+    sum.force += p.force;
+    if cx.mode != EstimatorMode::Measured {
+        let nb = |slot: usize| nbs.get(slot).ok_or(Fault::Internal);
+        let (nv, nw) = (nb(a.slots[1])?, nb(a.slots[2])?);
+        // Broadcast velocities: every neighbour was heard (`check_fresh`).
+        let (vv, vw) = (nv.velocity, nw.velocity);
+        let gain = a.estimator_gain;
+        // S3 with the own bearings s_uv, s_uw and the far vertices' velocities.
+        let rr = [
+            geometry::range_rate(&nv.s, &(vv - cx.v)),
+            geometry::range_rate(&nw.s, &(vw - cx.v)),
+        ];
+        let [r0, r1] = a.estimate;
+        let f0 = law::estimator_rate(rr[0], p.gamma, p.share[0], gain, r0);
+        let f1 = law::estimator_rate(rr[1], p.gamma, p.share[1], gain, r1);
+        settle(cx, a, 0, f0);
+        settle(cx, a, 1, f1);
+    }
+    Ok(())
+}
+
+/// The law on far vertex `k` of an angle: S6–S8 from what the apex sent `age` seconds
+/// ago ([`law::far_angle`]), and in per-agent mode the S9 flow of the own copy.
+#[inline(always)]
+fn far_law<T: Real, const MT: usize>(
+    cx: &LawContext<T>,
+    nbs: &[Neighbour<T, MT>],
+    a: &mut AngleState<T>,
+    k: usize,
+    remote: &Remote<T>,
+    age: T,
+    sum: &mut LawSum<T>,
+) -> Result<(), Fault> {
+    let n = nbs.get(a.slots[0]).ok_or(Fault::Internal)?;
+    let (s_ku, _) = n.bearing()?;
+    if !within(age, cx.timeout) {
+        return Err(Fault::MissingData(a.apex));
+    }
+    // SPEC §6: the apex's shared estimate, the own copy, or the range.
+    let r = match cx.mode {
+        EstimatorMode::Shared => remote.rho,
+        EstimatorMode::PerAgent => pick(&a.estimate, k),
+        EstimatorMode::Measured => n.range()?,
+    };
+    let v = cx.v;
+    // Own motion relative to the apex since it measured (taken as the tick before the
+    // frame arrived): displacement at the current relative velocity, change of own
+    // velocity since the frame arrived.
+    let v_apex = n.velocity;
+    let delta = (v - v_apex) * age;
+    let dv = v - remote.v_ref;
+    // S6–S8 on this far vertex.
+    let (gamma_k, g_k, f) = law::far_angle(
+        remote.gamma,
+        remote.sigma,
+        r,
+        &s_ku,
+        a.stiffness,
+        a.damping,
+        &delta,
+        &dv,
+    );
+    sum.force += f;
+    if cx.mode == EstimatorMode::PerAgent {
+        // S9 on the own copy r̂^k (SPEC §6): ṙ_uk = s_ukᵀ(v_k − v_u) with s_uk = −s_ku
+        // (S3), and the share f^k = +g_kᵀ v_k / r̂^k.
+        let rr = geometry::range_rate(&-s_ku, &(v - v_apex));
+        let share = law::own_share(&g_k, &v, r, true);
+        let flow = law::estimator_rate(rr, gamma_k, share, a.estimator_gain, r);
+        settle(cx, a, k, flow);
+    }
+    Ok(())
+}
+
+/// S9 with S3 for ṙ, then (stepping) S10 on the estimate `e`, or (evaluating) the flow
+/// kept in `flow`.
+#[inline(always)]
+fn settle<T: Real>(cx: &LawContext<T>, a: &mut AngleState<T>, e: usize, flow: T) {
+    if let (Some(est), Some(f)) = (a.estimate.get_mut(e), a.flow.get_mut(e)) {
+        match cx.integrate {
+            Some(dt) => {
+                *f = *est;
+                *est = law::estimator_step(*est, flow, dt, cx.r_min);
+            }
+            None => *f = flow,
+        }
     }
 }
 

@@ -25,6 +25,21 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// [`Agent::step`] calls it; simulators that drive [`Agent::evaluate`] themselves
     /// call it first (after [`Agent::set_estimate`], before exchanging frames).
     pub fn sense(&mut self, m: &Measurements<'_, T>) -> Result<(), Fault> {
+        self.sense_own(m)?;
+        let (mode, v) = (self.config.estimator, self.velocity);
+        let nbs = self.neighbours.as_slice();
+        for a in self.angles.as_mut_slice().as_flattened_mut() {
+            sense_angle(nbs, mode, &v, a, m.dt);
+        }
+        Ok(())
+    }
+
+    /// [`Agent::sense`] up to the angles: checks and stores the own measurements, ages and
+    /// updates the neighbour table. On refused measurements it also marks every angle
+    /// of which this agent is the apex with the fault and ages the others (what
+    /// [`sense_angle`] would have done), and nothing else changes.
+    #[inline(always)]
+    pub(super) fn sense_own(&mut self, m: &Measurements<'_, T>) -> Result<(), Fault> {
         let dt = m.dt;
         if !(finite(dt) && dt >= T::zero()) {
             return Err(Fault::Measurement(MeasurementError::NonFinite));
@@ -78,25 +93,6 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             }
         }
         self.oldest = Some(oldest);
-        let (mode, v) = (self.config.estimator, self.velocity);
-        let nbs = self.neighbours.as_slice();
-        for a in self.angles.as_mut_slice().as_flattened_mut() {
-            let computed = match a.side {
-                Side::Apex { .. } => Some(apex_part(nbs, mode, a, &v)),
-                Side::Far { .. } => None,
-            };
-            match (&mut a.side, computed) {
-                (Side::Apex { part, fault }, Some(result)) => match result {
-                    Ok(p) => {
-                        *part = p;
-                        *fault = None;
-                    }
-                    Err(f) => *fault = Some(f),
-                },
-                (Side::Far { age, .. }, _) => *age += dt,
-                (Side::Apex { .. }, None) => {}
-            }
-        }
         Ok(())
     }
 
@@ -152,6 +148,34 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             }
         }
         Ok(in_order)
+    }
+}
+
+/// One angle's part of [`Agent::sense`] after the own measurements were taken: the apex
+/// computes its kernel ([`apex_part`]) and keeps it, or the fault, for the law; a far
+/// vertex ages what it last received by `dt`.
+#[inline(always)]
+pub(super) fn sense_angle<T: Real, const MT: usize>(
+    nbs: &[Neighbour<T, MT>],
+    mode: EstimatorMode,
+    v: &Vec2<T>,
+    a: &mut AngleState<T>,
+    dt: T,
+) {
+    let computed = match a.side {
+        Side::Apex { .. } => Some(apex_part(nbs, mode, a, v)),
+        Side::Far { .. } => None,
+    };
+    match (&mut a.side, computed) {
+        (Side::Apex { part, fault }, Some(result)) => match result {
+            Ok(p) => {
+                *part = p;
+                *fault = None;
+            }
+            Err(f) => *fault = Some(f),
+        },
+        (Side::Far { age, .. }, _) => *age += dt,
+        (Side::Apex { .. }, None) => {}
     }
 }
 
