@@ -18,7 +18,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// that integrate the estimators themselves (continuous time) call [`Agent::sense`],
     /// exchange, then this.
     pub fn evaluate(&mut self) -> Result<Evaluation<T, MT>, Fault> {
-        let (force, degenerate) = self.law(None)?;
+        let (force, degenerate) = self.law_pass()?;
         let r_min = self.config.min_estimate;
         // S10, continuous form: no negative flow at r_min (zero for estimates not owned).
         let projected = |a: &AngleState<T>| {
@@ -93,23 +93,6 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         }
     }
 
-    /// The law S7–S12: the sum of the angles' S8 forces, S11 and S12, and the S9 flow of
-    /// every owned estimate. With `integrate = Some(dt)` the owned estimates take the
-    /// sampled S10 step `r̂ ← max(r_min, r̂ + Δt·S9)` (the continuous projection changes
-    /// nothing there: it acts only when r̂ ≤ r_min and S9 < 0, and then both give r_min),
-    /// and are put back as they were if the law ends in a fault; with `None` the flows are
-    /// left in each angle's `flow`. Returns the unsaturated force and whether a current
-    /// angle (of which this agent is the apex) is degenerate. The first fault in angle
-    /// order wins (after staleness).
-    fn law(&mut self, integrate: Option<T>) -> Result<(Vec2<T>, bool), Fault> {
-        let mut done = 0;
-        let result = self.law_pass(integrate, &mut done);
-        if result.is_err() && integrate.is_some() {
-            self.roll_back(done);
-        }
-        result
-    }
-
     /// Puts back the estimates of the first `done` angles from before the step (their
     /// `flow` holds them; the others are untouched).
     #[cold]
@@ -145,30 +128,29 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         }
     }
 
-    /// [`Agent::law`] without the roll-back: with `integrate`, `flow` keeps the estimates
-    /// from before the step of the `done` angles it went through.
+    /// The law S7–S12 on the stored state: the sum of the angles' S8 forces, S11 and S12,
+    /// and the S9 flow of every owned estimate, left in each angle's `flow`. Returns the
+    /// unsaturated force and whether a current angle (of which this agent is the apex) is
+    /// degenerate. The first fault in angle order wins (after staleness).
     #[inline]
-    fn law_pass(
-        &mut self,
-        integrate: Option<T>,
-        done: &mut usize,
-    ) -> Result<(Vec2<T>, bool), Fault> {
+    fn law_pass(&mut self) -> Result<(Vec2<T>, bool), Fault> {
         self.check_fresh()?;
-        let cx = self.law_context(integrate);
+        let cx = self.law_context(None);
         let mut sum = LawSum::new(self.velocity_force());
         let nbs = self.neighbours.as_slice();
         for a in self.angles.as_mut_slice().as_flattened_mut() {
             angle_law(&cx, nbs, a, &mut sum)?;
-            // Every fault of an angle comes before its estimates are settled.
-            *done += 1;
         }
         self.finish_law(sum)
     }
 
-    /// [`Agent::sense`]'s walk over the angles and [`Agent::law_pass`] (integrating over
-    /// `dt`) in one walk: each angle is sensed, then (until the first fault) its law runs.
-    /// Every angle is sensed whatever the law finds, as `sense` then `law` would. `done`:
-    /// the angles the law went through (to roll back after a fault).
+    /// [`Agent::sense`]'s walk over the angles and [`Agent::law_pass`]'s in one walk, the
+    /// owned estimates integrated over `dt` (the sampled S10 step `r̂ ← max(r_min, r̂ +
+    /// Δt·S9)`; the continuous projection would change nothing: it acts only when
+    /// r̂ ≤ r_min and S9 < 0, and then both give r_min). Each angle is sensed, then (until
+    /// the first fault, staleness first) its law runs; every angle is sensed whatever the
+    /// law finds, as `sense` then the law would. `done`: the angles whose estimates were
+    /// integrated (to roll back after a fault).
     #[inline]
     fn sense_and_law(&mut self, dt: T, done: &mut usize) -> Result<(Vec2<T>, bool), Fault> {
         let mut fault = self.check_fresh().err();
