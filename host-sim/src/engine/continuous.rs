@@ -39,8 +39,6 @@ struct Rhs {
     bearings: Vec<BearingMeasurement<f64>>,
     /// Each agent's bearings go to its core in slot order ([`SlotOrder`]).
     slot_order: SlotOrder,
-    /// Scratch of [`SlotOrder::apply`].
-    reordered: Vec<BearingMeasurement<f64>>,
     partner: Vec<Option<usize>>,
     ids: Vec<u8>,
     info: Vec<EstimateInfo>,
@@ -72,8 +70,7 @@ impl Rhs {
                     self.bearings.push(b);
                 }
             }
-            self.slot_order
-                .apply(i, &mut self.bearings, &mut self.reordered);
+            self.slot_order.apply(i, &mut self.bearings);
             let m = Measurements {
                 time: t,
                 dt: 0.0,
@@ -183,7 +180,6 @@ impl<'m> ContinuousSim<'m> {
                 sensors: Sensors::new(&SensorModel::ideal(BearingRate::Exact), model.seed),
                 bearings: Vec::with_capacity(model.graph.triangle.max_degree()),
                 slot_order,
-                reordered: Vec::with_capacity(model.graph.triangle.max_degree()),
                 partner,
                 ids,
                 est_start,

@@ -17,11 +17,13 @@ use super::driver::Engine;
 use super::hil::{HilError, LinkStats};
 use super::plant::Plant;
 use super::radio::{Radio, RadioFrame};
-use super::sensors::Sensors;
+use super::sensors::{BearingNoise, Sensors};
 use super::slot_order::SlotOrder;
 use super::stats::{add_frame_stats, ControlStats, FrameCounts};
 use crate::model::{resolve_estimates, BearingRate, EstimateInfo, Estimator, Model};
-use controller_core::{BearingMeasurement, FrameStats, Measurements, StepOutput, Vec2};
+use controller_core::{
+    BearingMeasurement, FrameStats, Measurements, StepOutput, Vec2, MAX_NEIGHBOURS,
+};
 use rayon::prelude::*;
 
 /// Runs of at least this many agents compute ticks and plant steps on every thread of the
@@ -63,8 +65,6 @@ pub struct SampledSim<'m> {
     bearings: Vec<BearingMeasurement<f64>>,
     /// Each agent's bearings go to its core in slot order ([`SlotOrder`]).
     slot_order: SlotOrder,
-    /// Scratch of [`SlotOrder::apply`].
-    reordered: Vec<BearingMeasurement<f64>>,
     partner: Vec<Option<usize>>,
     ids: Vec<u8>,
     estimates: Vec<f64>,
@@ -76,9 +76,10 @@ pub struct SampledSim<'m> {
     direct: bool,
     /// Every controller is a [`LocalCore`](super::LocalCore) (ticks may run in parallel).
     local: bool,
-    /// Bearings of every agent (parallel path), at `bear_start[i]..bear_start[i + 1]`.
-    bear_all: Vec<BearingMeasurement<f64>>,
-    bear_start: Vec<usize>,
+    /// The bearings' noise of every agent (parallel path), drawn in agent order: agent
+    /// `i`'s `k`-th triangle neighbour at `noise_start[i] + k`.
+    noise_all: Vec<Option<BearingNoise>>,
+    noise_start: Vec<usize>,
     /// Velocity and partner offset measured for every agent (parallel path).
     measured: Vec<(Vec2<f64>, Option<Vec2<f64>>)>,
 }
@@ -162,7 +163,6 @@ impl<'m> SampledSim<'m> {
             forces: vec![Vec2::zeros(); n],
             bearings: Vec::with_capacity(model.graph.triangle.max_degree()),
             slot_order,
-            reordered: Vec::with_capacity(model.graph.triangle.max_degree()),
             partner,
             ids,
             estimates: vec![model.initial_estimate; info.len()],
@@ -172,8 +172,8 @@ impl<'m> SampledSim<'m> {
             stats: ControlStats::default(),
             direct: direct_radio(model),
             local: false,
-            bear_all: Vec::with_capacity(model.graph.triangle.total()),
-            bear_start: Vec::with_capacity(n + 1),
+            noise_all: Vec::with_capacity(model.graph.triangle.total()),
+            noise_start: Vec::with_capacity(n + 1),
             measured: vec![(Vec2::zeros(), None); n],
         })
     }
@@ -256,8 +256,14 @@ impl SampledSim<'_> {
                 self.bearings.push(b);
             }
         }
-        self.slot_order
-            .apply(i, &mut self.bearings, &mut self.reordered);
+        self.slot_order.apply(i, &mut self.bearings);
+        self.measure_own(i)
+    }
+
+    /// Agent `i`'s own velocity and (a leader) its partner offset, drawn after its
+    /// bearings.
+    fn measure_own(&mut self, i: usize) -> (Vec2<f64>, Option<Vec2<f64>>) {
+        let (q, v) = (&self.plant.q, &self.plant.v);
         let velocity = self.sensors.velocity(&v[i]);
         let partner_offset = self.partner[i].map(|p| self.sensors.offset(&q[i], &q[p]));
         (velocity, partner_offset)
@@ -285,23 +291,29 @@ impl SampledSim<'_> {
         Ok(())
     }
 
-    /// Every agent measured in agent order (the random streams as in
-    /// [`Self::tick_sequential`]), then every local controller's tick in parallel.
+    /// Every random draw of the sensors in agent order (the stream as in
+    /// [`Self::tick_sequential`]: each agent's bearings, then its velocity and offset),
+    /// then on every thread each agent's bearings from those draws
+    /// ([`Sensors::bearing_with`], in its core's slot order) and its controller's tick.
     fn tick_parallel(&mut self, t: f64, dt: f64) {
         let exact = self.model.sensors.bearing_rate == BearingRate::Exact;
         let ranged = self.model.estimator == Estimator::Measured;
-        let mut all = std::mem::take(&mut self.bear_all);
-        all.clear();
-        self.bear_start.clear();
+        let graph = &self.model.graph.triangle;
+        self.noise_all.clear();
+        self.noise_start.clear();
         for i in 0..self.model.n() {
-            self.bearings.clear();
-            self.bear_start.push(all.len());
-            self.measured[i] = self.measure(i, exact, ranged);
-            all.extend_from_slice(&self.bearings);
+            self.noise_start.push(self.noise_all.len());
+            let q = &self.plant.q;
+            for &j in graph.of(i) {
+                let noise = self.sensors.bearing_noise(&q[i], &q[j], ranged);
+                self.noise_all.push(noise);
+            }
+            self.measured[i] = self.measure_own(i);
         }
-        self.bear_start.push(all.len());
-        self.bear_all = all;
-        let (bear_all, bear_start, measured) = (&self.bear_all, &self.bear_start, &self.measured);
+        let (noise_all, noise_start, measured) =
+            (&self.noise_all, &self.noise_start, &self.measured);
+        let (q, v, ids) = (&self.plant.q, &self.plant.v, &self.ids);
+        let (sensors, slot_order) = (self.sensors.model(), &self.slot_order);
         self.controllers
             .par_iter_mut()
             .zip(self.inboxes.par_iter_mut())
@@ -310,14 +322,26 @@ impl SampledSim<'_> {
             .enumerate()
             .with_min_len(CHUNK)
             .for_each(|(i, (((c, inbox), outbox), output))| {
+                // A local core holds every triangle neighbour in at most MAX_NEIGHBOURS
+                // slots: the buffer holds every bearing.
+                let mut bearings: heapless::Vec<BearingMeasurement<f64>, MAX_NEIGHBOURS> =
+                    heapless::Vec::new();
+                let base = noise_start[i];
+                for (k, &j) in graph.of(i).iter().enumerate() {
+                    if let Some(Some(n)) = noise_all.get(base + k) {
+                        let b = Sensors::bearing_with(
+                            sensors, *n, ids[j], &q[i], &q[j], &v[i], &v[j], exact,
+                        );
+                        let _ = bearings.push(b);
+                    }
+                }
+                slot_order.apply(i, &mut bearings);
                 let (velocity, partner_offset) = measured[i];
                 let m = Measurements {
                     time: t,
                     dt,
                     velocity,
-                    bearings: bear_all
-                        .get(bear_start[i]..bear_start[i + 1])
-                        .unwrap_or(&[]),
+                    bearings: &bearings,
                     partner_offset,
                 };
                 outbox.clear();

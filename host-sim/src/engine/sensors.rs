@@ -11,6 +11,15 @@ use rand_distr::StandardNormal;
 /// Random stream of the sensors (independent of the radio's stream).
 const SENSOR_STREAM: u64 = 1;
 
+/// The random part of one bearing measurement ([`Sensors::bearing_noise`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BearingNoise {
+    /// Rotation noise (rad), without the bias.
+    pub angle: f64,
+    /// Range error (m), when a range is measured.
+    pub range: Option<f64>,
+}
+
 /// The sensor model with its random number generator.
 #[derive(Clone, Debug)]
 pub struct Sensors {
@@ -45,6 +54,7 @@ impl Sensors {
     /// The bearing measured by an agent at `q_self` (velocity `v_self`) to a neighbour at
     /// `q_other` (`v_other`), tagged with the neighbour's id. `None` if they coincide.
     /// `exact_rate` adds the S2 rate of the true state; `with_range` the (noisy) distance.
+    /// ([`Sensors::bearing_noise`] then [`Sensors::bearing_with`].)
     #[allow(clippy::too_many_arguments)]
     #[inline]
     pub fn bearing(
@@ -57,13 +67,63 @@ impl Sensors {
         exact_rate: bool,
         with_range: bool,
     ) -> Option<BearingMeasurement<f64>> {
-        let d = q_other - q_self;
-        let r = d.norm();
+        let noise = self.bearing_noise(q_self, q_other, with_range)?;
+        Some(Self::bearing_with(
+            &self.model,
+            noise,
+            neighbour,
+            q_self,
+            q_other,
+            v_self,
+            v_other,
+            exact_rate,
+        ))
+    }
+
+    /// The random part of [`Sensors::bearing`], drawn from the stream exactly as it draws
+    /// it (the rotation, then the range error if `with_range`; nothing when the agents
+    /// coincide, `None`). With [`Sensors::bearing_with`] the draws (in agent order) and
+    /// the geometry (on any thread) can be apart.
+    #[inline]
+    pub fn bearing_noise(
+        &mut self,
+        q_self: &Vec2<f64>,
+        q_other: &Vec2<f64>,
+        with_range: bool,
+    ) -> Option<BearingNoise> {
+        let r = (q_other - q_self).norm();
         if !(r > 0.0 && r.is_finite()) {
             return None;
         }
+        let angle = self.gauss(self.model.bearing_noise);
+        let range = if with_range {
+            Some(self.gauss(self.model.range_noise))
+        } else {
+            None
+        };
+        Some(BearingNoise { angle, range })
+    }
+
+    /// The bearing with the given noise (no random draws): the true bearing rotated by
+    /// `bearing_bias + noise.angle`, the exact S2 rate with `exact_rate`, the distance
+    /// plus `noise.range` when drawn. The agents must not coincide (see
+    /// [`Sensors::bearing_noise`]).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn bearing_with(
+        model: &SensorModel,
+        noise: BearingNoise,
+        neighbour: u8,
+        q_self: &Vec2<f64>,
+        q_other: &Vec2<f64>,
+        v_self: &Vec2<f64>,
+        v_other: &Vec2<f64>,
+        exact_rate: bool,
+    ) -> BearingMeasurement<f64> {
+        let d = q_other - q_self;
+        let r = d.norm();
         let s_true = d / r;
-        let angle = self.model.bearing_bias + self.gauss(self.model.bearing_noise);
+        let angle = model.bearing_bias + noise.angle;
         let bearing = if angle != 0.0 {
             let (sn, cs) = angle.sin_cos();
             Vec2::new(cs * s_true.x - sn * s_true.y, sn * s_true.x + cs * s_true.y)
@@ -71,17 +131,13 @@ impl Sensors {
             s_true
         };
         let rate = exact_rate.then(|| geometry::bearing_rate(&s_true, &(v_other - v_self), r));
-        let range = if with_range {
-            Some((r + self.gauss(self.model.range_noise)).max(1e-6))
-        } else {
-            None
-        };
-        Some(BearingMeasurement {
+        let range = noise.range.map(|e| (r + e).max(1e-6));
+        BearingMeasurement {
             neighbour,
             bearing,
             rate,
             range,
-        })
+        }
     }
 
     /// The agent's measured own velocity.

@@ -5,7 +5,7 @@
 //! noisy run's result), so the measurements are put in slot order afterwards. A strip or
 //! lattice agent's slots are not sorted by agent index; the paper's are.
 
-use controller_core::BearingMeasurement;
+use controller_core::{BearingMeasurement, MAX_NEIGHBOURS};
 
 /// Per agent, the permutation from measurement order to slot order (empty: already in
 /// slot order, or unknown).
@@ -57,16 +57,12 @@ impl SlotOrder {
         Self { start, perm }
     }
 
-    /// Puts agent `i`'s bearings (measured in measurement order) in slot order, using
-    /// `scratch` (both keep their capacity: no allocation once warm). When a bearing is
-    /// missing (coincident agents) the order is left as measured: the core then searches.
+    /// Puts agent `i`'s bearings (measured in measurement order) in slot order, in place
+    /// (no allocation). When a bearing is missing (coincident agents) the order is left
+    /// as measured: the core then searches. (So is a list longer than a core's
+    /// neighbour capacity, which no core built here has.)
     #[inline]
-    pub fn apply(
-        &self,
-        i: usize,
-        bearings: &mut Vec<BearingMeasurement<f64>>,
-        scratch: &mut Vec<BearingMeasurement<f64>>,
-    ) {
+    pub fn apply(&self, i: usize, bearings: &mut [BearingMeasurement<f64>]) {
         let perm = match (self.start.get(i), self.start.get(i + 1)) {
             (Some(&a), Some(&b)) => self.perm.get(a..b).unwrap_or(&[]),
             _ => &[],
@@ -74,12 +70,16 @@ impl SlotOrder {
         if perm.is_empty() || perm.len() != bearings.len() {
             return;
         }
-        scratch.clear();
-        scratch.extend(
-            perm.iter()
-                .filter_map(|&k| bearings.get(usize::from(k)).copied()),
-        );
-        std::mem::swap(bearings, scratch);
+        let mut measured: heapless::Vec<BearingMeasurement<f64>, MAX_NEIGHBOURS> =
+            heapless::Vec::new();
+        if measured.extend_from_slice(bearings).is_err() {
+            return;
+        }
+        for (slot, &k) in bearings.iter_mut().zip(perm) {
+            if let Some(b) = measured.get(usize::from(k)) {
+                *slot = *b;
+            }
+        }
     }
 
     /// Agents whose bearings are reordered.
@@ -123,17 +123,16 @@ mod tests {
         };
         let o = SlotOrder::new(3, measured, slots);
         assert_eq!(o.reordered(), 1);
-        let mut scratch = Vec::new();
         let mut v = vec![b(3), b(5), b(7)];
-        o.apply(0, &mut v, &mut scratch);
+        o.apply(0, &mut v);
         assert_eq!(ids(&v), [5, 7, 3]);
         // A missing bearing: left as measured.
         let mut v = vec![b(3), b(7)];
-        o.apply(0, &mut v, &mut scratch);
+        o.apply(0, &mut v);
         assert_eq!(ids(&v), [3, 7]);
         for i in [1, 2] {
             let mut v: Vec<_> = measured(i).into_iter().map(b).collect();
-            o.apply(i, &mut v, &mut scratch);
+            o.apply(i, &mut v);
             assert_eq!(ids(&v), measured(i));
         }
     }
@@ -165,10 +164,9 @@ mod tests {
                 .collect();
             let o = SlotOrder::new(m.n(), measured, |i| cores[i].neighbour_order());
             assert_eq!(o.reordered() > m.n() / 4, reordered, "{}", o.reordered());
-            let mut scratch = Vec::new();
             for (i, core) in cores.iter().enumerate() {
                 let mut v: Vec<_> = measured(i).into_iter().map(b).collect();
-                o.apply(i, &mut v, &mut scratch);
+                o.apply(i, &mut v);
                 let slots = core.neighbour_order().expect("local core");
                 assert_eq!(ids(&v), slots[..v.len()], "agent {i}");
             }
