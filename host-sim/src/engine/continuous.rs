@@ -8,7 +8,7 @@
 
 use super::driver::Engine;
 use super::plant::acceleration;
-use super::sensors::Sensors;
+use super::sensors::{Sensors, Sight};
 use super::slot_order::SlotOrder;
 use super::stats::{ControlStats, FrameCounts};
 use crate::model::{
@@ -63,10 +63,15 @@ impl Rhs {
             self.bearings.clear();
             let (qi, vi) = (pos(i), vel(i));
             for &j in model.graph.triangle.of(i) {
-                if let Some(b) =
-                    self.sensors
-                        .bearing(self.ids[j], &qi, &pos(j), &vi, &vel(j), true, ranged)
-                {
+                let (qj, vj) = (pos(j), vel(j));
+                let sight = Sight {
+                    neighbour: self.ids[j],
+                    q_self: &qi,
+                    q_other: &qj,
+                    v_self: &vi,
+                    v_other: &vj,
+                };
+                if let Some(b) = self.sensors.bearing(&sight, true, ranged) {
                     self.bearings.push(b);
                 }
             }

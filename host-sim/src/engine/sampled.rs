@@ -17,7 +17,7 @@ use super::driver::Engine;
 use super::hil::{HilError, LinkStats};
 use super::plant::Plant;
 use super::radio::{Radio, RadioFrame};
-use super::sensors::{BearingNoise, Sensors};
+use super::sensors::{BearingNoise, Sensors, Sight};
 use super::slot_order::SlotOrder;
 use super::stats::{add_frame_stats, ControlStats, FrameCounts};
 use crate::model::{resolve_estimates, BearingRate, EstimateInfo, Estimator, Model};
@@ -249,10 +249,14 @@ impl SampledSim<'_> {
     fn measure(&mut self, i: usize, exact: bool, ranged: bool) -> (Vec2<f64>, Option<Vec2<f64>>) {
         let (q, v) = (&self.plant.q, &self.plant.v);
         for &j in self.model.graph.triangle.of(i) {
-            if let Some(b) =
-                self.sensors
-                    .bearing(self.ids[j], &q[i], &q[j], &v[i], &v[j], exact, ranged)
-            {
+            let sight = Sight {
+                neighbour: self.ids[j],
+                q_self: &q[i],
+                q_other: &q[j],
+                v_self: &v[i],
+                v_other: &v[j],
+            };
+            if let Some(b) = self.sensors.bearing(&sight, exact, ranged) {
                 self.bearings.push(b);
             }
         }
@@ -329,9 +333,14 @@ impl SampledSim<'_> {
                 let base = noise_start[i];
                 for (k, &j) in graph.of(i).iter().enumerate() {
                     if let Some(Some(n)) = noise_all.get(base + k) {
-                        let b = Sensors::bearing_with(
-                            sensors, *n, ids[j], &q[i], &q[j], &v[i], &v[j], exact,
-                        );
+                        let sight = Sight {
+                            neighbour: ids[j],
+                            q_self: &q[i],
+                            q_other: &q[j],
+                            v_self: &v[i],
+                            v_other: &v[j],
+                        };
+                        let b = Sensors::bearing_with(sensors, *n, &sight, exact);
                         let _ = bearings.push(b);
                     }
                 }
