@@ -7,7 +7,8 @@
 //! * a large run computed on two threads is bit-identical to one thread (the parallel
 //!   path of `SampledSim` draws its random numbers in agent order).
 //!
-//! * each in-process agent's capacity class (`LOCAL_CAPACITIES`) never changes a result.
+//! * each in-process agent's capacity class (`LOCAL_CAPACITIES`) never changes a result;
+//! * every agent's bearings reach its core in the core's slot order (its one-pass path).
 //!
 //! That the inner loop allocates nothing per tick is `tests/no_alloc.rs`.
 
@@ -154,4 +155,41 @@ fn the_capacity_class_of_an_agent_never_changes_a_result() {
         [true; LOCAL_CAPACITIES.len()],
         "a class is not exercised"
     );
+}
+
+/// A designed lattice (whose cores' slots are mostly not sorted by agent index) and the
+/// built-in strip (whose are): every agent's bearings, measured in graph order, reach
+/// its core as a prefix of its slots.
+#[test]
+fn every_agents_bearings_reach_its_core_in_slot_order() {
+    use controller_core::{BearingMeasurement, Vec2};
+    use host_sim::engine::local_core;
+    use host_sim::engine::slot_order::SlotOrder;
+    let b = |id: u8| BearingMeasurement {
+        neighbour: id,
+        bearing: Vec2::new(1.0, 0.0),
+        rate: None,
+        range: None,
+    };
+    let lattice = designed(Generator::TriangularLattice {
+        n: 40,
+        spacing: 1.0,
+    });
+    for (m, reordered) in [(lattice, true), (strip_model(40, 1.0), false)] {
+        let wire: Vec<u8> = m.agents.iter().map(|a| a.id).collect();
+        let measured =
+            |i: usize| -> Vec<u8> { m.graph.triangle.of(i).iter().map(|&j| wire[j]).collect() };
+        let cores: Vec<_> = (0..m.n())
+            .map(|i| local_core(&m, i).expect("core"))
+            .collect();
+        let o = SlotOrder::new(m.n(), measured, |i| cores[i].neighbour_order());
+        assert_eq!(o.reordered() > m.n() / 4, reordered, "{}", o.reordered());
+        for (i, core) in cores.iter().enumerate() {
+            let mut v: Vec<_> = measured(i).into_iter().map(b).collect();
+            o.apply(i, &mut v);
+            let slots = core.neighbour_order().expect("local core");
+            let ids: Vec<u8> = v.iter().map(|x| x.neighbour).collect();
+            assert_eq!(ids, slots[..v.len()], "agent {i}");
+        }
+    }
 }

@@ -21,7 +21,7 @@ mod record;
 mod result;
 pub mod sampled;
 pub mod sensors;
-mod slot_order;
+pub mod slot_order;
 mod stats;
 
 pub use continuous::ContinuousSim;

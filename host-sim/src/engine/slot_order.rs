@@ -83,7 +83,6 @@ impl SlotOrder {
     }
 
     /// Agents whose bearings are reordered.
-    #[cfg(test)]
     pub fn reordered(&self) -> usize {
         self.start.windows(2).filter(|w| w[1] > w[0]).count()
     }
@@ -134,42 +133,6 @@ mod tests {
             let mut v: Vec<_> = measured(i).into_iter().map(b).collect();
             o.apply(i, &mut v);
             assert_eq!(ids(&v), measured(i));
-        }
-    }
-
-    /// A designed lattice (whose cores' slots are mostly not sorted by agent index) and the
-    /// built-in strip (whose are): every agent's bearings, measured in graph order, reach
-    /// its core as a prefix of its slots.
-    #[test]
-    fn every_agents_bearings_reach_its_core_in_slot_order() {
-        use crate::design::{
-            construct, render_scenario, DesignOptions, Generator, ScenarioOptions,
-        };
-        let g = Generator::TriangularLattice {
-            n: 40,
-            spacing: 1.0,
-        };
-        let p = g.points().expect("points");
-        let opts = DesignOptions::default();
-        let c = construct(&p, &opts).expect("construct");
-        let text = render_scenario(&p, &c, &opts, &ScenarioOptions::default()).expect("render");
-        let lattice = crate::load_toml(&text, "designed", &[]).expect("load");
-        let strip = crate::scenario::strip_model(40, 1.0);
-        for (m, reordered) in [(lattice, true), (strip, false)] {
-            let wire: Vec<u8> = m.agents.iter().map(|a| a.id).collect();
-            let measured =
-                |i: usize| -> Vec<u8> { m.graph.triangle.of(i).iter().map(|&j| wire[j]).collect() };
-            let cores: Vec<_> = (0..m.n())
-                .map(|i| crate::engine::local_core(&m, i).expect("core"))
-                .collect();
-            let o = SlotOrder::new(m.n(), measured, |i| cores[i].neighbour_order());
-            assert_eq!(o.reordered() > m.n() / 4, reordered, "{}", o.reordered());
-            for (i, core) in cores.iter().enumerate() {
-                let mut v: Vec<_> = measured(i).into_iter().map(b).collect();
-                o.apply(i, &mut v);
-                let slots = core.neighbour_order().expect("local core");
-                assert_eq!(ids(&v), slots[..v.len()], "agent {i}");
-            }
         }
     }
 }
