@@ -158,11 +158,31 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         let mut sum = LawSum::new(self.velocity_force());
         let nbs = self.neighbours.as_slice();
         for a in self.angles.as_mut_slice().as_flattened_mut() {
+            if let Side::Far { age, .. } = &mut a.side {
+                // A far vertex: its data ages (sensing), then its law.
+                *age += dt;
+                if fault.is_none() {
+                    if let Side::Far { k, remote, age } = a.side {
+                        match far_law(&cx, nbs, a, k, &remote, age, &mut sum) {
+                            Ok(()) => *done += 1,
+                            Err(f) => fault = Some(f),
+                        }
+                    }
+                }
+                continue;
+            }
+            // The apex: its kernel (sensing), then its law on what sensing kept.
             sense_angle(nbs, cx.mode, &cx.v, a, dt);
             if fault.is_none() {
-                match angle_law(&cx, nbs, a, &mut sum) {
-                    Ok(()) => *done += 1,
-                    Err(f) => fault = Some(f),
+                if let Side::Apex { part, fault: kept } = a.side {
+                    let law = match kept {
+                        Some(f) => Err(f),
+                        None => apex_law(&cx, nbs, a, &part, &mut sum),
+                    };
+                    match law {
+                        Ok(()) => *done += 1,
+                        Err(f) => fault = Some(f),
+                    }
                 }
             }
         }
