@@ -82,6 +82,21 @@ fn hil_error(r: Result<RunResult, RunError>) -> HilError {
 
 // ------------------------------------------------------------------ stand-in target
 
+/// A target's controller knows the neighbour slots of the core it runs (the same
+/// configuration as the host's core), so the simulator sends its bearings in that order.
+#[test]
+fn targets_get_their_bearings_in_their_cores_slot_order() {
+    let m = paper(None);
+    let mut cs = hil::controllers(&m, &fake(&[1, 2, 3, 4], FakeBehaviour::default(), 10.0))
+        .expect("controllers");
+    for (i, c) in cs.iter_mut().enumerate() {
+        let local = sim::local_core(&m, i).expect("core");
+        assert!(c.neighbour_order().is_some(), "agent {i}");
+        assert_eq!(c.neighbour_order(), local.neighbour_order(), "agent {i}");
+        c.finish().expect("finish");
+    }
+}
+
 #[test]
 fn stand_in_agents_converge_like_the_host() {
     let m = paper(None);

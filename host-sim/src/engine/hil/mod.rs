@@ -106,12 +106,17 @@ fn launch(
     Ok((link, target, started, deadline))
 }
 
-/// Estimate layout and frame slots of agent `i` (from the host's own core agent of the
-/// same configuration, so the order is the one the target uses).
-fn estimate_slots(
-    model: &Model,
-    i: usize,
-) -> Result<(Vec<controller_core::OwnedEstimate<f64>>, Vec<EstimateSlot>), String> {
+/// What the target of agent `i` orders as its own core does, read from the host's core
+/// agent of the same configuration: the estimate layout, its frame slots and the
+/// neighbour slots (wire ids).
+type TargetOrder = (
+    Vec<controller_core::OwnedEstimate<f64>>,
+    Vec<EstimateSlot>,
+    Vec<u8>,
+);
+
+/// [`TargetOrder`] of agent `i`.
+fn target_order(model: &Model, i: usize) -> Result<TargetOrder, String> {
     let core = model.core_agent(i)?;
     let layout: Vec<_> = core.owned_estimates().collect();
     let infos = resolve_estimates(model, i, &layout)?;
@@ -126,7 +131,7 @@ fn estimate_slots(
             other: model.agents[info.other].id,
         })
         .collect();
-    Ok((layout, slots))
+    Ok((layout, slots, core.neighbours().collect()))
 }
 
 /// Builds the controllers of a host-in-the-loop run: the chosen agents on their targets
@@ -172,22 +177,26 @@ pub fn controllers(
     for ((&i, config), (link, target, started, startup)) in
         indices.iter().zip(&configs).zip(launched)
     {
-        let (layout, slots) = estimate_slots(model, i).map_err(|reason| HilError::Refused {
-            agent: model.agents[i].name.clone(),
-            reason,
-        })?;
-        hil.push(Some(HilController::configure(
-            config,
-            link,
-            target,
-            opts.timeout,
-            startup,
-            layout,
-            slots,
-            model.initial_estimate,
-            started,
-            &model.agents[i].name,
-        )?));
+        let (layout, slots, order) =
+            target_order(model, i).map_err(|reason| HilError::Refused {
+                agent: model.agents[i].name.clone(),
+                reason,
+            })?;
+        hil.push(Some(
+            HilController::configure(
+                config,
+                link,
+                target,
+                opts.timeout,
+                startup,
+                layout,
+                slots,
+                model.initial_estimate,
+                started,
+                &model.agents[i].name,
+            )?
+            .with_neighbour_order(order),
+        ));
     }
     let mut out: Vec<Box<dyn AgentController>> = Vec::with_capacity(model.n());
     for i in 0..model.n() {

@@ -43,6 +43,8 @@ pub struct HilController {
     timeout: Duration,
     layout: Vec<OwnedEstimate<f64>>,
     slots: Vec<EstimateSlot>,
+    /// The target's neighbour slots (wire ids), when known: bearings go in this order.
+    neighbour_order: Option<Vec<u8>>,
     estimates: Vec<f64>,
     estimates_from_target: bool,
     /// The frames' integrity and estimator mode (to read the agent's own frames).
@@ -91,6 +93,7 @@ impl HilController {
             estimates: vec![initial; layout.len()],
             layout,
             slots,
+            neighbour_order: None,
             estimates_from_target: false,
             modes: (config.integrity, config.estimator),
             ticks: 0,
@@ -175,6 +178,15 @@ impl HilController {
                 what: format!("{other:?} (expected Ready)"),
             }),
         }
+    }
+
+    /// The target's neighbour slots in order (wire ids, as
+    /// `controller_core::Agent::neighbours` gives them for its configuration): the
+    /// simulator then sends the bearings in that order, the one the target's core takes
+    /// in one pass.
+    pub fn with_neighbour_order(mut self, order: Vec<u8>) -> Self {
+        self.neighbour_order = Some(order);
+        self
     }
 
     /// QEMU's pid, for a QEMU target.

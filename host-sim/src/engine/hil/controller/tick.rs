@@ -237,6 +237,10 @@ impl AgentController for HilController {
         self.receive_tick(outbox)
     }
 
+    fn neighbour_order(&self) -> Option<Vec<u8>> {
+        self.neighbour_order.clone()
+    }
+
     fn take_error(&mut self) -> Option<HilError> {
         self.error.take()
     }
