@@ -182,7 +182,7 @@ fn every_agents_bearings_reach_its_core_in_slot_order() {
         let cores: Vec<_> = (0..m.n())
             .map(|i| local_core(&m, i).expect("core"))
             .collect();
-        let o = SlotOrder::new(m.n(), measured, |i| cores[i].neighbour_order());
+        let o = SlotOrder::for_model(&m, |i| cores[i].neighbour_order());
         assert_eq!(o.reordered() > m.n() / 4, reordered, "{}", o.reordered());
         for (i, core) in cores.iter().enumerate() {
             let mut v: Vec<_> = measured(i).into_iter().map(b).collect();

@@ -157,6 +157,9 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         let cx = self.law_context(Some(dt));
         let mut sum = LawSum::new(self.velocity_force());
         let nbs = self.neighbours.as_slice();
+        // The two arms below are `sense_angle` and `angle_law` written out so that the
+        // side of each angle is tested once: on target that is 951 → 903 (tri2) and
+        // 2 772 → 2 601 (tri8) instructions per step (docs/firmware.md).
         for a in self.angles.as_mut_slice().as_flattened_mut() {
             if let Side::Far { age, .. } = &mut a.side {
                 // A far vertex: its data ages (sensing), then its law.

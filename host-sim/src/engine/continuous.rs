@@ -172,12 +172,8 @@ impl<'m> ContinuousSim<'m> {
         }
         y.extend(info.iter().map(|_| model.initial_estimate));
         let partner = model.partners();
-        let ids: Vec<u8> = model.agents.iter().map(|a| a.id).collect();
-        let slot_order = SlotOrder::new(
-            n,
-            |i| model.graph.triangle.of(i).iter().map(|&j| ids[j]).collect(),
-            |i| agents.get(i).map(|a| a.neighbours().collect()),
-        );
+        let slot_order =
+            SlotOrder::for_model(model, |i| agents.get(i).map(|a| a.neighbours().collect()));
         let mut sim = Self {
             model,
             rhs: Rhs {
@@ -186,7 +182,7 @@ impl<'m> ContinuousSim<'m> {
                 bearings: Vec::with_capacity(model.graph.triangle.max_degree()),
                 slot_order,
                 partner,
-                ids,
+                ids: model.agents.iter().map(|a| a.id).collect(),
                 est_start,
                 info,
                 sense_fault: vec![None; n],

@@ -139,12 +139,7 @@ impl<'m> SampledSim<'m> {
             .map(|i| Vec::with_capacity(model.graph.radio.of(i).len() * FRAMES_PER_TICK * 4 + 8))
             .collect();
         let partner = model.partners();
-        let ids: Vec<u8> = model.agents.iter().map(|a| a.id).collect();
-        let slot_order = SlotOrder::new(
-            n,
-            |i| model.graph.triangle.of(i).iter().map(|&j| ids[j]).collect(),
-            |i| controllers[i].neighbour_order(),
-        );
+        let slot_order = SlotOrder::for_model(model, |i| controllers[i].neighbour_order());
         let mut radio = Radio::new(&model.radio, n, model.seed, capacity);
         radio.attach_channel(&model.graph.radio, period);
         Ok(Self {
@@ -164,7 +159,7 @@ impl<'m> SampledSim<'m> {
             bearings: Vec::with_capacity(model.graph.triangle.max_degree()),
             slot_order,
             partner,
-            ids,
+            ids: model.agents.iter().map(|a| a.id).collect(),
             estimates: vec![model.initial_estimate; info.len()],
             est_start,
             info,
@@ -249,13 +244,7 @@ impl SampledSim<'_> {
     fn measure(&mut self, i: usize, exact: bool, ranged: bool) -> (Vec2<f64>, Option<Vec2<f64>>) {
         let (q, v) = (&self.plant.q, &self.plant.v);
         for &j in self.model.graph.triangle.of(i) {
-            let sight = Sight {
-                neighbour: self.ids[j],
-                q_self: &q[i],
-                q_other: &q[j],
-                v_self: &v[i],
-                v_other: &v[j],
-            };
+            let sight = Sight::between(&self.ids, q, v, i, j);
             if let Some(b) = self.sensors.bearing(&sight, exact, ranged) {
                 self.bearings.push(b);
             }
@@ -307,9 +296,10 @@ impl SampledSim<'_> {
         self.noise_start.clear();
         for i in 0..self.model.n() {
             self.noise_start.push(self.noise_all.len());
-            let q = &self.plant.q;
+            let (q, v) = (&self.plant.q, &self.plant.v);
             for &j in graph.of(i) {
-                let noise = self.sensors.bearing_noise(&q[i], &q[j], ranged);
+                let sight = Sight::between(&self.ids, q, v, i, j);
+                let noise = self.sensors.bearing_noise(&sight, ranged);
                 self.noise_all.push(noise);
             }
             self.measured[i] = self.measure_own(i);
@@ -333,13 +323,7 @@ impl SampledSim<'_> {
                 let base = noise_start[i];
                 for (k, &j) in graph.of(i).iter().enumerate() {
                     if let Some(Some(n)) = noise_all.get(base + k) {
-                        let sight = Sight {
-                            neighbour: ids[j],
-                            q_self: &q[i],
-                            q_other: &q[j],
-                            v_self: &v[i],
-                            v_other: &v[j],
-                        };
+                        let sight = Sight::between(ids, q, v, i, j);
                         let b = Sensors::bearing_with(sensors, *n, &sight, exact);
                         let _ = bearings.push(b);
                     }

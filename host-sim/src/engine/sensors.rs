@@ -27,6 +27,20 @@ pub struct Sight<'a> {
     pub v_other: &'a Vec2<f64>,
 }
 
+impl<'a> Sight<'a> {
+    /// Agent `i`'s sight of agent `j`, from every agent's wire id, position and velocity.
+    #[inline]
+    pub fn between(ids: &[u8], q: &'a [Vec2<f64>], v: &'a [Vec2<f64>], i: usize, j: usize) -> Self {
+        Self {
+            neighbour: ids[j],
+            q_self: &q[i],
+            q_other: &q[j],
+            v_self: &v[i],
+            v_other: &v[j],
+        }
+    }
+}
+
 /// The random part of one bearing measurement ([`Sensors::bearing_noise`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct BearingNoise {
@@ -69,8 +83,8 @@ impl Sensors {
 
     /// The bearing measured along `sight` (tagged with the neighbour's id), `None` if
     /// the agents coincide. `exact_rate` adds the S2 rate of the true state;
-    /// `with_range` the (noisy) distance. ([`Sensors::bearing_noise`] then
-    /// [`Sensors::bearing_with`].)
+    /// `with_range` the (noisy) distance. (What [`Sensors::bearing_noise`] then
+    /// [`Sensors::bearing_with`] give, with the distance computed once.)
     #[inline]
     pub fn bearing(
         &mut self,
@@ -78,8 +92,9 @@ impl Sensors {
         exact_rate: bool,
         with_range: bool,
     ) -> Option<BearingMeasurement<f64>> {
-        let noise = self.bearing_noise(sight.q_self, sight.q_other, with_range)?;
-        Some(Self::bearing_with(&self.model, noise, sight, exact_rate))
+        let (d, r) = separation(sight)?;
+        let noise = self.draw(with_range);
+        Some(measured(&self.model, noise, sight, d, r, exact_rate))
     }
 
     /// The random part of [`Sensors::bearing`], drawn from the stream exactly as it draws
@@ -87,23 +102,9 @@ impl Sensors {
     /// coincide, `None`). With [`Sensors::bearing_with`] the draws (in agent order) and
     /// the geometry (on any thread) can be apart.
     #[inline]
-    pub fn bearing_noise(
-        &mut self,
-        q_self: &Vec2<f64>,
-        q_other: &Vec2<f64>,
-        with_range: bool,
-    ) -> Option<BearingNoise> {
-        let r = (q_other - q_self).norm();
-        if !(r > 0.0 && r.is_finite()) {
-            return None;
-        }
-        let angle = self.gauss(self.model.bearing_noise);
-        let range = if with_range {
-            Some(self.gauss(self.model.range_noise))
-        } else {
-            None
-        };
-        Some(BearingNoise { angle, range })
+    pub fn bearing_noise(&mut self, sight: &Sight<'_>, with_range: bool) -> Option<BearingNoise> {
+        separation(sight)?;
+        Some(self.draw(with_range))
     }
 
     /// The bearing with the given noise (no random draws): the true bearing rotated by
@@ -117,31 +118,21 @@ impl Sensors {
         sight: &Sight<'_>,
         exact_rate: bool,
     ) -> BearingMeasurement<f64> {
-        let Sight {
-            neighbour,
-            q_self,
-            q_other,
-            v_self,
-            v_other,
-        } = *sight;
-        let d = q_other - q_self;
+        let d = sight.q_other - sight.q_self;
         let r = d.norm();
-        let s_true = d / r;
-        let angle = model.bearing_bias + noise.angle;
-        let bearing = if angle != 0.0 {
-            let (sn, cs) = angle.sin_cos();
-            Vec2::new(cs * s_true.x - sn * s_true.y, sn * s_true.x + cs * s_true.y)
+        measured(model, noise, sight, d, r, exact_rate)
+    }
+
+    /// The noise of one bearing: the rotation, then the range error if `with_range`.
+    #[inline]
+    fn draw(&mut self, with_range: bool) -> BearingNoise {
+        let angle = self.gauss(self.model.bearing_noise);
+        let range = if with_range {
+            Some(self.gauss(self.model.range_noise))
         } else {
-            s_true
+            None
         };
-        let rate = exact_rate.then(|| geometry::bearing_rate(&s_true, &(v_other - v_self), r));
-        let range = noise.range.map(|e| (r + e).max(1e-6));
-        BearingMeasurement {
-            neighbour,
-            bearing,
-            rate,
-            range,
-        }
+        BearingNoise { angle, range }
     }
 
     /// The agent's measured own velocity.
@@ -158,6 +149,46 @@ impl Sensors {
         let s = self.model.offset_noise;
         let d = q_partner - q_self;
         Vec2::new(d.x + self.gauss(s), d.y + self.gauss(s))
+    }
+}
+
+/// The displacement `d = q_other − q_self` and distance `r = |d|` of a sight, `None` when
+/// no bearing can be measured (the agents coincide, or `r` is not finite).
+#[inline]
+fn separation(sight: &Sight<'_>) -> Option<(Vec2<f64>, f64)> {
+    let d = sight.q_other - sight.q_self;
+    let r = d.norm();
+    (r > 0.0 && r.is_finite()).then_some((d, r))
+}
+
+/// The bearing along `sight` with displacement `d` and distance `r` and the given noise:
+/// the true bearing `d / r` rotated by `bearing_bias + noise.angle`, the exact S2 rate
+/// with `exact_rate`, the distance plus `noise.range` when drawn.
+#[inline]
+fn measured(
+    model: &SensorModel,
+    noise: BearingNoise,
+    sight: &Sight<'_>,
+    d: Vec2<f64>,
+    r: f64,
+    exact_rate: bool,
+) -> BearingMeasurement<f64> {
+    let s_true = d / r;
+    let angle = model.bearing_bias + noise.angle;
+    let bearing = if angle != 0.0 {
+        let (sn, cs) = angle.sin_cos();
+        Vec2::new(cs * s_true.x - sn * s_true.y, sn * s_true.x + cs * s_true.y)
+    } else {
+        s_true
+    };
+    let rate =
+        exact_rate.then(|| geometry::bearing_rate(&s_true, &(sight.v_other - sight.v_self), r));
+    let range = noise.range.map(|e| (r + e).max(1e-6));
+    BearingMeasurement {
+        neighbour: sight.neighbour,
+        bearing,
+        rate,
+        range,
     }
 }
 
@@ -236,7 +267,7 @@ mod tests {
             };
             let a = one.bearing(&sight, true, ranged);
             let b = two
-                .bearing_noise(&q[i], &q[j], ranged)
+                .bearing_noise(&sight, ranged)
                 .map(|n| Sensors::bearing_with(&m, n, &sight, true));
             assert_eq!(a, b, "draw {k}");
             drawn += usize::from(a.is_some());

@@ -2,9 +2,11 @@
 //! `controller_core::Agent::neighbours`). A core takes bearings in slot order in one pass;
 //! in any other order it searches for each one (same result, more work). The sensors
 //! measure in graph order, the order their random stream is drawn in (which fixes every
-//! noisy run's result), so the measurements are put in slot order afterwards. A strip or
-//! lattice agent's slots are not sorted by agent index; the paper's are.
+//! noisy run's result), so the measurements are put in slot order afterwards. A designed
+//! formation's slots are mostly not sorted by agent index; the paper's and the built-in
+//! strip's are.
 
+use crate::model::Model;
 use controller_core::{BearingMeasurement, MAX_NEIGHBOURS};
 
 /// Per agent, the permutation from measurement order to slot order (empty: already in
@@ -55,6 +57,24 @@ impl SlotOrder {
         }
         start.push(perm.len());
         Self { start, perm }
+    }
+
+    /// [`SlotOrder::new`] for `model`'s agents, measured in the order of its triangle
+    /// graph (as the engine's sensors measure them).
+    pub fn for_model(model: &Model, slots: impl Fn(usize) -> Option<Vec<u8>>) -> Self {
+        Self::new(
+            model.n(),
+            |i| {
+                model
+                    .graph
+                    .triangle
+                    .of(i)
+                    .iter()
+                    .map(|&j| model.agents[j].id)
+                    .collect()
+            },
+            slots,
+        )
     }
 
     /// Puts agent `i`'s bearings (measured in measurement order) in slot order, in place

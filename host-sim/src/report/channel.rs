@@ -27,9 +27,7 @@ pub(super) fn add_json(obj: &mut Map<String, Value>, m: &Model, r: &RunResult) {
     let (Some(c), Some(s)) = (&m.radio.channel, &r.channel) else {
         return;
     };
-    obj.insert(
-        "channel".to_owned(),
-        json!({
+    let mut channel = json!({
             "preset": c.preset,
             "access": c.access.as_str(),
             "bit_rate": fin(c.bit_rate),
@@ -49,12 +47,11 @@ pub(super) fn add_json(obj: &mut Map<String, Value>, m: &Model, r: &RunResult) {
             "max_access_wait_s": fin(s.max_access_wait),
             "mean_neighbour_age_s": fin(s.mean_age),
             "max_neighbour_age_s": fin(s.max_age),
-        }),
-    );
+    });
     // Transmitters outside the swarm (a flood): only for scenarios with attackers, so
     // other summaries keep their bytes.
     if !m.attacks.is_empty() {
-        if let Some(Value::Object(ch)) = obj.get_mut("channel") {
+        if let Value::Object(ch) = &mut channel {
             ch.insert(
                 "external_transmissions".to_owned(),
                 json!(s.external_transmissions),
@@ -66,6 +63,7 @@ pub(super) fn add_json(obj: &mut Map<String, Value>, m: &Model, r: &RunResult) {
             );
         }
     }
+    obj.insert("channel".to_owned(), channel);
 }
 
 /// Rows of the summary table (none without a channel or a reduced broadcast rate).
