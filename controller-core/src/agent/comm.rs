@@ -6,7 +6,7 @@ use super::state::{AngleState, Remote, Side};
 use super::Agent;
 use crate::config::AgentId;
 use crate::wire::auth::{self, Counter};
-use crate::wire::{check_mode, quant, FrameError, Integrity, RawAngle};
+use crate::wire::{check_mode, quant, CrcCheck, FrameError, Integrity, RawAngle};
 use crate::{law, Real, Vec2};
 
 /// A broadcast item at full precision (the wire rounds the angle's values to binary16).
@@ -127,22 +127,46 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         result
     }
 
+    /// [`Agent::receive`] of `bytes` whose CRC was checked once for every receiver:
+    /// `check` is [`CrcCheck::of`] these same bytes (or `None`). The same result and
+    /// counters as `receive`, without computing the CRC again; for simulators that hand
+    /// one broadcast to many agents. As a guard, a check whose length or trailer differs
+    /// from `bytes` is ignored (the CRC is then computed).
+    pub fn receive_checked(
+        &mut self,
+        bytes: &[u8],
+        check: Option<CrcCheck>,
+    ) -> Result<(), FrameError> {
+        let crc_ok = check.and_then(|c| c.result_for(bytes));
+        let result = match (self.config.integrity, crc_ok) {
+            (Integrity::Crc16, Some(ok)) => self.receive_in(bytes, Integrity::Crc16, Some(ok)),
+            _ => self.receive_inner(bytes),
+        };
+        self.stats.record(&result);
+        result
+    }
+
     /// [`Agent::receive`] without the counting: one copy of [`Agent::receive_in`] for
     /// `auth` and one for `crc16`/`link`, so that the integrity mode is tested once per
     /// frame and the `crc16`/`link` path carries none of the `auth` path's work.
     fn receive_inner(&mut self, bytes: &[u8]) -> Result<(), FrameError> {
         match self.config.integrity {
-            Integrity::Auth(key) => self.receive_in(bytes, Integrity::Auth(key)),
-            Integrity::Crc16 => self.receive_in(bytes, Integrity::Crc16),
-            Integrity::Link => self.receive_in(bytes, Integrity::Link),
+            Integrity::Auth(key) => self.receive_in(bytes, Integrity::Auth(key), None),
+            Integrity::Crc16 => self.receive_in(bytes, Integrity::Crc16, None),
+            Integrity::Link => self.receive_in(bytes, Integrity::Link, None),
         }
     }
 
     /// Checks and applies one frame for a receiver with `integrity` (its configured mode,
-    /// a constant where it is inlined).
+    /// a constant where it is inlined); `crc_ok`: the CRC check's result if known.
     #[inline(always)]
-    fn receive_in(&mut self, bytes: &[u8], integrity: Integrity) -> Result<(), FrameError> {
-        let frame = check_mode(bytes, integrity, self.mode)?;
+    fn receive_in(
+        &mut self,
+        bytes: &[u8],
+        integrity: Integrity,
+        crc_ok: Option<bool>,
+    ) -> Result<(), FrameError> {
+        let frame = check_mode(bytes, integrity, self.mode, crc_ok)?;
         let sender = frame.header.sender;
         if sender == self.config.id {
             return Err(FrameError::OwnFrame);

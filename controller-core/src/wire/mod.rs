@@ -50,12 +50,14 @@
 //! but the counters.
 
 pub mod auth;
+mod checked;
 mod cobs;
 pub mod quant;
 mod reader;
 mod writer;
 
 pub use auth::SwarmKey;
+pub use checked::CrcCheck;
 pub use cobs::{cobs_decode, cobs_encode, CobsAccumulator, MAX_COBS_LEN};
 pub use reader::{check_frame, decode_frame, AngleItem, Frame, FrameView};
 pub(crate) use reader::{check_mode, RawAngle};

@@ -189,16 +189,19 @@ pub fn check_frame(
     integrity: Integrity,
     estimator: EstimatorMode,
 ) -> Result<FrameView<'_>, FrameError> {
-    check_mode(bytes, integrity, mode_byte(integrity, estimator))
+    check_mode(bytes, integrity, mode_byte(integrity, estimator), None)
 }
 
-/// [`check_frame`] against the receiver's mode byte (see [`super::mode_byte`]). Always
-/// inlined: where `integrity` is a constant, the other modes' checks fold away.
+/// [`check_frame`] against the receiver's mode byte (see [`super::mode_byte`]), with the
+/// result of the CRC check if it is already known for these bytes (`crc_ok`, see
+/// [`super::CrcCheck`]). Always inlined: where `integrity` is a constant, the other
+/// modes' checks fold away.
 #[inline(always)]
 pub(crate) fn check_mode(
     bytes: &[u8],
     integrity: Integrity,
     expected_mode: u8,
+    crc_ok: Option<bool>,
 ) -> Result<FrameView<'_>, FrameError> {
     if bytes.len() > MAX_FRAME_LEN {
         return Err(FrameError::TooLong);
@@ -210,7 +213,11 @@ pub(crate) fn check_mode(
         .split_first_chunk::<FIXED_LEN>()
         .ok_or(FrameError::TooShort)?;
     if let (Integrity::Crc16, [c0, c1]) = (integrity, trailer) {
-        if crc16::checksum(body) != u16::from_le_bytes([*c0, *c1]) {
+        let ok = match crc_ok {
+            Some(ok) => ok,
+            None => crc16::checksum(body) == u16::from_le_bytes([*c0, *c1]),
+        };
+        if !ok {
             return Err(FrameError::BadCrc);
         }
     }

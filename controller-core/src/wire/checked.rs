@@ -1,0 +1,58 @@
+//! A frame's CRC-16 checked once for several receivers ([`CrcCheck`]).
+
+use super::{Integrity, MAX_FRAME_LEN, WIRE_VERSION};
+use crate::crc16;
+use core::num::NonZeroU8;
+
+/// The result of the CRC-16 check of one `crc16` frame, computed once
+/// ([`CrcCheck::of`]) for bytes that several receivers take in: a simulator delivers each
+/// broadcast to every agent in radio range, and each would compute the same CRC of the
+/// same bytes. [`crate::Agent::receive_checked`] uses it instead of computing the CRC
+/// again, and only for the bytes it was computed from (same length and trailer;
+/// otherwise it computes the CRC itself). Everything else about the frame is checked by
+/// each receiver as in [`crate::Agent::receive`], with the same result.
+///
+/// A microcontroller hears each frame once: it calls [`crate::Agent::receive`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CrcCheck {
+    /// Its last two bytes (the CRC it carries).
+    trailer: [u8; 2],
+    /// Bits 0–6: the frame's length (2 ..= [`MAX_FRAME_LEN`], so never zero); bit 7: the
+    /// CRC-16 of the bytes before the trailer equals the trailer. (Three bytes in all,
+    /// `Option<CrcCheck>` too: a simulator's frame of 60 bytes, its length and its check
+    /// fit one 64-byte cache line.)
+    len_ok: NonZeroU8,
+}
+
+/// Bit 7 of [`CrcCheck::len_ok`].
+const OK: u8 = 0x80;
+
+impl CrcCheck {
+    /// The CRC check of `bytes` if they are a version-3 `crc16` frame of at most
+    /// [`MAX_FRAME_LEN`] bytes (mode byte and length); `None` otherwise (then a
+    /// receiver checks the frame itself, as always).
+    pub fn of(bytes: &[u8]) -> Option<Self> {
+        let crc16_mode = (WIRE_VERSION << 4) | (Integrity::Crc16.code() << 2);
+        let mode = *bytes.first()?;
+        if mode & 0xFC != crc16_mode || bytes.len() > MAX_FRAME_LEN {
+            return None;
+        }
+        let (body, trailer) = bytes.split_last_chunk::<2>()?;
+        // 2 ..= 60: fits bits 0–6 and is not zero.
+        let len = u8::try_from(bytes.len()).ok()?;
+        let ok = crc16::checksum(body) == u16::from_le_bytes(*trailer);
+        Some(Self {
+            trailer: *trailer,
+            len_ok: NonZeroU8::new(len | if ok { OK } else { 0 })?,
+        })
+    }
+
+    /// The check's result if it was computed from `bytes` (same length and trailer).
+    #[inline]
+    pub(crate) fn result_for(&self, bytes: &[u8]) -> Option<bool> {
+        let len_ok = self.len_ok.get();
+        let same = usize::from(len_ok & !OK) == bytes.len()
+            && bytes.last_chunk::<2>().is_some_and(|t| *t == self.trailer);
+        same.then_some(len_ok & OK != 0)
+    }
+}
