@@ -12,6 +12,60 @@ use crate::engine::radio::RadioFrame;
 use crate::model::{Model, MT, NB};
 use controller_core::{Agent, FrameStats, Measurements, OwnedEstimate, StepOutput};
 
+/// The frames an agent takes in at one tick, in arrival order: what the radio delivered
+/// to it, then (direct delivery, [`crate::engine::sampled::direct_radio`]) its radio
+/// neighbours' broadcasts of the last tick in sender order, read where their senders
+/// left them (no copy per receiver).
+#[derive(Clone, Copy, Debug)]
+pub struct Inbox<'a> {
+    delivered: &'a [RadioFrame],
+    senders: &'a [usize],
+    sent: &'a [Vec<RadioFrame>],
+}
+
+impl<'a> Inbox<'a> {
+    /// The frames the radio `delivered`.
+    pub fn new(delivered: &'a [RadioFrame]) -> Self {
+        Self {
+            delivered,
+            senders: &[],
+            sent: &[],
+        }
+    }
+
+    /// Then the frames `sent[j]` of every sender `j` in `senders`, in that order.
+    pub fn with_sent(self, senders: &'a [usize], sent: &'a [Vec<RadioFrame>]) -> Self {
+        Self {
+            senders,
+            sent,
+            ..self
+        }
+    }
+
+    /// Every frame, in arrival order.
+    pub fn frames(&self) -> impl Iterator<Item = &'a RadioFrame> + 'a {
+        let sent = self.sent;
+        let direct = self.senders.iter().filter_map(move |&j| sent.get(j));
+        self.delivered.iter().chain(direct.flatten())
+    }
+
+    /// The number of frames.
+    pub fn len(&self) -> usize {
+        let sent = self.sent;
+        let direct: usize = self
+            .senders
+            .iter()
+            .filter_map(|&j| sent.get(j).map(Vec::len))
+            .sum();
+        self.delivered.len() + direct
+    }
+
+    /// No frame.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
 /// One agent's controller, as seen by the sampled simulator.
 pub trait AgentController: Send {
     /// The agent's wire id.
@@ -22,7 +76,7 @@ pub trait AgentController: Send {
     /// `outbox`, and return the force command.
     fn tick(
         &mut self,
-        inbox: &[RadioFrame],
+        inbox: Inbox<'_>,
         m: &Measurements<'_, f64>,
         outbox: &mut Vec<RadioFrame>,
     ) -> StepOutput<f64>;
@@ -50,7 +104,7 @@ pub trait AgentController: Send {
     /// the whole tick at once.
     fn start_tick(
         &mut self,
-        inbox: &[RadioFrame],
+        inbox: Inbox<'_>,
         m: &Measurements<'_, f64>,
         outbox: &mut Vec<RadioFrame>,
     ) -> Result<Option<StepOutput<f64>>, HilError> {
@@ -140,13 +194,14 @@ impl<const M: usize, const N: usize> AgentController for LocalCore<M, N> {
 
     fn tick(
         &mut self,
-        inbox: &[RadioFrame],
+        inbox: Inbox<'_>,
         m: &Measurements<'_, f64>,
         outbox: &mut Vec<RadioFrame>,
     ) -> StepOutput<f64> {
-        for f in inbox {
-            // Rejections are counted in the agent's FrameStats.
-            let _ = self.agent.receive(f.as_bytes());
+        for f in inbox.frames() {
+            // Rejections are counted in the agent's FrameStats. The frame's CRC was
+            // checked once for all its receivers (the same result as `receive`).
+            let _ = self.agent.receive_checked(f.as_bytes(), f.crc_check());
         }
         let out = self.agent.step(m);
         self.agent

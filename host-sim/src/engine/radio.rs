@@ -1,4 +1,4 @@
-//! The radio model: frames are real postcard bytes (at most 60), broadcast by a sender
+//! The radio model: frames are the core's real wire bytes (version 3, at most 60), broadcast by a sender
 //! and copied to each of its radio neighbours; every copy independently suffers loss,
 //! latency + jitter, reordering, duplication and corruption. A sender's air time is
 //! limited by an optional bandwidth with a bounded transmit queue.
@@ -18,6 +18,7 @@
 use super::channel::{Channel, ChannelStats};
 use crate::model::graph::Adjacency;
 use crate::model::RadioModel;
+use controller_core::wire::CrcCheck;
 use controller_core::{Vec2, MAX_FRAME_LEN};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -31,12 +32,22 @@ const TIME_EPS: f64 = 1e-9;
 /// The sender index of frames from outside the swarm ([`Radio::inject`]).
 const EXTERNAL: usize = u32::MAX as usize;
 
-/// One frame on the air: up to [`MAX_FRAME_LEN`] bytes, stored inline (no heap).
+/// One frame on the air: up to [`MAX_FRAME_LEN`] bytes, stored inline (no heap), with
+/// its CRC check ([`CrcCheck`], for `crc16` frames), done once when the frame is made
+/// (or corrupted) instead of once by every receiver: every copy of a broadcast carries
+/// it ([`Self::crc_check`], `controller_core::Agent::receive_checked`).
+///
+/// 64 bytes, aligned to 64: one cache line per frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(align(64))]
 pub struct RadioFrame {
     len: u8,
     bytes: [u8; MAX_FRAME_LEN],
+    crc: Option<CrcCheck>,
 }
+
+// One cache line: the length byte, 60 bytes and the 3-byte check.
+const _: () = assert!(std::mem::size_of::<RadioFrame>() == 64);
 
 impl RadioFrame {
     /// Copies `bytes` (truncated to [`MAX_FRAME_LEN`]; the core never produces more).
@@ -45,11 +56,18 @@ impl RadioFrame {
         let mut f = Self {
             len: n as u8,
             bytes: [0; MAX_FRAME_LEN],
+            crc: None,
         };
         if let (Some(dst), Some(src)) = (f.bytes.get_mut(..n), bytes.get(..n)) {
             dst.copy_from_slice(src);
         }
+        f.crc = CrcCheck::of(f.as_bytes());
         f
+    }
+
+    /// The frame's CRC check, if it is a `crc16` frame.
+    pub fn crc_check(&self) -> Option<CrcCheck> {
+        self.crc
     }
 
     /// The frame's bytes.
@@ -65,6 +83,7 @@ impl RadioFrame {
             if let Some(byte) = self.bytes.get_mut(b / 8) {
                 *byte ^= 1 << (b % 8);
             }
+            self.crc = CrcCheck::of(self.as_bytes());
         }
     }
 }
@@ -219,12 +238,23 @@ impl Radio {
 
     /// Broadcasts `bytes` from agent `from` at time `now` to `receivers`.
     pub fn broadcast(&mut self, now: f64, from: usize, receivers: &[usize], bytes: &[u8]) {
-        let frame = RadioFrame::new(bytes);
+        self.broadcast_frame(now, from, receivers, RadioFrame::new(bytes));
+    }
+
+    /// [`Self::broadcast`] of a frame already made.
+    pub fn broadcast_frame(
+        &mut self,
+        now: f64,
+        from: usize,
+        receivers: &[usize],
+        frame: RadioFrame,
+    ) {
+        let bytes = frame.as_bytes();
         self.stats.broadcasts += 1;
         let copies = receivers.len() as u64;
         self.stats.sent += copies;
         if let Some(c) = &mut self.channel {
-            if !c.transmit(now, from, bytes, self.model.queue_limit) {
+            if !c.transmit(now, from, frame, self.model.queue_limit) {
                 self.stats.queue_dropped += copies;
             }
             return;

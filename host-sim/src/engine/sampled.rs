@@ -12,7 +12,7 @@
 
 use super::attack::{AttackCounts, Attacks};
 use super::channel::ChannelStats;
-use super::controller::{local_core, AgentController};
+use super::controller::{local_core, AgentController, Inbox};
 use super::driver::Engine;
 use super::hil::{HilError, LinkStats};
 use super::plant::Plant;
@@ -20,6 +20,7 @@ use super::radio::{Radio, RadioFrame};
 use super::sensors::{BearingNoise, Sensors, Sight};
 use super::slot_order::SlotOrder;
 use super::stats::{add_frame_stats, ControlStats, FrameCounts};
+use crate::model::graph::Adjacency;
 use crate::model::{resolve_estimates, BearingRate, EstimateInfo, Estimator, Model};
 use controller_core::{
     BearingMeasurement, FrameStats, Measurements, StepOutput, Vec2, MAX_NEIGHBOURS,
@@ -59,6 +60,9 @@ pub struct SampledSim<'m> {
     attacks: Attacks,
     inboxes: Vec<Vec<RadioFrame>>,
     outboxes: Vec<Vec<RadioFrame>>,
+    /// Direct delivery: the outboxes of the last tick, which the receivers read in place
+    /// (swapped with `outboxes` at every tick).
+    sent: Vec<Vec<RadioFrame>>,
     outputs: Vec<Option<StepOutput<f64>>>,
     error: Option<HilError>,
     forces: Vec<Vec2<f64>>,
@@ -135,9 +139,17 @@ impl<'m> SampledSim<'m> {
         let capacity = (links * FRAMES_PER_TICK * 2)
             .saturating_mul(ticks_in_flight)
             .min(1 << 20);
+        let direct = direct_radio(model);
+        // Direct delivery reads the senders' frames in place: no inbox.
         let inboxes = (0..n)
-            .map(|i| Vec::with_capacity(model.graph.radio.of(i).len() * FRAMES_PER_TICK * 4 + 8))
+            .map(|i| match direct {
+                true => Vec::new(),
+                false => {
+                    Vec::with_capacity(model.graph.radio.of(i).len() * FRAMES_PER_TICK * 4 + 8)
+                }
+            })
             .collect();
+        let outbox = || Vec::with_capacity(4 * FRAMES_PER_TICK);
         let partner = model.partners();
         let slot_order = SlotOrder::for_model(model, |i| controllers[i].neighbour_order());
         let mut radio = Radio::new(&model.radio, n, model.seed, capacity);
@@ -150,9 +162,11 @@ impl<'m> SampledSim<'m> {
             radio,
             attacks: Attacks::new(model),
             inboxes,
-            outboxes: (0..n)
-                .map(|_| Vec::with_capacity(4 * FRAMES_PER_TICK))
-                .collect(),
+            outboxes: (0..n).map(|_| outbox()).collect(),
+            sent: match direct {
+                true => (0..n).map(|_| outbox()).collect(),
+                false => Vec::new(),
+            },
             outputs: vec![None; n],
             error: None,
             forces: vec![Vec2::zeros(); n],
@@ -165,7 +179,7 @@ impl<'m> SampledSim<'m> {
             info,
             last_tick: None,
             stats: ControlStats::default(),
-            direct: direct_radio(model),
+            direct,
             local: false,
             noise_all: Vec::with_capacity(model.graph.triangle.total()),
             noise_start: Vec::with_capacity(n + 1),
@@ -210,33 +224,20 @@ impl SampledSim<'_> {
         self.local && self.model.n() >= PARALLEL_MIN_AGENTS && rayon::current_num_threads() > 1
     }
 
-    /// Direct delivery: every receiver gets its radio neighbours' frames of the last tick,
-    /// in sender order (what [`Radio`]'s queue delivers when nothing delays or changes
-    /// them), and the radio counts them delivered.
-    fn gather(&mut self, parallel: bool) {
-        let radio = &self.model.graph.radio;
-        let out = &self.outboxes;
-        let fill = |(j, inbox): (usize, &mut Vec<RadioFrame>)| -> u64 {
-            let mut k = 0;
-            for &i in radio.of(j) {
-                if let Some(frames) = out.get(i) {
-                    inbox.extend_from_slice(frames);
-                    k += frames.len() as u64;
-                }
-            }
-            k
-        };
-        let delivered: u64 = if parallel {
-            self.inboxes
-                .par_iter_mut()
-                .enumerate()
-                .with_min_len(CHUNK)
-                .map(fill)
-                .sum()
-        } else {
-            self.inboxes.iter_mut().enumerate().map(fill).sum()
-        };
-        self.radio.count_delivered(delivered);
+    /// What agent `i` takes in at this tick: what the radio delivered, or with direct
+    /// delivery its radio neighbours' frames of the last tick in sender order (what
+    /// [`Radio`]'s queue delivers when nothing delays or changes them).
+    fn inbox<'a>(
+        delivered: &'a [RadioFrame],
+        sent: &'a [Vec<RadioFrame>],
+        radio: &'a Adjacency,
+        i: usize,
+    ) -> Inbox<'a> {
+        let delivered = Inbox::new(delivered);
+        match sent.is_empty() {
+            true => delivered,
+            false => delivered.with_sent(radio.of(i), sent),
+        }
     }
 
     /// Measures agent `i` (drawing its noise from the sensors' stream) into `bearings`,
@@ -266,6 +267,7 @@ impl SampledSim<'_> {
     fn tick_sequential(&mut self, t: f64, dt: f64) -> Result<(), HilError> {
         let exact = self.model.sensors.bearing_rate == BearingRate::Exact;
         let ranged = self.model.estimator == Estimator::Measured;
+        let mut delivered = 0;
         for i in 0..self.model.n() {
             self.bearings.clear();
             let (velocity, partner_offset) = self.measure(i, exact, ranged);
@@ -277,10 +279,12 @@ impl SampledSim<'_> {
                 partner_offset,
             };
             self.outboxes[i].clear();
-            self.outputs[i] =
-                self.controllers[i].start_tick(&self.inboxes[i], &m, &mut self.outboxes[i])?;
+            let inbox = Self::inbox(&self.inboxes[i], &self.sent, &self.model.graph.radio, i);
+            delivered += inbox.len() as u64;
+            self.outputs[i] = self.controllers[i].start_tick(inbox, &m, &mut self.outboxes[i])?;
             self.inboxes[i].clear();
         }
+        self.count_direct(delivered);
         Ok(())
     }
 
@@ -308,14 +312,16 @@ impl SampledSim<'_> {
             (&self.noise_all, &self.noise_start, &self.measured);
         let (q, v, ids) = (&self.plant.q, &self.plant.v, &self.ids);
         let (sensors, slot_order) = (self.sensors.model(), &self.slot_order);
-        self.controllers
+        let (sent, radio) = (&self.sent, &self.model.graph.radio);
+        let delivered = self
+            .controllers
             .par_iter_mut()
             .zip(self.inboxes.par_iter_mut())
             .zip(self.outboxes.par_iter_mut())
             .zip(self.outputs.par_iter_mut())
             .enumerate()
             .with_min_len(CHUNK)
-            .for_each(|(i, (((c, inbox), outbox), output))| {
+            .map(|(i, (((c, inbox), outbox), output))| {
                 // A local core holds every triangle neighbour in at most MAX_NEIGHBOURS
                 // slots: the buffer holds every bearing.
                 let mut bearings: heapless::Vec<BearingMeasurement<f64>, MAX_NEIGHBOURS> =
@@ -338,9 +344,21 @@ impl SampledSim<'_> {
                     partner_offset,
                 };
                 outbox.clear();
-                *output = Some(c.tick(inbox, &m, outbox));
+                let frames = Self::inbox(inbox, sent, radio, i);
+                let delivered = frames.len() as u64;
+                *output = Some(c.tick(frames, &m, outbox));
                 inbox.clear();
-            });
+                delivered
+            })
+            .sum();
+        self.count_direct(delivered);
+    }
+
+    /// Counts the frames `delivered` directly (none through the radio's queue).
+    fn count_direct(&mut self, delivered: u64) {
+        if self.direct {
+            self.radio.count_delivered(delivered);
+        }
     }
 }
 
@@ -356,7 +374,8 @@ impl Engine for SampledSim<'_> {
         let model = self.model;
         let parallel = self.parallel();
         if self.direct {
-            self.gather(parallel);
+            // The frames of the last tick are read where their senders left them.
+            std::mem::swap(&mut self.outboxes, &mut self.sent);
         } else {
             self.radio.observe(&self.plant.q);
             if !self.attacks.is_empty() {
@@ -390,7 +409,7 @@ impl Engine for SampledSim<'_> {
                     .count_direct(self.outboxes[i].len(), receivers.len());
             } else {
                 for f in &self.outboxes[i] {
-                    self.radio.broadcast(t, i, receivers, f.as_bytes());
+                    self.radio.broadcast_frame(t, i, receivers, *f);
                     if !self.attacks.is_empty() {
                         self.attacks.overhear(
                             t,

@@ -191,8 +191,8 @@ impl Channel {
     /// Puts a frame of agent `from`, produced at `now`, on the air. Returns `false`
     /// (and puts nothing on the air) when it would wait longer than `queue_limit` s
     /// for the medium.
-    pub fn transmit(&mut self, now: f64, from: usize, bytes: &[u8], queue_limit: f64) -> bool {
-        let air = self.model.air_time(bytes.len());
+    pub fn transmit(&mut self, now: f64, from: usize, frame: RadioFrame, queue_limit: f64) -> bool {
+        let air = self.model.air_time(frame.as_bytes().len());
         let ready = self.next_free.get(from).copied().unwrap_or(now).max(now);
         let start = self.start_of(now, from, ready, air);
         let wait = start - self.model.turnaround - now;
@@ -214,7 +214,7 @@ impl Channel {
             from: from as u32,
             order: self.order,
             done: false,
-            frame: RadioFrame::new(bytes),
+            frame,
         });
         true
     }

@@ -3,7 +3,7 @@
 //! and [`HilController`] as an [`AgentController`].
 
 use super::{HilController, TargetHandle};
-use crate::engine::controller::AgentController;
+use crate::engine::controller::{AgentController, Inbox};
 use crate::engine::hil::{HilError, LinkStats, When};
 use crate::engine::radio::RadioFrame;
 use controller_core::link::{HostMsg, LinkBearing, LinkError, LinkOutput, LinkStep, TargetMsg};
@@ -12,11 +12,7 @@ use controller_core::{Fault, FrameStats, Measurements, OwnedEstimate, Status, St
 use std::time::{Duration, Instant};
 
 impl HilController {
-    fn send_tick(
-        &mut self,
-        inbox: &[RadioFrame],
-        m: &Measurements<'_, f64>,
-    ) -> Result<(), HilError> {
+    fn send_tick(&mut self, inbox: Inbox<'_>, m: &Measurements<'_, f64>) -> Result<(), HilError> {
         self.time = m.time;
         let when = self.when();
         let internal = |what: String| HilError::Corrupt {
@@ -24,7 +20,7 @@ impl HilController {
             when,
             what,
         };
-        for f in inbox {
+        for f in inbox.frames() {
             let mut v = heapless::Vec::new();
             v.extend_from_slice(f.as_bytes())
                 .map_err(|_| internal("a radio frame longer than 60 bytes".to_owned()))?;
@@ -205,7 +201,7 @@ impl AgentController for HilController {
     /// [`AgentController::take_error`]) and the output is zero force, safe.
     fn tick(
         &mut self,
-        inbox: &[RadioFrame],
+        inbox: Inbox<'_>,
         m: &Measurements<'_, f64>,
         outbox: &mut Vec<RadioFrame>,
     ) -> StepOutput<f64> {
@@ -225,7 +221,7 @@ impl AgentController for HilController {
 
     fn start_tick(
         &mut self,
-        inbox: &[RadioFrame],
+        inbox: Inbox<'_>,
         m: &Measurements<'_, f64>,
         _outbox: &mut Vec<RadioFrame>,
     ) -> Result<Option<StepOutput<f64>>, HilError> {
