@@ -164,3 +164,30 @@ fn a_check_of_other_bytes_is_not_trusted() {
     rx.receive_checked(&good, check).expect("valid");
     assert_eq!((rx.stats().bad_crc, rx.stats().accepted), (3, 1));
 }
+
+/// `frames_checked` sends the bytes of `frames`, each with the check `CrcCheck::of` them
+/// gives (`crc16`), or none (`link`, `auth`).
+#[test]
+fn frames_checked_gives_the_frames_and_their_checks() {
+    for integrity in [
+        Integrity::Crc16,
+        Integrity::Link,
+        Integrity::Auth(controller_core::wire::SwarmKey::new([7; 16])),
+    ] {
+        let agent = receiver(integrity);
+        let (mut plain, mut checked) = (agent.clone(), agent);
+        let mut frames = Vec::new();
+        let n = plain.frames(|b| frames.push(b.to_vec()));
+        let mut with_checks = Vec::new();
+        let m = checked.frames_checked(|b, c| with_checks.push((b.to_vec(), c)));
+        assert!(n >= 1);
+        assert_eq!(n, m);
+        for (bytes, (b, check)) in frames.iter().zip(&with_checks) {
+            assert_eq!(bytes, b);
+            let expected = CrcCheck::of(bytes);
+            assert_eq!(expected.is_some(), integrity == Integrity::Crc16);
+            assert_eq!(*check, expected, "{integrity:?}");
+        }
+        assert_eq!(format!("{plain:?}"), format!("{checked:?}"));
+    }
+}

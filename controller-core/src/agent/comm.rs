@@ -57,6 +57,17 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// followed by a sync frame now and then (every `SYNC_EVERY` frames); after `2³² − 1` frames
     /// in one boot epoch the agent sends nothing more (a counter is never reused).
     pub fn frames(&mut self, mut send: impl FnMut(&[u8])) -> usize {
+        self.frames_checked(|bytes, _| send(bytes))
+    }
+
+    /// [`Agent::frames`], each frame with its [`CrcCheck`] (`crc16` integrity; `None`
+    /// otherwise), known without computing the CRC again since this agent has just written
+    /// it: for simulators that hand each broadcast to [`Agent::receive_checked`] of every
+    /// receiver.
+    pub fn frames_checked(&mut self, mut send: impl FnMut(&[u8], Option<CrcCheck>)) -> usize {
+        let crc16 = matches!(self.config.integrity, Integrity::Crc16);
+        let mut send =
+            |bytes: &[u8]| send(bytes, crc16.then(|| CrcCheck::written(bytes)).flatten());
         if !self.comm_due {
             return 0;
         }

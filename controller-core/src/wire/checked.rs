@@ -47,6 +47,19 @@ impl CrcCheck {
         })
     }
 
+    /// The check of a frame this crate has just finished (its trailer is its CRC, by
+    /// construction): no CRC computed. `None` for lengths outside 2 ..= 60.
+    pub(crate) fn written(bytes: &[u8]) -> Option<Self> {
+        let trailer = *bytes.last_chunk::<2>()?;
+        let len = u8::try_from(bytes.len())
+            .ok()
+            .filter(|&n| n <= MAX_FRAME_LEN as u8)?;
+        Some(Self {
+            trailer,
+            len_ok: NonZeroU8::new(len | OK)?,
+        })
+    }
+
     /// The check's result if it was computed from `bytes` (same length and trailer).
     #[inline]
     pub(crate) fn result_for(&self, bytes: &[u8]) -> Option<bool> {
