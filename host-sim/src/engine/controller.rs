@@ -204,8 +204,9 @@ impl<const M: usize, const N: usize> AgentController for LocalCore<M, N> {
             let _ = self.agent.receive_checked(f.as_bytes(), f.crc_check());
         }
         let out = self.agent.step(m);
+        // Each frame with its CRC check from the writer (no second CRC per broadcast).
         self.agent
-            .frames(|bytes| outbox.push(RadioFrame::new(bytes)));
+            .frames_checked(|bytes, check| outbox.push(RadioFrame::checked(bytes, check)));
         out
     }
 

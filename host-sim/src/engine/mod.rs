@@ -16,6 +16,7 @@ mod driver;
 mod error;
 pub mod hil;
 pub mod plant;
+mod prefetch;
 pub mod radio;
 mod record;
 mod result;

@@ -50,8 +50,16 @@ pub struct RadioFrame {
 const _: () = assert!(std::mem::size_of::<RadioFrame>() == 64);
 
 impl RadioFrame {
-    /// Copies `bytes` (truncated to [`MAX_FRAME_LEN`]; the core never produces more).
+    /// Copies `bytes` (truncated to [`MAX_FRAME_LEN`]; the core never produces more) and
+    /// checks their CRC if they are a `crc16` frame.
     pub fn new(bytes: &[u8]) -> Self {
+        let mut f = Self::copy(bytes);
+        f.crc = CrcCheck::of(f.as_bytes());
+        f
+    }
+
+    /// Copies `bytes` (truncated to [`MAX_FRAME_LEN`]), without a CRC check.
+    fn copy(bytes: &[u8]) -> Self {
         let n = bytes.len().min(MAX_FRAME_LEN);
         let mut f = Self {
             len: n as u8,
@@ -61,7 +69,14 @@ impl RadioFrame {
         if let (Some(dst), Some(src)) = (f.bytes.get_mut(..n), bytes.get(..n)) {
             dst.copy_from_slice(src);
         }
-        f.crc = CrcCheck::of(f.as_bytes());
+        f
+    }
+
+    /// A frame of `bytes` whose CRC check its writer gave
+    /// (`controller_core::Agent::frames_checked`).
+    pub fn checked(bytes: &[u8], crc: Option<CrcCheck>) -> Self {
+        let mut f = Self::copy(bytes);
+        f.crc = crc;
         f
     }
 

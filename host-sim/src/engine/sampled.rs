@@ -16,6 +16,7 @@ use super::controller::{local_core, AgentController, Inbox};
 use super::driver::Engine;
 use super::hil::{HilError, LinkStats};
 use super::plant::Plant;
+use super::prefetch::{self, Footprint};
 use super::radio::{Radio, RadioFrame};
 use super::sensors::{BearingNoise, Sensors, Sight};
 use super::slot_order::SlotOrder;
@@ -53,6 +54,8 @@ pub fn direct_radio(model: &Model) -> bool {
 pub struct SampledSim<'m> {
     model: &'m Model,
     controllers: Vec<Box<dyn AgentController>>,
+    /// Where each controller lies in memory ([`prefetch`]).
+    footprints: Vec<Footprint>,
     /// The plant state.
     pub plant: Plant,
     sensors: Sensors,
@@ -156,6 +159,7 @@ impl<'m> SampledSim<'m> {
         radio.attach_channel(&model.graph.radio, period);
         Ok(Self {
             model,
+            footprints: controllers.iter().map(|c| Footprint::of(&**c)).collect(),
             controllers,
             plant: Plant::new(model),
             sensors: Sensors::new(&model.sensors, model.seed),
@@ -269,6 +273,7 @@ impl SampledSim<'_> {
         let ranged = self.model.estimator == Estimator::Measured;
         let mut delivered = 0;
         for i in 0..self.model.n() {
+            self.prefetch(i + prefetch::AHEAD);
             self.bearings.clear();
             let (velocity, partner_offset) = self.measure(i, exact, ranged);
             let m = Measurements {
@@ -313,6 +318,7 @@ impl SampledSim<'_> {
         let (q, v, ids) = (&self.plant.q, &self.plant.v, &self.ids);
         let (sensors, slot_order) = (self.sensors.model(), &self.slot_order);
         let (sent, radio) = (&self.sent, &self.model.graph.radio);
+        let footprints = &self.footprints;
         let delivered = self
             .controllers
             .par_iter_mut()
@@ -322,6 +328,8 @@ impl SampledSim<'_> {
             .enumerate()
             .with_min_len(CHUNK)
             .map(|(i, (((c, inbox), outbox), output))| {
+                // Within a work item, the agents ahead are this thread's next ones.
+                prefetch_agent(footprints, sent, i + prefetch::AHEAD);
                 // A local core holds every triangle neighbour in at most MAX_NEIGHBOURS
                 // slots: the buffer holds every bearing.
                 let mut bearings: heapless::Vec<BearingMeasurement<f64>, MAX_NEIGHBOURS> =
@@ -352,6 +360,13 @@ impl SampledSim<'_> {
             })
             .sum();
         self.count_direct(delivered);
+    }
+
+    /// Prefetches what agent `i`'s tick will read: its controller and, with direct
+    /// delivery, its frames of the last tick (read by its radio neighbours, the first of
+    /// which ticks about when `i` does).
+    fn prefetch(&self, i: usize) {
+        prefetch_agent(&self.footprints, &self.sent, i);
     }
 
     /// Counts the frames `delivered` directly (none through the radio's queue).
@@ -531,5 +546,17 @@ fn read_estimates(
         if let Some(slot) = est.get_mut(a..b) {
             c.read_estimates(slot);
         }
+    }
+}
+
+/// [`SampledSim::prefetch`] from the parts it reads (for the parallel walk, which holds
+/// the controllers mutably).
+#[inline]
+fn prefetch_agent(footprints: &[Footprint], sent: &[Vec<RadioFrame>], i: usize) {
+    if let Some(f) = footprints.get(i) {
+        f.prefetch();
+    }
+    if let Some(frames) = sent.get(i) {
+        prefetch::prefetch(frames.as_slice());
     }
 }
