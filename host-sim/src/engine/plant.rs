@@ -55,11 +55,13 @@ impl Plant {
     /// uncoupled between control ticks, so each is integrated on its own.
     pub fn step(&mut self, forces: &[Vec2<f64>], dt: f64) {
         step_agents(
-            &mut self.q,
-            &mut self.v,
-            forces,
-            &self.mass,
-            &self.friction,
+            Span {
+                q: &mut self.q,
+                v: &mut self.v,
+                u: forces,
+                m: &self.mass,
+                d: &self.friction,
+            },
             dt,
         );
     }
@@ -77,37 +79,38 @@ impl Plant {
                     .par_chunks(chunk)
                     .zip(self.friction.par_chunks(chunk)),
             )
-            .for_each(|(((q, v), u), (m, d))| step_agents(q, v, u, m, d, dt));
+            .for_each(|(((q, v), u), (m, d))| step_agents(Span { q, v, u, m, d }, dt));
     }
 }
 
-/// [`rk4`] for every agent of the slices (as far as the shortest reaches): two agents at
-/// a time in 256-bit AVX registers where the processor has them ([`avx::step_pairs`]:
-/// the same operations in the same order on each lane, so the same bits; the four
-/// divisions by the mass per step were a fifth of an agent-step), the rest one by one.
-fn step_agents(
-    q: &mut [Vec2<f64>],
-    v: &mut [Vec2<f64>],
-    u: &[Vec2<f64>],
-    m: &[f64],
-    d: &[[f64; 2]],
-    dt: f64,
-) {
-    let n = q.len().min(v.len()).min(u.len()).min(m.len()).min(d.len());
+/// What one RK4 step of a run of agents reads and writes: positions, velocities, held
+/// forces, masses, frictions (as far as the shortest slice reaches).
+struct Span<'a> {
+    q: &'a mut [Vec2<f64>],
+    v: &'a mut [Vec2<f64>],
+    u: &'a [Vec2<f64>],
+    m: &'a [f64],
+    d: &'a [[f64; 2]],
+}
+
+/// [`rk4`] for every agent of the span: two agents at a time in 256-bit AVX registers
+/// where the processor has them ([`avx::step_pairs`]: the same operations in the same
+/// order on each lane, so the same bits; the four divisions by the mass per step were a
+/// fifth of an agent-step), the rest one by one.
+fn step_agents(mut s: Span<'_>, dt: f64) {
     #[allow(unused_mut)]
     let mut done = 0;
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx") {
         // SAFETY: the processor has AVX (checked just above).
-        done = unsafe { avx::step_pairs(q, v, u, m, d, dt, n) };
+        done = unsafe { avx::step_pairs(&mut s, dt) };
     }
-    let rest = q
-        .iter_mut()
-        .zip(v.iter_mut())
-        .zip(u)
-        .zip(m.iter().zip(d))
-        .take(n)
-        .skip(done);
+    let rest =
+        s.q.iter_mut()
+            .zip(s.v.iter_mut())
+            .zip(s.u)
+            .zip(s.m.iter().zip(s.d))
+            .skip(done);
     for (((q, v), u), (&m, d)) in rest {
         rk4(q, v, u, m, d, dt);
     }
@@ -131,35 +134,26 @@ fn rk4(q: &mut Vec2<f64>, v: &mut Vec2<f64>, u: &Vec2<f64>, m: f64, d: &[f64; 2]
 /// [`rk4`] on two agents at once.
 #[cfg(target_arch = "x86_64")]
 mod avx {
-    use super::Vec2;
+    use super::{Span, Vec2};
     use std::arch::x86_64::{
         __m256d, _mm256_add_pd, _mm256_div_pd, _mm256_mul_pd, _mm256_set1_pd, _mm256_set_pd,
         _mm256_storeu_pd, _mm256_sub_pd,
     };
 
-    /// Steps agents `0, 1`, `2, 3`, … below `n` in pairs (lanes: x₀, y₀, x₁, y₁) and
-    /// returns how many it stepped (`n` rounded down to even). Each lane computes
+    /// Steps the span's agents `0, 1`, `2, 3`, … in pairs (lanes: x₀, y₀, x₁, y₁) and
+    /// returns how many it stepped (its length rounded down to even). Each lane computes
     /// exactly [`super::rk4`]'s operations in its order (no fused multiply-add, `2·x` as
     /// `x + x`, which is exact), so the results are the scalar ones bit for bit.
     ///
     /// # Safety
     /// The processor must support AVX.
     #[target_feature(enable = "avx")]
-    pub(super) unsafe fn step_pairs(
-        q: &mut [Vec2<f64>],
-        v: &mut [Vec2<f64>],
-        u: &[Vec2<f64>],
-        m: &[f64],
-        d: &[[f64; 2]],
-        dt: f64,
-        n: usize,
-    ) -> usize {
-        let pairs = q
-            .chunks_exact_mut(2)
-            .zip(v.chunks_exact_mut(2))
-            .zip(u.chunks_exact(2))
-            .zip(m.chunks_exact(2).zip(d.chunks_exact(2)))
-            .take(n / 2);
+    pub(super) unsafe fn step_pairs(s: &mut Span<'_>, dt: f64) -> usize {
+        let pairs =
+            s.q.chunks_exact_mut(2)
+                .zip(s.v.chunks_exact_mut(2))
+                .zip(s.u.chunks_exact(2))
+                .zip(s.m.chunks_exact(2).zip(s.d.chunks_exact(2)));
         let mut done = 0;
         let (half, full, sixth) = (
             _mm256_set1_pd(0.5 * dt),
@@ -249,7 +243,14 @@ mod tests {
         // A long step, so that any change of rounding shows in the last bits.
         let dt = 0.173;
         for _ in 0..20 {
-            step_agents(&mut q1, &mut v1, &u, &m, &d, dt);
+            let span = Span {
+                q: &mut q1,
+                v: &mut v1,
+                u: &u,
+                m: &m,
+                d: &d,
+            };
+            step_agents(span, dt);
         }
         let (mut q2, mut v2) = (q, v);
         for _ in 0..20 {
