@@ -1,7 +1,7 @@
 //! A frame's CRC-16 checked once for several receivers ([`CrcCheck`]).
 
-use super::{Integrity, MAX_FRAME_LEN, WIRE_VERSION};
-use crate::crc16;
+use super::{mode_byte, Integrity, MAX_FRAME_LEN};
+use crate::{crc16, EstimatorMode};
 use core::num::NonZeroU8;
 
 /// The result of the CRC-16 check of one `crc16` frame, computed once
@@ -27,36 +27,41 @@ pub struct CrcCheck {
 /// Bit 7 of [`CrcCheck::len_ok`].
 const OK: u8 = 0x80;
 
+/// The mode byte of a version-3 `crc16` frame, bits 1–0 (the estimator mode,
+/// [`super::estimator_code`]) cleared.
+const CRC16_MODE: u8 = mode_byte(Integrity::Crc16, EstimatorMode::Shared);
+/// The estimator bits of the mode byte.
+const ESTIMATOR_BITS: u8 = 0b11;
+
 impl CrcCheck {
     /// The CRC check of `bytes` if they are a version-3 `crc16` frame of at most
     /// [`MAX_FRAME_LEN`] bytes (mode byte and length); `None` otherwise (then a
     /// receiver checks the frame itself, as always).
     pub fn of(bytes: &[u8]) -> Option<Self> {
-        let crc16_mode = (WIRE_VERSION << 4) | (Integrity::Crc16.code() << 2);
-        let mode = *bytes.first()?;
-        if mode & 0xFC != crc16_mode || bytes.len() > MAX_FRAME_LEN {
+        if bytes.first()? & !ESTIMATOR_BITS != CRC16_MODE {
             return None;
         }
         let (body, trailer) = bytes.split_last_chunk::<2>()?;
-        // 2 ..= 60: fits bits 0–6 and is not zero.
-        let len = u8::try_from(bytes.len()).ok()?;
-        let ok = crc16::checksum(body) == u16::from_le_bytes(*trailer);
-        Some(Self {
-            trailer: *trailer,
-            len_ok: NonZeroU8::new(len | if ok { OK } else { 0 })?,
-        })
+        Self::new(bytes, crc16::checksum(body) == u16::from_le_bytes(*trailer))
     }
 
     /// The check of a frame this crate has just finished (its trailer is its CRC, by
-    /// construction): no CRC computed. `None` for lengths outside 2 ..= 60.
+    /// construction): no CRC computed.
     pub(crate) fn written(bytes: &[u8]) -> Option<Self> {
+        Self::new(bytes, true)
+    }
+
+    /// The check of `bytes` with the CRC's result `ok`; `None` for lengths outside
+    /// 2 ..= [`MAX_FRAME_LEN`].
+    fn new(bytes: &[u8], ok: bool) -> Option<Self> {
         let trailer = *bytes.last_chunk::<2>()?;
+        // 2 ..= 60: fits bits 0–6 and is not zero.
         let len = u8::try_from(bytes.len())
             .ok()
-            .filter(|&n| n <= MAX_FRAME_LEN as u8)?;
+            .filter(|&n| usize::from(n) <= MAX_FRAME_LEN)?;
         Some(Self {
             trailer,
-            len_ok: NonZeroU8::new(len | OK)?,
+            len_ok: NonZeroU8::new(len | if ok { OK } else { 0 })?,
         })
     }
 

@@ -145,11 +145,9 @@ impl<'m> SampledSim<'m> {
         let direct = direct_radio(model);
         // Direct delivery reads the senders' frames in place: no inbox.
         let inboxes = (0..n)
-            .map(|i| match direct {
-                true => Vec::new(),
-                false => {
-                    Vec::with_capacity(model.graph.radio.of(i).len() * FRAMES_PER_TICK * 4 + 8)
-                }
+            .map(|i| {
+                let frames = model.graph.radio.of(i).len() * FRAMES_PER_TICK * 4 + 8;
+                Vec::with_capacity(if direct { 0 } else { frames })
             })
             .collect();
         let outbox = || Vec::with_capacity(4 * FRAMES_PER_TICK);
@@ -167,10 +165,7 @@ impl<'m> SampledSim<'m> {
             attacks: Attacks::new(model),
             inboxes,
             outboxes: (0..n).map(|_| outbox()).collect(),
-            sent: match direct {
-                true => (0..n).map(|_| outbox()).collect(),
-                false => Vec::new(),
-            },
+            sent: (0..if direct { n } else { 0 }).map(|_| outbox()).collect(),
             outputs: vec![None; n],
             error: None,
             forces: vec![Vec2::zeros(); n],
@@ -238,9 +233,10 @@ impl SampledSim<'_> {
         i: usize,
     ) -> Inbox<'a> {
         let delivered = Inbox::new(delivered);
-        match sent.is_empty() {
-            true => delivered,
-            false => delivered.with_sent(radio.of(i), sent),
+        if sent.is_empty() {
+            delivered
+        } else {
+            delivered.with_sent(radio.of(i), sent)
         }
     }
 
@@ -273,7 +269,7 @@ impl SampledSim<'_> {
         let ranged = self.model.estimator == Estimator::Measured;
         let mut delivered = 0;
         for i in 0..self.model.n() {
-            self.prefetch(i + prefetch::AHEAD);
+            prefetch_agent(&self.footprints, &self.sent, i + prefetch::AHEAD);
             self.bearings.clear();
             let (velocity, partner_offset) = self.measure(i, exact, ranged);
             let m = Measurements {
@@ -360,13 +356,6 @@ impl SampledSim<'_> {
             })
             .sum();
         self.count_direct(delivered);
-    }
-
-    /// Prefetches what agent `i`'s tick will read: its controller and, with direct
-    /// delivery, its frames of the last tick (read by its radio neighbours, the first of
-    /// which ticks about when `i` does).
-    fn prefetch(&self, i: usize) {
-        prefetch_agent(&self.footprints, &self.sent, i);
     }
 
     /// Counts the frames `delivered` directly (none through the radio's queue).
@@ -549,8 +538,10 @@ fn read_estimates(
     }
 }
 
-/// [`SampledSim::prefetch`] from the parts it reads (for the parallel walk, which holds
-/// the controllers mutably).
+/// Prefetches what agent `i`'s tick will read: its controller and, with direct delivery,
+/// its frames of the last tick (read by its radio neighbours, the first of which ticks
+/// about when `i` does). Takes the parts it reads, not the simulator: the parallel walk
+/// holds the controllers mutably.
 #[inline]
 fn prefetch_agent(footprints: &[Footprint], sent: &[Vec<RadioFrame>], i: usize) {
     if let Some(f) = footprints.get(i) {
