@@ -14,7 +14,9 @@
 
 use host_sim::design::{construct, render_scenario, DesignOptions, Generator, ScenarioOptions};
 use host_sim::engine::PARALLEL_MIN_AGENTS;
-use host_sim::engine::{AgentController, Engine, LocalCore, SampledSim, LOCAL_CAPACITIES};
+use host_sim::engine::{
+    AgentController, ControlStats, Engine, LocalCore, SampledSim, LOCAL_CAPACITIES,
+};
 use host_sim::scenario::strip_model;
 
 /// Frames broadcast, copies sent and copies delivered per agent-tick over `ticks` ticks.
@@ -44,23 +46,31 @@ fn work_per_agent_step_does_not_grow_with_n() {
     }
 }
 
-/// Plant state after `ticks` ticks of a strip of `n` agents on `threads` threads.
-fn state(n: usize, ticks: usize, threads: usize) -> (Vec<u64>, [u64; 4]) {
-    let m = strip_model(n, 10.0);
+/// What a run leaves: the bits of the plant state and estimates, the frame counters
+/// (broadcast, sent, delivered, accepted) and the controllers' statistics.
+type Snapshot = (Vec<u64>, [u64; 4], ControlStats);
+
+/// A snapshot after `ticks` ticks of a strip of `n` agents on `threads` threads.
+fn state(n: usize, ticks: usize, threads: usize) -> Snapshot {
+    on_threads(&strip_model(n, 10.0), ticks, threads)
+}
+
+/// A snapshot after `ticks` ticks of `m` on `threads` threads.
+fn on_threads(m: &host_sim::Model, ticks: usize, threads: usize) -> Snapshot {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .expect("pool");
-    pool.install(|| snapshot(&m, ticks))
+    pool.install(|| snapshot(m, ticks))
 }
 
-/// Bits of the plant state and estimates, and the frame counters, after `ticks` ticks.
-fn snapshot(m: &host_sim::Model, ticks: usize) -> (Vec<u64>, [u64; 4]) {
+/// The [`Snapshot`] after `ticks` ticks.
+fn snapshot(m: &host_sim::Model, ticks: usize) -> Snapshot {
     snapshot_of(SampledSim::new(m).expect("sim"), ticks)
 }
 
 /// [`snapshot`] of a given simulation.
-fn snapshot_of(mut sim: SampledSim<'_>, ticks: usize) -> (Vec<u64>, [u64; 4]) {
+fn snapshot_of(mut sim: SampledSim<'_>, ticks: usize) -> Snapshot {
     sim.advance_ticks(0.0, ticks);
     let (q, v, est) = sim.view();
     let bits = q
@@ -70,7 +80,8 @@ fn snapshot_of(mut sim: SampledSim<'_>, ticks: usize) -> (Vec<u64>, [u64; 4]) {
         .chain(est.iter().map(|e| e.to_bits()))
         .collect();
     let c = sim.frame_counts();
-    (bits, [c.broadcasts, c.sent, c.delivered, c.accepted])
+    let counts = [c.broadcasts, c.sent, c.delivered, c.accepted];
+    (bits, counts, sim.control_stats())
 }
 
 #[test]
@@ -79,10 +90,46 @@ fn a_large_run_on_two_threads_is_bit_identical_to_one() {
     let one = state(n, 30, 1);
     let two = state(n, 30, 2);
     assert_eq!(one.1, two.1);
+    assert_eq!(one.2, two.2);
     assert!(one.0 == two.0, "the states differ");
     // The state moved (the check is not comparing two initial states).
     let start = state(n, 0, 1);
     assert!(start.0 != one.0);
+}
+
+/// A large run on two threads is bit-identical to one thread (state, counters and
+/// statistics) with sensors that draw random numbers (bearings, ranges, velocities and
+/// the leader's partner offset: drawn in agent order) and with sensors that draw none
+/// (measured on every thread), both with ranges, a leader, a lossy radio (frames through
+/// the radio's queue, broadcast in agent order) and two agents that start at one point
+/// (no bearing between them, so no draw).
+#[test]
+fn noisy_and_quiet_large_runs_on_two_threads_are_bit_identical_to_one() {
+    for noisy in [true, false] {
+        let mut m = designed(Generator::Strip {
+            n: PARALLEL_MIN_AGENTS + 300,
+            spacing: 1.0,
+        });
+        assert!(m.leader.is_some());
+        let sigma = if noisy { 0.01 } else { 0.0 };
+        m.sensors.bearing_noise = sigma;
+        m.sensors.velocity_noise = sigma;
+        m.sensors.range_noise = sigma;
+        m.sensors.offset_noise = sigma;
+        m.sensors.velocity_bias = [0.01, -0.02];
+        m.estimator = host_sim::model::Estimator::Measured;
+        m.radio.loss = 0.1;
+        // Agents 10 and 11 start at one point: neither measures a bearing to the other.
+        m.agents[11].position = m.agents[10].position;
+        assert!(!host_sim::engine::direct_radio(&m));
+        let one = on_threads(&m, 30, 1);
+        let two = on_threads(&m, 30, 2);
+        assert_eq!(one.1, two.1, "noisy: {noisy}");
+        assert_eq!(one.2, two.2, "noisy: {noisy}");
+        assert!(one.0 == two.0, "noisy: {noisy}: the states differ");
+        // Faults happened (the coincident pair), so the statistics compare something.
+        assert!(one.2.safe_after_start > 0, "{:?}", one.2);
+    }
 }
 
 /// Direct delivery (ideal radio) gives what the radio's queue gives: a latency of 0.6
@@ -94,7 +141,7 @@ fn direct_delivery_is_what_the_queue_delivers() {
         let mut m = strip_model(60, 10.0);
         m.radio.latency = latency;
         let direct = host_sim::engine::direct_radio(&m);
-        let (bits, counts) = snapshot(&m, 200);
+        let (bits, counts, _) = snapshot(&m, 200);
         (direct, bits, counts)
     };
     let (direct, a, ca) = run(0.0);

@@ -300,6 +300,13 @@ impl Radio {
         self.stats.sent += (frames * receivers) as u64;
     }
 
+    /// [`Self::count_direct`] for many senders at once: `frames` broadcasts and their
+    /// `copies` to all receivers.
+    pub fn count_direct_sums(&mut self, frames: u64, copies: u64) {
+        self.stats.broadcasts += frames;
+        self.stats.sent += copies;
+    }
+
     /// Counts copies the simulator delivered itself ([`Self::count_direct`]).
     pub fn count_delivered(&mut self, copies: u64) {
         self.stats.delivered += copies;

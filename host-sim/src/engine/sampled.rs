@@ -10,6 +10,8 @@
 //! in agent order in a sequential phase, so the result does not depend on the number of
 //! threads.
 
+mod parallel;
+
 use super::attack::{AttackCounts, Attacks};
 use super::channel::ChannelStats;
 use super::controller::{local_core, AgentController, Inbox};
@@ -23,10 +25,7 @@ use super::slot_order::SlotOrder;
 use super::stats::{add_frame_stats, ControlStats, FrameCounts};
 use crate::model::graph::Adjacency;
 use crate::model::{resolve_estimates, BearingRate, EstimateInfo, Estimator, Model};
-use controller_core::{
-    BearingMeasurement, FrameStats, Measurements, StepOutput, Vec2, MAX_NEIGHBOURS,
-};
-use rayon::prelude::*;
+use controller_core::{BearingMeasurement, FrameStats, Measurements, StepOutput, Vec2};
 
 /// Runs of at least this many agents compute ticks and plant steps on every thread of the
 /// current rayon pool (below it the fork-join costs more than it saves).
@@ -89,6 +88,9 @@ pub struct SampledSim<'m> {
     noise_start: Vec<usize>,
     /// Velocity and partner offset measured for every agent (parallel path).
     measured: Vec<(Vec2<f64>, Option<Vec2<f64>>)>,
+    /// For every agent, bit `k`: its `k`-th triangle neighbour is in sight
+    /// ([`in_sight`], parallel path).
+    in_sight: Vec<u64>,
 }
 
 /// Frames one agent emits per tick, at most (used to preallocate).
@@ -183,6 +185,7 @@ impl<'m> SampledSim<'m> {
             noise_all: Vec::with_capacity(model.graph.triangle.total()),
             noise_start: Vec::with_capacity(n + 1),
             measured: vec![(Vec2::zeros(), None); n],
+            in_sight: vec![0; n],
         })
     }
 
@@ -289,73 +292,18 @@ impl SampledSim<'_> {
         Ok(())
     }
 
-    /// Every random draw of the sensors in agent order (the stream as in
-    /// [`Self::tick_sequential`]: each agent's bearings, then its velocity and offset),
-    /// then on every thread each agent's bearings from those draws
-    /// ([`Sensors::bearing_with`], in its core's slot order) and its controller's tick.
-    fn tick_parallel(&mut self, t: f64, dt: f64) {
-        let exact = self.model.sensors.bearing_rate == BearingRate::Exact;
-        let ranged = self.model.estimator == Estimator::Measured;
-        let graph = &self.model.graph.triangle;
-        self.noise_all.clear();
-        self.noise_start.clear();
-        for i in 0..self.model.n() {
-            self.noise_start.push(self.noise_all.len());
-            let (q, v) = (&self.plant.q, &self.plant.v);
-            for &j in graph.of(i) {
-                let sight = Sight::between(&self.ids, q, v, i, j);
-                let noise = self.sensors.bearing_noise(&sight, ranged);
-                self.noise_all.push(noise);
+    /// Agent `i`'s frames of this tick through the radio (and the attackers that
+    /// overhear them).
+    fn broadcast(&mut self, t: f64, i: usize) {
+        let model = self.model;
+        let receivers = model.graph.radio.of(i);
+        for f in &self.outboxes[i] {
+            self.radio.broadcast_frame(t, i, receivers, *f);
+            if !self.attacks.is_empty() {
+                self.attacks
+                    .overhear(t, i, f.as_bytes(), &self.plant.q, model, &mut self.radio);
             }
-            self.measured[i] = self.measure_own(i);
         }
-        let (noise_all, noise_start, measured) =
-            (&self.noise_all, &self.noise_start, &self.measured);
-        let (q, v, ids) = (&self.plant.q, &self.plant.v, &self.ids);
-        let (sensors, slot_order) = (self.sensors.model(), &self.slot_order);
-        let (sent, radio) = (&self.sent, &self.model.graph.radio);
-        let footprints = &self.footprints;
-        let delivered = self
-            .controllers
-            .par_iter_mut()
-            .zip(self.inboxes.par_iter_mut())
-            .zip(self.outboxes.par_iter_mut())
-            .zip(self.outputs.par_iter_mut())
-            .enumerate()
-            .with_min_len(CHUNK)
-            .map(|(i, (((c, inbox), outbox), output))| {
-                // Within a work item, the agents ahead are this thread's next ones.
-                prefetch_agent(footprints, sent, i + prefetch::AHEAD);
-                // A local core holds every triangle neighbour in at most MAX_NEIGHBOURS
-                // slots: the buffer holds every bearing.
-                let mut bearings: heapless::Vec<BearingMeasurement<f64>, MAX_NEIGHBOURS> =
-                    heapless::Vec::new();
-                let base = noise_start[i];
-                for (k, &j) in graph.of(i).iter().enumerate() {
-                    if let Some(Some(n)) = noise_all.get(base + k) {
-                        let sight = Sight::between(ids, q, v, i, j);
-                        let b = Sensors::bearing_with(sensors, *n, &sight, exact);
-                        let _ = bearings.push(b);
-                    }
-                }
-                slot_order.apply(i, &mut bearings);
-                let (velocity, partner_offset) = measured[i];
-                let m = Measurements {
-                    time: t,
-                    dt,
-                    velocity,
-                    bearings: &bearings,
-                    partner_offset,
-                };
-                outbox.clear();
-                let frames = Self::inbox(inbox, sent, radio, i);
-                let delivered = frames.len() as u64;
-                *output = Some(c.tick(frames, &m, outbox));
-                inbox.clear();
-                delivered
-            })
-            .sum();
-        self.count_direct(delivered);
     }
 
     /// Counts the frames `delivered` directly (none through the radio's queue).
@@ -391,8 +339,18 @@ impl Engine for SampledSim<'_> {
         }
         let dt = self.last_tick.map_or(0.0, |p| t - p);
         if parallel {
+            // Forces, counters and statistics kept on every thread: only the radio's
+            // broadcasts (one random stream, in agent order) remain.
             self.tick_parallel(t, dt);
-        } else if let Err(e) = self.tick_sequential(t, dt) {
+            if !self.direct {
+                for i in 0..model.n() {
+                    self.broadcast(t, i);
+                }
+            }
+            self.last_tick = Some(t);
+            return;
+        }
+        if let Err(e) = self.tick_sequential(t, dt) {
             self.error = Some(e);
             return;
         }
@@ -407,24 +365,12 @@ impl Engine for SampledSim<'_> {
                     }
                 },
             };
-            let receivers = model.graph.radio.of(i);
             if self.direct {
+                let receivers = model.graph.radio.of(i);
                 self.radio
                     .count_direct(self.outboxes[i].len(), receivers.len());
             } else {
-                for f in &self.outboxes[i] {
-                    self.radio.broadcast_frame(t, i, receivers, *f);
-                    if !self.attacks.is_empty() {
-                        self.attacks.overhear(
-                            t,
-                            i,
-                            f.as_bytes(),
-                            &self.plant.q,
-                            model,
-                            &mut self.radio,
-                        );
-                    }
-                }
+                self.broadcast(t, i);
             }
             self.forces[i] = out.force;
             self.stats.record(

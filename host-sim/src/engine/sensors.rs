@@ -93,18 +93,19 @@ impl Sensors {
         with_range: bool,
     ) -> Option<BearingMeasurement<f64>> {
         let (d, r) = separation(sight)?;
-        let noise = self.draw(with_range);
+        let noise = self.draw_noise(with_range);
         Some(measured(&self.model, noise, sight, d, r, exact_rate))
     }
 
     /// The random part of [`Sensors::bearing`], drawn from the stream exactly as it draws
     /// it (the rotation, then the range error if `with_range`; nothing when the agents
     /// coincide, `None`). With [`Sensors::bearing_with`] the draws (in agent order) and
-    /// the geometry (on any thread) can be apart.
+    /// the geometry (on any thread) can be apart; [`in_sight`] and
+    /// [`Sensors::draw_noise`] split it once more (the geometry on any thread, then only
+    /// the draws in agent order).
     #[inline]
     pub fn bearing_noise(&mut self, sight: &Sight<'_>, with_range: bool) -> Option<BearingNoise> {
-        separation(sight)?;
-        Some(self.draw(with_range))
+        in_sight(sight).then(|| self.draw_noise(with_range))
     }
 
     /// The bearing with the given noise (no random draws): the true bearing rotated by
@@ -123,9 +124,10 @@ impl Sensors {
         measured(model, noise, sight, d, r, exact_rate)
     }
 
-    /// The noise of one bearing: the rotation, then the range error if `with_range`.
+    /// The noise of one bearing: the rotation, then the range error if `with_range` (what
+    /// [`Sensors::bearing_noise`] draws for a sight [`in_sight`]).
     #[inline]
-    fn draw(&mut self, with_range: bool) -> BearingNoise {
+    pub fn draw_noise(&mut self, with_range: bool) -> BearingNoise {
         let angle = self.gauss(self.model.bearing_noise);
         let range = if with_range {
             Some(self.gauss(self.model.range_noise))
@@ -138,18 +140,62 @@ impl Sensors {
     /// The agent's measured own velocity.
     #[inline]
     pub fn velocity(&mut self, v: &Vec2<f64>) -> Vec2<f64> {
-        let b = self.model.velocity_bias;
         let s = self.model.velocity_noise;
-        Vec2::new(v.x + b[0] + self.gauss(s), v.y + b[1] + self.gauss(s))
+        let noise = [self.gauss(s), self.gauss(s)];
+        velocity_with(&self.model, v, noise)
     }
 
     /// A leader's measured partner offset `q_partner − q_self`.
     #[inline]
     pub fn offset(&mut self, q_self: &Vec2<f64>, q_partner: &Vec2<f64>) -> Vec2<f64> {
         let s = self.model.offset_noise;
-        let d = q_partner - q_self;
-        Vec2::new(d.x + self.gauss(s), d.y + self.gauss(s))
+        let noise = [self.gauss(s), self.gauss(s)];
+        offset_with(q_self, q_partner, noise)
     }
+
+    /// Whether measuring draws from the random stream: some noise that applies is not
+    /// zero (`with_range`: ranges are measured). When none does, every measurement is
+    /// a function of the state alone ([`quiet_noise`], [`velocity_with`], [`offset_with`] with
+    /// zero noise give what the drawing methods give, bit for bit) and can be taken on
+    /// any thread in any order.
+    pub fn draws(&self, with_range: bool) -> bool {
+        let m = &self.model;
+        m.bearing_noise > 0.0
+            || (with_range && m.range_noise > 0.0)
+            || m.velocity_noise > 0.0
+            || m.offset_noise > 0.0
+    }
+}
+
+/// The noise of a bearing when [`Sensors::draws`] is false (what
+/// [`Sensors::draw_noise`] then returns): no rotation, and a zero range error when
+/// ranges are measured.
+pub fn quiet_noise(with_range: bool) -> BearingNoise {
+    BearingNoise {
+        angle: 0.0,
+        range: with_range.then_some(0.0),
+    }
+}
+
+/// The measured own velocity with the given noise (the bias added first).
+#[inline]
+pub fn velocity_with(model: &SensorModel, v: &Vec2<f64>, noise: [f64; 2]) -> Vec2<f64> {
+    let b = model.velocity_bias;
+    Vec2::new(v.x + b[0] + noise[0], v.y + b[1] + noise[1])
+}
+
+/// The measured partner offset `q_partner − q_self` with the given noise.
+#[inline]
+pub fn offset_with(q_self: &Vec2<f64>, q_partner: &Vec2<f64>, noise: [f64; 2]) -> Vec2<f64> {
+    let d = q_partner - q_self;
+    Vec2::new(d.x + noise[0], d.y + noise[1])
+}
+
+/// Whether a bearing can be measured along `sight`: the agents do not coincide (and
+/// their distance is finite). No random draw.
+#[inline]
+pub fn in_sight(sight: &Sight<'_>) -> bool {
+    separation(sight).is_some()
 }
 
 /// The displacement `d = q_other − q_self` and distance `r = |d|` of a sight, `None` when

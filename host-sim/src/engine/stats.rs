@@ -107,4 +107,21 @@ impl ControlStats {
             self.max_force = force;
         }
     }
+
+    /// Adds what was recorded in `later` (of outputs after these, as a parallel walk's
+    /// part): the same as recording them here, in order.
+    pub fn merge(&mut self, later: &ControlStats) {
+        self.ticks += later.ticks;
+        self.safe += later.safe;
+        self.safe_after_start += later.safe_after_start;
+        self.saturated += later.saturated;
+        self.degenerate += later.degenerate;
+        // `>` as in `record`: NaN never enters, the maximum does not depend on the order.
+        if later.max_force > self.max_force {
+            self.max_force = later.max_force;
+        }
+        if later.last_fault.is_some() {
+            self.last_fault = later.last_fault;
+        }
+    }
 }
