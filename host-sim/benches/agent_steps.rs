@@ -10,6 +10,9 @@
 //!   one thread (a one-thread rayon pool): the cost per agent-step should not grow with N.
 //! * `agent_steps_parallel/strip_nN`: the same on every core (rayon's global pool); the
 //!   result is bit-identical to one thread (`tests/scaling.rs`).
+//! * `…/strip_noisy_nN` (N = 10,000 and 100,000): the strip with sensor noise (bearings
+//!   0.5°, velocities 0.01 m/s): the random draws, one stream in agent order, stay
+//!   sequential on every core.
 //!
 //! `cargo bench -p host-sim --bench agent_steps -- --quick` runs all in a few minutes;
 //! docs/performance.md has the figures and the log-log slope.
@@ -28,6 +31,14 @@ use std::time::Duration;
 
 /// Strip sizes and the ticks per iteration (about 10⁵ agent-steps per iteration).
 const STRIPS: [(usize, usize); 4] = [(100, 1000), (1000, 100), (10_000, 10), (100_000, 1)];
+
+/// The strip of `n` agents with noisy sensors (every measurement draws random numbers).
+fn noisy_strip(n: usize) -> Model {
+    let mut m = strip_model(n, 1000.0);
+    m.sensors.bearing_noise = 0.5f64.to_radians();
+    m.sensors.velocity_noise = 0.01;
+    m
+}
 
 /// Benchmarks `ticks` control periods per iteration of the model `make` builds. The model
 /// and its simulator are built only when criterion runs this benchmark (a filtered run,
@@ -84,11 +95,19 @@ fn agent_steps(c: &mut Criterion) {
             Some(&one),
         );
     }
+    for (n, ticks) in STRIPS.into_iter().skip(2) {
+        let name = format!("strip_noisy_n{n}");
+        bench(&mut group, &name, || noisy_strip(n), n, ticks, Some(&one));
+    }
     group.finish();
     let mut group = c.benchmark_group("agent_steps_parallel");
     for (n, ticks) in STRIPS.into_iter().skip(2) {
         let strip = || strip_model(n, 1000.0);
         bench(&mut group, &format!("strip_n{n}"), strip, n, ticks, None);
+    }
+    for (n, ticks) in STRIPS.into_iter().skip(2) {
+        let name = format!("strip_noisy_n{n}");
+        bench(&mut group, &name, || noisy_strip(n), n, ticks, None);
     }
     group.finish();
 }
