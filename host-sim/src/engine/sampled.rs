@@ -83,7 +83,8 @@ pub struct SampledSim<'m> {
     /// Every controller is a [`LocalCore`](super::LocalCore) (ticks may run in parallel).
     local: bool,
     /// The bearings' noise of every agent (parallel path), drawn in agent order: agent
-    /// `i`'s `k`-th triangle neighbour at `noise_start[i] + k`.
+    /// `i`'s `k`-th triangle neighbour at `noise_start[i] + k` (`noise_start`: `n + 1`
+    /// offsets, fixed).
     noise_all: Vec<Option<BearingNoise>>,
     noise_start: Vec<usize>,
     /// Velocity and partner offset measured for every agent (parallel path).
@@ -91,6 +92,8 @@ pub struct SampledSim<'m> {
     /// For every agent, bit `k`: its `k`-th triangle neighbour is in sight
     /// ([`in_sight`], parallel path).
     in_sight: Vec<u64>,
+    /// The sums of each block of agents of a noisy parallel tick (reused).
+    block_sums: Vec<parallel::TickSums>,
 }
 
 /// Frames one agent emits per tick, at most (used to preallocate).
@@ -182,10 +185,16 @@ impl<'m> SampledSim<'m> {
             stats: ControlStats::default(),
             direct,
             local: false,
-            noise_all: Vec::with_capacity(model.graph.triangle.total()),
-            noise_start: Vec::with_capacity(n + 1),
+            noise_all: vec![None; model.graph.triangle.total()],
+            noise_start: std::iter::once(0)
+                .chain((0..n).scan(0, |at, i| {
+                    *at += model.graph.triangle.of(i).len();
+                    Some(*at)
+                }))
+                .collect(),
             measured: vec![(Vec2::zeros(), None); n],
             in_sight: vec![0; n],
+            block_sums: Vec::new(),
         })
     }
 
@@ -258,12 +267,15 @@ impl SampledSim<'_> {
     }
 
     /// Agent `i`'s own velocity and (a leader) its partner offset, drawn after its
-    /// bearings.
+    /// bearings ([`own_measurement`]).
     fn measure_own(&mut self, i: usize) -> (Vec2<f64>, Option<Vec2<f64>>) {
-        let (q, v) = (&self.plant.q, &self.plant.v);
-        let velocity = self.sensors.velocity(&v[i]);
-        let partner_offset = self.partner[i].map(|p| self.sensors.offset(&q[i], &q[p]));
-        (velocity, partner_offset)
+        own_measurement(
+            &mut self.sensors,
+            &self.plant.q,
+            &self.plant.v,
+            &self.partner,
+            i,
+        )
     }
 
     /// Every agent measured and its tick started, in agent order.
@@ -482,6 +494,20 @@ fn read_estimates(
             c.read_estimates(slot);
         }
     }
+}
+
+/// Agent `i`'s measured own velocity, then (a leader) its partner offset, from the
+/// sensors' stream in that order.
+fn own_measurement(
+    sensors: &mut Sensors,
+    q: &[Vec2<f64>],
+    v: &[Vec2<f64>],
+    partner: &[Option<usize>],
+    i: usize,
+) -> (Vec2<f64>, Option<Vec2<f64>>) {
+    let velocity = sensors.velocity(&v[i]);
+    let partner_offset = partner[i].map(|p| sensors.offset(&q[i], &q[p]));
+    (velocity, partner_offset)
 }
 
 /// Prefetches what agent `i`'s tick will read: its controller and, with direct delivery,
