@@ -20,11 +20,11 @@ use super::hil::{HilError, LinkStats};
 use super::plant::Plant;
 use super::prefetch::{self, Footprint};
 use super::radio::{Radio, RadioFrame};
-use super::sensors::{BearingNoise, Sensors, Sight};
+use super::sensors::{offset_with, quiet_bearing, velocity_with, BearingNoise, Sensors, Sight};
 use super::slot_order::SlotOrder;
 use super::stats::{add_frame_stats, ControlStats, FrameCounts};
 use crate::model::graph::Adjacency;
-use crate::model::{resolve_estimates, BearingRate, EstimateInfo, Estimator, Model};
+use crate::model::{resolve_estimates, BearingRate, EstimateInfo, Estimator, Model, SensorModel};
 use controller_core::{BearingMeasurement, FrameStats, Measurements, StepOutput, Vec2};
 
 /// Runs of at least this many agents compute ticks and plant steps on every thread of the
@@ -253,17 +253,25 @@ impl SampledSim<'_> {
     }
 
     /// Measures agent `i` (drawing its noise from the sensors' stream) into `bearings`,
-    /// in its core's slot order.
-    fn measure(&mut self, i: usize, exact: bool, ranged: bool) -> (Vec2<f64>, Option<Vec2<f64>>) {
+    /// in its core's slot order; with `m.quiet` (the sensors draw nothing:
+    /// [`Sensors::draws`]) the same measurements without the stream.
+    fn measure(&mut self, i: usize, m: MeasureMode) -> (Vec2<f64>, Option<Vec2<f64>>) {
         let (q, v) = (&self.plant.q, &self.plant.v);
         for &j in self.model.graph.triangle.of(i) {
             let sight = Sight::between(&self.ids, q, v, i, j);
-            if let Some(b) = self.sensors.bearing(&sight, exact, ranged) {
+            let b = match m.quiet {
+                true => quiet_bearing(self.sensors.model(), &sight, m.exact, m.ranged),
+                false => self.sensors.bearing(&sight, m.exact, m.ranged),
+            };
+            if let Some(b) = b {
                 self.bearings.push(b);
             }
         }
         self.slot_order.apply(i, &mut self.bearings);
-        self.measure_own(i)
+        match m.quiet {
+            true => quiet_own(self.sensors.model(), q, v, &self.partner, i),
+            false => self.measure_own(i),
+        }
     }
 
     /// Agent `i`'s own velocity and (a leader) its partner offset, drawn after its
@@ -280,13 +288,17 @@ impl SampledSim<'_> {
 
     /// Every agent measured and its tick started, in agent order.
     fn tick_sequential(&mut self, t: f64, dt: f64) -> Result<(), HilError> {
-        let exact = self.model.sensors.bearing_rate == BearingRate::Exact;
         let ranged = self.model.estimator == Estimator::Measured;
+        let mode = MeasureMode {
+            exact: self.model.sensors.bearing_rate == BearingRate::Exact,
+            ranged,
+            quiet: !self.sensors.draws(ranged),
+        };
         let mut delivered = 0;
         for i in 0..self.model.n() {
             prefetch_agent(&self.footprints, &self.sent, i + prefetch::AHEAD);
             self.bearings.clear();
-            let (velocity, partner_offset) = self.measure(i, exact, ranged);
+            let (velocity, partner_offset) = self.measure(i, mode);
             let m = Measurements {
                 time: t,
                 dt,
@@ -494,6 +506,30 @@ fn read_estimates(
             c.read_estimates(slot);
         }
     }
+}
+
+/// How a tick measures: exact bearing rates, ranges, sensors that draw nothing.
+#[derive(Clone, Copy, Debug)]
+struct MeasureMode {
+    exact: bool,
+    ranged: bool,
+    quiet: bool,
+}
+
+/// [`own_measurement`] when the sensors draw nothing ([`Sensors::draws`]): the same
+/// values, without the stream.
+fn quiet_own(
+    model: &SensorModel,
+    q: &[Vec2<f64>],
+    v: &[Vec2<f64>],
+    partner: &[Option<usize>],
+    i: usize,
+) -> (Vec2<f64>, Option<Vec2<f64>>) {
+    let velocity = velocity_with(model, &v[i], [0.0; 2]);
+    (
+        velocity,
+        partner[i].map(|p| offset_with(&q[i], &q[p], [0.0; 2])),
+    )
 }
 
 /// Agent `i`'s measured own velocity, then (a leader) its partner offset, from the

@@ -177,6 +177,26 @@ pub fn quiet_noise(with_range: bool) -> BearingNoise {
     }
 }
 
+/// The bearing along `sight` when [`Sensors::draws`] is false: what
+/// [`Sensors::bearing`] then gives, without the stream (`None` if the agents coincide).
+#[inline]
+pub fn quiet_bearing(
+    model: &SensorModel,
+    sight: &Sight<'_>,
+    exact_rate: bool,
+    with_range: bool,
+) -> Option<BearingMeasurement<f64>> {
+    let (d, r) = separation(sight)?;
+    Some(measured(
+        model,
+        quiet_noise(with_range),
+        sight,
+        d,
+        r,
+        exact_rate,
+    ))
+}
+
 /// The measured own velocity with the given noise (the bias added first).
 #[inline]
 pub fn velocity_with(model: &SensorModel, v: &Vec2<f64>, noise: [f64; 2]) -> Vec2<f64> {
@@ -259,6 +279,54 @@ mod tests {
         // P(s) v / r with s = (0.6, 0.8), v = (1, 0): (1 − 0.36, −0.48) / 5.
         let rate = b.rate.unwrap();
         assert!((rate - Vec2::new(0.64 / 5.0, -0.48 / 5.0)).norm() < 1e-15);
+    }
+
+    /// Sensors without noise (but with biases) draw nothing, and the quiet functions give
+    /// the drawing methods' bits (a -0.0 component included); any noise that applies
+    /// makes them draw.
+    #[test]
+    fn quiet_measurements_are_the_drawn_ones_without_the_stream() {
+        let mut m = SensorModel::ideal(BearingRate::Exact);
+        m.bearing_bias = 0.01;
+        m.velocity_bias = [0.02, -0.03];
+        m.range_noise = 0.5; // applies only with ranges
+        let mut s = Sensors::new(&m, 7);
+        assert!(!s.draws(false) && s.draws(true));
+        let (q, v) = (
+            [Vec2::new(0.1, -0.0), Vec2::new(3.0, 4.0)],
+            Vec2::new(-0.0, 1.5),
+        );
+        let sight = Sight {
+            neighbour: 2,
+            q_self: &q[0],
+            q_other: &q[1],
+            v_self: &v,
+            v_other: &Vec2::new(1.0, 0.0),
+        };
+        for exact in [true, false] {
+            assert_eq!(
+                s.bearing(&sight, exact, false),
+                quiet_bearing(&m, &sight, exact, false)
+            );
+        }
+        let bits = |x: Vec2<f64>| [x.x.to_bits(), x.y.to_bits()];
+        assert_eq!(bits(s.velocity(&v)), bits(velocity_with(&m, &v, [0.0; 2])));
+        let offset = offset_with(&q[0], &q[1], [0.0; 2]);
+        assert_eq!(bits(s.offset(&q[0], &q[1])), bits(offset));
+        // Nothing was drawn: the stream is where a fresh one starts.
+        assert_eq!(
+            s.gauss(1.0).to_bits(),
+            Sensors::new(&m, 7).gauss(1.0).to_bits()
+        );
+        for noisy in [0, 1, 2] {
+            let mut n = SensorModel::ideal(BearingRate::Exact);
+            match noisy {
+                0 => n.bearing_noise = 1e-3,
+                1 => n.velocity_noise = 1e-3,
+                _ => n.offset_noise = 1e-3,
+            }
+            assert!(Sensors::new(&n, 1).draws(false), "{n:?}");
+        }
     }
 
     #[test]

@@ -4,13 +4,11 @@
 //! and the radio's broadcasts (idem) stay sequential; the draws of one block of agents
 //! are made while the other threads tick the blocks drawn before.
 
-use super::{own_measurement, prefetch_agent, SampledSim, CHUNK};
+use super::{own_measurement, prefetch_agent, quiet_own, SampledSim, CHUNK};
 use crate::engine::controller::AgentController;
 use crate::engine::prefetch;
 use crate::engine::radio::RadioFrame;
-use crate::engine::sensors::{
-    in_sight, offset_with, quiet_noise, velocity_with, BearingNoise, Sensors, Sight,
-};
+use crate::engine::sensors::{in_sight, quiet_bearing, BearingNoise, Sensors, Sight};
 use crate::engine::stats::ControlStats;
 use crate::model::graph::Adjacency;
 use crate::model::{BearingRate, Estimator, SensorModel};
@@ -92,22 +90,22 @@ impl Walk<'_> {
             heapless::Vec::new();
         for (k, &j) in self.graph.of(i).iter().enumerate() {
             let sight = Sight::between(self.ids, q, v, i, j);
-            let noise = match drawn {
-                Some((noise, _)) => noise.get(k).copied().flatten(),
-                None => in_sight(&sight).then(|| quiet_noise(self.ranged)),
+            let b = match drawn {
+                Some((noise, _)) => noise
+                    .get(k)
+                    .copied()
+                    .flatten()
+                    .map(|n| Sensors::bearing_with(self.sensors, n, &sight, self.exact)),
+                None => quiet_bearing(self.sensors, &sight, self.exact, self.ranged),
             };
-            if let Some(n) = noise {
-                let b = Sensors::bearing_with(self.sensors, n, &sight, self.exact);
+            if let Some(b) = b {
                 let _ = bearings.push(b);
             }
         }
         self.slot_order.apply(i, &mut bearings);
         let (velocity, partner_offset) = match drawn {
             Some((_, own)) => own,
-            None => (
-                velocity_with(self.sensors, &v[i], [0.0; 2]),
-                self.partner[i].map(|p| offset_with(&q[i], &q[p], [0.0; 2])),
-            ),
+            None => quiet_own(self.sensors, q, v, self.partner, i),
         };
         let m = Measurements {
             time: self.t,
