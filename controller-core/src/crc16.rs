@@ -9,10 +9,7 @@
 //! tables, built at compile time) takes one 32-bit load and four table look-ups per four
 //! bytes. The reflected (LSB-first) variant needs no byte swap of the little-endian load,
 //! one instruction less per word than CRC-16/IBM-3740 with the same polynomial.
-//! Elsewhere (a host running many agents, where the table's 4 KiB are cheap and the
-//! look-ups of eight bytes overlap) two words per step, "slice-by-8": the same loop with
-//! four more tables. `tests/wire.rs` checks it against the `crc` crate on random inputs
-//! of every length.
+//! `tests/wire.rs` checks it against the `crc` crate on random inputs of every length.
 
 /// Polynomial x¹⁶ + x¹² + x⁵ + 1, reflected (LSB first: 0x1021 bit-reversed).
 const POLY: u16 = 0x8408;
@@ -21,18 +18,15 @@ const INIT: u16 = 0xFFFF;
 /// Final XOR.
 const XOR_OUT: u16 = 0xFFFF;
 
-/// Bytes per step of the loop: 4 on the microcontroller, 8 elsewhere (see above).
-const SLICES: usize = if cfg!(target_arch = "arm") { 4 } else { 8 };
-
 /// `TABLES[k][b]`: the (reflected) register after feeding byte `b` followed by `k` zero
 /// bytes into a zero register.
-static TABLES: [[u16; 256]; SLICES] = build_tables();
+static TABLES: [[u16; 256]; 4] = build_tables();
 
 // Evaluated at compile time only (`static` initialiser): an out-of-bounds index would be
 // a build error, never a run-time panic.
 #[allow(clippy::indexing_slicing)]
-const fn build_tables() -> [[u16; 256]; SLICES] {
-    let mut t = [[0u16; 256]; SLICES];
+const fn build_tables() -> [[u16; 256]; 4] {
+    let mut t = [[0u16; 256]; 4];
     let mut b = 0;
     while b < 256 {
         let mut crc = b as u16;
@@ -49,7 +43,7 @@ const fn build_tables() -> [[u16; 256]; SLICES] {
         b += 1;
     }
     let mut k = 1;
-    while k < SLICES {
+    while k < 4 {
         let mut b = 0;
         while b < 256 {
             let prev = t[k - 1][b];
@@ -73,44 +67,18 @@ fn look(table: &[u16; 256], index: u32) -> u32 {
 /// CRC-16/IBM-SDLC of `data`. (One out-of-line copy: the unrolled loop is 0.5 KiB.)
 #[inline(never)]
 pub fn checksum(data: &[u8]) -> u16 {
-    let (mut crc, rest) = sliced(u32::from(INIT), data);
-    for &b in rest {
-        crc = (crc >> 8) ^ look(&TABLES[0], crc ^ u32::from(b));
-    }
-    (crc as u16) ^ XOR_OUT
-}
-
-/// The register after the whole words of `data` (four bytes per step), and the bytes
-/// left over.
-#[cfg(target_arch = "arm")]
-#[inline(always)]
-fn sliced(mut crc: u32, data: &[u8]) -> (u32, &[u8]) {
     let [t0, t1, t2, t3] = &TABLES;
+    let mut crc = u32::from(INIT);
     let (words, rest) = data.as_chunks::<4>();
     for w in words {
         // Four bytes at once: the register's two bytes meet the first two data bytes.
         let x = u32::from_le_bytes(*w) ^ crc;
         crc = look(t3, x) ^ look(t2, x >> 8) ^ look(t1, x >> 16) ^ look(t0, x >> 24);
     }
-    (crc, rest)
-}
-
-/// The register after the whole pairs of words of `data` (eight bytes per step), and the
-/// bytes left over.
-#[cfg(not(target_arch = "arm"))]
-#[inline(always)]
-fn sliced(mut crc: u32, data: &[u8]) -> (u32, &[u8]) {
-    let [t0, t1, t2, t3, t4, t5, t6, t7] = &TABLES;
-    let (pairs, rest) = data.as_chunks::<8>();
-    for &[a, b, c, d, e, f, g, h] in pairs {
-        // The register's two bytes meet the first two data bytes; byte j goes through
-        // the table of the 7 − j bytes after it.
-        let x = u32::from_le_bytes([a, b, c, d]) ^ crc;
-        let y = u32::from_le_bytes([e, f, g, h]);
-        crc = look(t7, x) ^ look(t6, x >> 8) ^ look(t5, x >> 16) ^ look(t4, x >> 24);
-        crc ^= look(t3, y) ^ look(t2, y >> 8) ^ look(t1, y >> 16) ^ look(t0, y >> 24);
+    for &b in rest {
+        crc = (crc >> 8) ^ look(t0, crc ^ u32::from(b));
     }
-    (crc, rest)
+    (crc as u16) ^ XOR_OUT
 }
 
 #[cfg(test)]
