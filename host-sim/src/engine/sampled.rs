@@ -6,8 +6,9 @@
 //! ([`direct_radio`]), each receiver reads its radio neighbours' frames of the previous
 //! tick straight from their outboxes, in sender order, which is exactly what the radio's
 //! queue would have delivered. Large runs with local controllers compute the agents'
-//! ticks and the plant in parallel ([`PARALLEL_MIN_AGENTS`]): the random streams are drawn
-//! in agent order in a sequential phase, so the result does not depend on the number of
+//! ticks and the plant in parallel ([`PARALLEL_MIN_AGENTS`], `sampled/parallel.rs`): the
+//! random streams are drawn in agent order (a block of agents at a time, while the other
+//! threads tick the blocks drawn before), so the result does not depend on the number of
 //! threads.
 
 mod parallel;
