@@ -296,8 +296,7 @@ impl Radio {
     /// Counts a sender's `frames` broadcast to `receivers` radio neighbours when the
     /// simulator delivers them itself (ideal radio, [`super::sampled::direct_radio`]).
     pub fn count_direct(&mut self, frames: usize, receivers: usize) {
-        self.stats.broadcasts += frames as u64;
-        self.stats.sent += (frames * receivers) as u64;
+        self.count_direct_sums(frames as u64, (frames * receivers) as u64);
     }
 
     /// [`Self::count_direct`] for many senders at once: `frames` broadcasts and their

@@ -275,6 +275,16 @@ impl SampledSim<'_> {
         }
     }
 
+    /// How this run's agents measure.
+    fn measure_mode(&self) -> MeasureMode {
+        let ranged = self.model.estimator == Estimator::Measured;
+        MeasureMode {
+            exact: self.model.sensors.bearing_rate == BearingRate::Exact,
+            ranged,
+            quiet: !self.sensors.draws(ranged),
+        }
+    }
+
     /// Agent `i`'s own velocity and (a leader) its partner offset, drawn after its
     /// bearings ([`own_measurement`]).
     fn measure_own(&mut self, i: usize) -> (Vec2<f64>, Option<Vec2<f64>>) {
@@ -289,12 +299,7 @@ impl SampledSim<'_> {
 
     /// Every agent measured and its tick started, in agent order.
     fn tick_sequential(&mut self, t: f64, dt: f64) -> Result<(), HilError> {
-        let ranged = self.model.estimator == Estimator::Measured;
-        let mode = MeasureMode {
-            exact: self.model.sensors.bearing_rate == BearingRate::Exact,
-            ranged,
-            quiet: !self.sensors.draws(ranged),
-        };
+        let mode = self.measure_mode();
         let mut delivered = 0;
         for i in 0..self.model.n() {
             prefetch_agent(&self.footprints, &self.sent, i + prefetch::AHEAD);

@@ -41,7 +41,7 @@ impl<'a> Sight<'a> {
     }
 }
 
-/// The random part of one bearing measurement ([`Sensors::bearing_noise`]).
+/// The random part of one bearing measurement ([`Sensors::draw_noise`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct BearingNoise {
     /// Rotation noise (rad), without the bias.
@@ -83,8 +83,9 @@ impl Sensors {
 
     /// The bearing measured along `sight` (tagged with the neighbour's id), `None` if
     /// the agents coincide. `exact_rate` adds the S2 rate of the true state;
-    /// `with_range` the (noisy) distance. (What [`Sensors::bearing_noise`] then
-    /// [`Sensors::bearing_with`] give, with the distance computed once.)
+    /// `with_range` the (noisy) distance. (What [`in_sight`], [`Sensors::draw_noise`]
+    /// and [`Sensors::bearing_with`] give, with the distance computed once: the draws in
+    /// agent order and the geometry on any thread can be apart.)
     #[inline]
     pub fn bearing(
         &mut self,
@@ -97,21 +98,9 @@ impl Sensors {
         Some(measured(&self.model, noise, sight, d, r, exact_rate))
     }
 
-    /// The random part of [`Sensors::bearing`], drawn from the stream exactly as it draws
-    /// it (the rotation, then the range error if `with_range`; nothing when the agents
-    /// coincide, `None`). With [`Sensors::bearing_with`] the draws (in agent order) and
-    /// the geometry (on any thread) can be apart; [`in_sight`] and
-    /// [`Sensors::draw_noise`] split it once more (the geometry on any thread, then only
-    /// the draws in agent order).
-    #[inline]
-    pub fn bearing_noise(&mut self, sight: &Sight<'_>, with_range: bool) -> Option<BearingNoise> {
-        in_sight(sight).then(|| self.draw_noise(with_range))
-    }
-
     /// The bearing with the given noise (no random draws): the true bearing rotated by
     /// `bearing_bias + noise.angle`, the exact S2 rate with `exact_rate`, the distance
-    /// plus `noise.range` when drawn. The agents must not coincide (see
-    /// [`Sensors::bearing_noise`]).
+    /// plus `noise.range` when drawn. The agents must not coincide ([`in_sight`]).
     #[inline]
     pub fn bearing_with(
         model: &SensorModel,
@@ -125,7 +114,7 @@ impl Sensors {
     }
 
     /// The noise of one bearing: the rotation, then the range error if `with_range` (what
-    /// [`Sensors::bearing_noise`] draws for a sight [`in_sight`]).
+    /// [`Sensors::bearing`] draws for a sight [`in_sight`]).
     #[inline]
     pub fn draw_noise(&mut self, with_range: bool) -> BearingNoise {
         let angle = self.gauss(self.model.bearing_noise);
@@ -380,8 +369,8 @@ mod tests {
                 v_other: &v[j],
             };
             let a = one.bearing(&sight, true, ranged);
-            let b = two
-                .bearing_noise(&sight, ranged)
+            let b = in_sight(&sight)
+                .then(|| two.draw_noise(ranged))
                 .map(|n| Sensors::bearing_with(&m, n, &sight, true));
             assert_eq!(a, b, "draw {k}");
             drawn += usize::from(a.is_some());

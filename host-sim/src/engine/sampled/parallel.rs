@@ -4,14 +4,14 @@
 //! and the radio's broadcasts (idem) stay sequential; the draws of one block of agents
 //! are made while the other threads tick the blocks drawn before.
 
-use super::{own_measurement, prefetch_agent, quiet_own, SampledSim, CHUNK};
+use super::{own_measurement, prefetch_agent, quiet_own, MeasureMode, SampledSim, CHUNK};
 use crate::engine::controller::AgentController;
 use crate::engine::prefetch;
 use crate::engine::radio::RadioFrame;
 use crate::engine::sensors::{in_sight, quiet_bearing, BearingNoise, Sensors, Sight};
 use crate::engine::stats::ControlStats;
 use crate::model::graph::Adjacency;
-use crate::model::{BearingRate, Estimator, SensorModel};
+use crate::model::SensorModel;
 use controller_core::{BearingMeasurement, Measurements, Vec2, MAX_NEIGHBOURS};
 use rayon::prelude::*;
 
@@ -50,8 +50,7 @@ const BLOCK: usize = 256;
 struct Walk<'a> {
     t: f64,
     dt: f64,
-    exact: bool,
-    ranged: bool,
+    mode: MeasureMode,
     graph: &'a Adjacency,
     radio: &'a Adjacency,
     partner: &'a [Option<usize>],
@@ -95,8 +94,8 @@ impl Walk<'_> {
                     .get(k)
                     .copied()
                     .flatten()
-                    .map(|n| Sensors::bearing_with(self.sensors, n, &sight, self.exact)),
-                None => quiet_bearing(self.sensors, &sight, self.exact, self.ranged),
+                    .map(|n| Sensors::bearing_with(self.sensors, n, &sight, self.mode.exact)),
+                None => quiet_bearing(self.sensors, &sight, self.mode.exact, self.mode.ranged),
             };
             if let Some(b) = b {
                 let _ = bearings.push(b);
@@ -159,8 +158,8 @@ impl SampledSim<'_> {
     /// this thread while the others tick the blocks already drawn; sensors that draw
     /// nothing are read on every thread.
     pub(super) fn tick_parallel(&mut self, t: f64, dt: f64) {
-        let ranged = self.model.estimator == Estimator::Measured;
-        let draws = self.sensors.draws(ranged);
+        let mode = self.measure_mode();
+        let draws = !mode.quiet;
         if draws {
             self.find_in_sight();
         }
@@ -169,8 +168,7 @@ impl SampledSim<'_> {
         let walk = Walk {
             t,
             dt,
-            exact: model.sensors.bearing_rate == BearingRate::Exact,
-            ranged,
+            mode,
             graph: &model.graph.triangle,
             radio: &model.graph.radio,
             partner: &self.partner,
@@ -182,6 +180,12 @@ impl SampledSim<'_> {
             sent: &self.sent,
             footprints: &self.footprints,
         };
+        let agents = Agents {
+            controllers: &mut self.controllers,
+            inboxes: &mut self.inboxes,
+            outboxes: &mut self.outboxes,
+            forces: &mut self.forces,
+        };
         let sums = if draws {
             let draw = Draw {
                 sensors: &mut self.sensors,
@@ -190,33 +194,16 @@ impl SampledSim<'_> {
                 partner: &self.partner,
                 q: &self.plant.q,
                 v: &self.plant.v,
-                ranged,
-            };
-            let agents = Agents {
-                controllers: &mut self.controllers,
-                inboxes: &mut self.inboxes,
-                outboxes: &mut self.outboxes,
-                forces: &mut self.forces,
+                ranged: mode.ranged,
             };
             let out = (&mut self.noise_all[..], &mut self.measured[..]);
             pipelined(&walk, draw, agents, out, &mut self.block_sums)
         } else {
-            self.controllers
-                .par_iter_mut()
-                .zip(self.inboxes.par_iter_mut())
-                .zip(self.outboxes.par_iter_mut())
-                .zip(self.forces.par_iter_mut())
+            agents
+                .par_slots()
                 .enumerate()
                 .with_min_len(CHUNK)
-                .map(|(i, (((controller, inbox), outbox), force))| {
-                    let a = AgentSlots {
-                        controller,
-                        inbox,
-                        outbox,
-                        force,
-                    };
-                    walk.agent(i, a, None)
-                })
+                .map(|(i, a)| walk.agent(i, a, None))
                 .reduce(TickSums::default, TickSums::then)
         };
         self.count_direct(sums.delivered);
@@ -297,17 +284,49 @@ impl<'s> Agents<'s> {
             outboxes,
             forces,
         } = self;
-        controllers
+        let each = controllers
             .iter_mut()
-            .zip(inboxes.iter_mut())
-            .zip(outboxes.iter_mut())
-            .zip(forces.iter_mut())
-            .map(|(((controller, inbox), outbox), force)| AgentSlots {
-                controller,
-                inbox,
-                outbox,
-                force,
-            })
+            .zip(inboxes)
+            .zip(outboxes)
+            .zip(forces);
+        each.map(AgentSlots::of)
+    }
+
+    /// Each agent's slots, on every thread.
+    fn par_slots(self) -> impl IndexedParallelIterator<Item = AgentSlots<'s>> {
+        let Self {
+            controllers,
+            inboxes,
+            outboxes,
+            forces,
+        } = self;
+        let each = controllers
+            .par_iter_mut()
+            .zip(inboxes)
+            .zip(outboxes)
+            .zip(forces);
+        each.map(AgentSlots::of)
+    }
+}
+
+/// One agent's four parts, as the zipped walks give them.
+type Zipped<'s> = (
+    (
+        (&'s mut Box<dyn AgentController>, &'s mut Vec<RadioFrame>),
+        &'s mut Vec<RadioFrame>,
+    ),
+    &'s mut Vec2<f64>,
+);
+
+impl<'s> AgentSlots<'s> {
+    /// The slots of one zipped agent.
+    fn of((((controller, inbox), outbox), force): Zipped<'s>) -> Self {
+        Self {
+            controller,
+            inbox,
+            outbox,
+            force,
+        }
     }
 }
 
