@@ -15,6 +15,7 @@ pub mod controller;
 mod driver;
 mod error;
 pub mod hil;
+mod huge_pages;
 pub mod plant;
 mod prefetch;
 pub mod radio;

@@ -18,6 +18,7 @@ use super::channel::ChannelStats;
 use super::controller::{local_core, AgentController, Inbox};
 use super::driver::Engine;
 use super::hil::{HilError, LinkStats};
+use super::huge_pages::Span;
 use super::plant::Plant;
 use super::prefetch::{self, Footprint};
 use super::radio::{Radio, RadioFrame};
@@ -161,7 +162,7 @@ impl<'m> SampledSim<'m> {
         let slot_order = SlotOrder::for_model(model, |i| controllers[i].neighbour_order());
         let mut radio = Radio::new(&model.radio, n, model.seed, capacity);
         radio.attach_channel(&model.graph.radio, period);
-        Ok(Self {
+        let sim = Self {
             model,
             footprints: controllers.iter().map(|c| Footprint::of(&**c)).collect(),
             controllers,
@@ -196,7 +197,24 @@ impl<'m> SampledSim<'m> {
             measured: vec![(Vec2::zeros(), None); n],
             in_sight: vec![0; n],
             block_sums: Vec::new(),
-        })
+        };
+        sim.huge_pages();
+        Ok(sim)
+    }
+
+    /// Backs the per-agent memory every tick walks (controllers, frame buffers) with huge
+    /// pages where the system allows it ([`huge_pages`](super::huge_pages)): a hint, no
+    /// value changes.
+    fn huge_pages(&self) {
+        // One span: the allocator interleaves the controllers and the frame buffers.
+        let mut span = Span::new();
+        for c in &self.controllers {
+            span.add(&**c);
+        }
+        for b in self.outboxes.iter().chain(&self.sent).chain(&self.inboxes) {
+            span.add_buffer(b);
+        }
+        span.collapse();
     }
 
     /// Runs `ticks` control periods (control, then `steps_per_tick` RK4 steps) without
