@@ -22,6 +22,15 @@ pub trait Engine {
     fn control(&mut self, t: f64);
     /// Advances the state by one RK4 step from `t`.
     fn integrate(&mut self, t: f64);
+    /// Advances the state by the RK4 steps `k..k + steps` of `model` (step `j` starts at
+    /// `model.time(j)`) with nothing observed in between: the same as
+    /// [`Self::integrate`] at each (an engine may take them in another order where that
+    /// gives the same bits).
+    fn integrate_steps(&mut self, model: &Model, k: usize, steps: usize) {
+        for j in k..k + steps {
+            self.integrate(model.time(j));
+        }
+    }
     /// Refreshes the estimate values and returns `(q, v, estimates)`.
     fn view(&mut self) -> (&[Vec2<f64>], &[Vec2<f64>], &[f64]);
     /// The estimates' layout.
@@ -44,6 +53,13 @@ pub trait Engine {
     fn take_error(&mut self) -> Option<HilError> {
         None
     }
+}
+
+/// The first step after `k` that is a control tick (a multiple of `spt`), a log instant (a
+/// multiple of `log_every`) or the last one (`total`).
+fn next_instant(k: usize, spt: usize, log_every: usize, total: usize) -> usize {
+    let after = |every: usize| (k / every + 1) * every;
+    after(spt).min(after(log_every)).min(total)
 }
 
 fn signed_area(q: &[Vec2<f64>], t: [usize; 3]) -> f64 {
@@ -111,7 +127,8 @@ pub fn drive(
     };
     let rows = recorder.wants_rows();
     let mut steps = 0;
-    for k in 0..=total {
+    let mut k = 0;
+    loop {
         let t = model.time(k);
         let tick = k.is_multiple_of(spt);
         if tick {
@@ -150,11 +167,16 @@ pub fn drive(
         if k == total {
             break;
         }
-        engine.integrate(t);
-        steps += 1;
-        if k.is_multiple_of(progress_every) {
+        // The steps up to the next instant that looks at the state: a control tick, a log
+        // instant or the end.
+        let next = next_instant(k, spt, log_every, total);
+        engine.integrate_steps(model, k, next - k);
+        steps += next - k;
+        // As at every step that is a multiple of `progress_every`.
+        if k.next_multiple_of(progress_every) < next {
             progress(t);
         }
+        k = next;
     }
     recorder
         .finish()
