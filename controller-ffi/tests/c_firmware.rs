@@ -93,7 +93,7 @@ fn c_firmware_converges_on_qemu() {
     assert_eq!(*code, Some(0), "the C firmware did not exit 0:\n{log}");
     assert!(log.contains("DEMO result converged=true"), "{log}");
     let (t, rel) = parse_demo_final(log).unwrap_or_else(|e| panic!("{e}\n{log}"));
-    let d = max_difference(&rel, &SQUARE);
+    let d = max_difference(&rel, &SQUARE).unwrap_or_else(|e| panic!("{e}\n{log}"));
     println!("C firmware on QEMU: converged at t = {t} s, q_i - q_1 = {rel:?}, {d:.2e} m from the square");
     assert!(
         d <= TOLERANCE,

@@ -86,7 +86,7 @@ fn the_c_demo_configured_by_exported_blobs_converges() {
     assert!(out.status.success(), "exit {}:\n{log}", out.status);
     assert!(log.contains("DEMO result converged=true"), "{log}");
     let (t, rel) = parse_demo_final(&log).unwrap_or_else(|e| panic!("{e}\n{log}"));
-    let d = max_difference(&rel, &SQUARE);
+    let d = max_difference(&rel, &SQUARE).unwrap_or_else(|e| panic!("{e}"));
     println!("C demo from exported blobs: t = {t} s, {d:.2e} m from the square");
     assert!(d <= TOLERANCE, "{rel:?}\n{log}");
 }

@@ -36,50 +36,12 @@ use std::time::Duration;
 
 use qemu_harness::{defmt, firmware, Exit, Qemu};
 
-/// Largest difference of a relative position `q_i − q_1`, in metres.
-const TOLERANCE: f64 = 1e-2;
+// The `DEMO` line's parser, the paper's square and the tolerance: one implementation,
+// shared with the C demos' tests of controller-ffi.
+#[path = "../../controller-ffi/tests/common/mod.rs"]
+mod common;
 
-/// The paper's target square, `q_i − q_1` (SPEC §9, `z* = q1 − q2 = (10, −10)`).
-const SQUARE: [[f64; 2]; 4] = [[0.0, 0.0], [-10.0, 10.0], [10.0, 10.0], [0.0, 20.0]];
-
-/// Parses `DEMO final t=<t> rel=<x1>,<y1>;<x2>,<y2>;…` from the demo's output:
-/// returns `(t, [q_i − q_1])`.
-fn parse_demo_final(log: &str) -> Result<(f64, Vec<[f64; 2]>), String> {
-    let line = log
-        .lines()
-        .rev()
-        .find(|l| l.contains("DEMO final"))
-        .ok_or("no 'DEMO final' line in the demo's output")?;
-    let field = |name: &str| -> Result<&str, String> {
-        let start = line
-            .find(&format!("{name}="))
-            .ok_or(format!("no '{name}=' in {line:?}"))?
-            + name.len()
-            + 1;
-        Ok(line[start..].split_whitespace().next().unwrap_or(""))
-    };
-    let t: f64 = field("t")?
-        .parse()
-        .map_err(|e| format!("bad t in {line:?}: {e}"))?;
-    let rel = field("rel")?
-        .split(';')
-        .map(|pair| {
-            let xy: Vec<f64> = pair
-                .split(',')
-                .map(|x| {
-                    x.trim()
-                        .parse::<f64>()
-                        .map_err(|e| format!("bad number {x:?}: {e}"))
-                })
-                .collect::<Result<_, _>>()?;
-            match xy[..] {
-                [x, y] => Ok([x, y]),
-                _ => Err(format!("expected x,y, got {pair:?}")),
-            }
-        })
-        .collect::<Result<Vec<_>, String>>()?;
-    Ok((t, rel))
-}
+use common::{max_difference, parse_demo_final, SQUARE, TOLERANCE};
 
 /// Extracts `final_positions: [[x, y], …]` from a `summary.json`.
 fn parse_final_positions(json: &str) -> Result<Vec<[f64; 2]>, String> {
@@ -99,17 +61,6 @@ fn relative(positions: &[[f64; 2]]) -> Vec<[f64; 2]> {
         .iter()
         .map(|p| [p[0] - p0[0], p[1] - p0[1]])
         .collect()
-}
-
-/// Largest distance between corresponding relative positions.
-fn max_difference(a: &[[f64; 2]], b: &[[f64; 2]]) -> Result<f64, String> {
-    if a.len() != b.len() {
-        return Err(format!("{} positions against {}", a.len(), b.len()));
-    }
-    Ok(a.iter()
-        .zip(b)
-        .map(|(p, q)| (p[0] - q[0]).hypot(p[1] - q[1]))
-        .fold(0.0, f64::max))
 }
 
 struct DemoRun {

@@ -1,5 +1,5 @@
-//! Helpers of the C tests: building the C programs (`c/build.sh`) and reading their
-//! `DEMO` lines.
+//! Helpers of the C tests and of the QEMU demo's test (`tests/tests/qemu_demo.rs`):
+//! building the C programs (`c/build.sh`) and reading their `DEMO` lines.
 #![allow(dead_code)] // Each test binary uses a part.
 
 use std::path::{Path, PathBuf};
@@ -76,7 +76,8 @@ pub fn parse_demo_final(log: &str) -> Result<(f64, Vec<[f64; 2]>), String> {
             let xy: Vec<f64> = pair
                 .split(',')
                 .map(|x| {
-                    x.parse::<f64>()
+                    x.trim()
+                        .parse::<f64>()
                         .map_err(|e| format!("bad number {x:?}: {e}"))
                 })
                 .collect::<Result<_, _>>()?;
@@ -89,11 +90,13 @@ pub fn parse_demo_final(log: &str) -> Result<(f64, Vec<[f64; 2]>), String> {
     Ok((t, rel))
 }
 
-/// Largest distance between corresponding points.
-pub fn max_difference(a: &[[f64; 2]], b: &[[f64; 2]]) -> f64 {
-    assert_eq!(a.len(), b.len(), "{a:?} against {b:?}");
-    a.iter()
+/// Largest distance between corresponding points (an error if their numbers differ).
+pub fn max_difference(a: &[[f64; 2]], b: &[[f64; 2]]) -> Result<f64, String> {
+    if a.len() != b.len() {
+        return Err(format!("{} positions against {}", a.len(), b.len()));
+    }
+    Ok(a.iter()
         .zip(b)
         .map(|(p, q)| (p[0] - q[0]).hypot(p[1] - q[1]))
-        .fold(0.0, f64::max)
+        .fold(0.0, f64::max))
 }
