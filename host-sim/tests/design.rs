@@ -9,26 +9,7 @@ use host_sim::design::{
 use std::f64::consts::PI;
 
 fn generators(n: usize) -> Vec<Generator> {
-    vec![
-        Generator::Polygon {
-            n,
-            spacing: 1.0,
-            centre: false,
-        },
-        Generator::Polygon {
-            n,
-            spacing: 1.0,
-            centre: true,
-        },
-        Generator::RectangularLattice { n, spacing: 1.0 },
-        Generator::TriangularLattice { n, spacing: 1.0 },
-        Generator::Strip { n, spacing: 1.0 },
-        Generator::RandomDisc {
-            n,
-            spacing: 1.0,
-            seed: 1,
-        },
-    ]
+    Generator::every_shape(n, 1.0, 1).into()
 }
 
 fn angle_at(p: Point, a: Point, b: Point) -> f64 {

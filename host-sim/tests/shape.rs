@@ -174,26 +174,7 @@ fn a_target_that_does_not_realise_the_angles_is_refused() {
 }
 
 fn generators(n: usize) -> Vec<Generator> {
-    vec![
-        Generator::Polygon {
-            n,
-            spacing: 1.0,
-            centre: false,
-        },
-        Generator::Polygon {
-            n,
-            spacing: 1.0,
-            centre: true,
-        },
-        Generator::RectangularLattice { n, spacing: 1.0 },
-        Generator::TriangularLattice { n, spacing: 1.0 },
-        Generator::Strip { n, spacing: 1.0 },
-        Generator::RandomDisc {
-            n,
-            spacing: 1.0,
-            seed: 1,
-        },
-    ]
+    Generator::every_shape(n, 1.0, 1).into()
 }
 
 /// A designed scenario, gains of `formation-only`, every agent displaced by up to 10 % of

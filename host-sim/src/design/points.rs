@@ -65,6 +65,27 @@ pub enum Generator {
 }
 
 impl Generator {
+    /// One generator of each shape, with `n` points and the given spacing (and seed for the
+    /// random disc): every shape at once, for surveys, examples and tests.
+    pub fn every_shape(n: usize, spacing: f64, seed: u64) -> [Self; 6] {
+        [
+            Self::Polygon {
+                n,
+                spacing,
+                centre: false,
+            },
+            Self::Polygon {
+                n,
+                spacing,
+                centre: true,
+            },
+            Self::RectangularLattice { n, spacing },
+            Self::TriangularLattice { n, spacing },
+            Self::Strip { n, spacing },
+            Self::RandomDisc { n, spacing, seed },
+        ]
+    }
+
     /// One line for the scenario header, e.g. `triangular lattice, n = 50, spacing 1 m`.
     pub fn describe(&self) -> String {
         match *self {
@@ -348,26 +369,7 @@ mod tests {
     #[test]
     fn generators_give_n_points_with_the_spacing() {
         for n in [10, 50, 200] {
-            let gens = [
-                Generator::Polygon {
-                    n,
-                    spacing: 1.0,
-                    centre: false,
-                },
-                Generator::Polygon {
-                    n,
-                    spacing: 1.0,
-                    centre: true,
-                },
-                Generator::RectangularLattice { n, spacing: 1.0 },
-                Generator::TriangularLattice { n, spacing: 1.0 },
-                Generator::Strip { n, spacing: 1.0 },
-                Generator::RandomDisc {
-                    n,
-                    spacing: 1.0,
-                    seed: 3,
-                },
-            ];
+            let gens = Generator::every_shape(n, 1.0, 3);
             for g in gens {
                 let p = g.points().unwrap();
                 assert_eq!(p.len(), n, "{}", g.describe());
