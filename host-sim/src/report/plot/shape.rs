@@ -107,22 +107,8 @@ where
     let ok = |p: &(f64, f64)| sane(p.0) && sane(p.1);
     let (x0, x1) = lin_range(tgt.iter().chain(&fitted).filter(|p| ok(p)).map(|p| p.0));
     let (y0, y1) = lin_range(tgt.iter().chain(&fitted).filter(|p| ok(p)).map(|p| p.1));
-    let (w, h) = plot.dim_in_pixel();
-    let pw = f64::from(w.saturating_sub(2 * CHART_MARGIN + Y_LABEL_AREA).max(1));
-    let ph = f64::from(h.saturating_sub(2 * CHART_MARGIN + X_LABEL_AREA).max(1));
-    let scale = ((x1 - x0) / pw).max((y1 - y0) / ph);
-    let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
-    let (hx, hy) = (scale * pw / 2.0, scale * ph / 2.0);
-    let mut chart = chart_on(&plot).build_cartesian_2d(cx - hx..cx + hx, cy - hy..cy + hy)?;
-    chart
-        .configure_mesh()
-        .x_desc("x (target frame, m)")
-        .y_desc("y (target frame, m)")
-        .label_style(label_style())
-        .axis_desc_style(desc_style())
-        .bold_line_style(BLACK.mix(0.12))
-        .light_line_style(BLACK.mix(0.04))
-        .draw()?;
+    let descs = ("x (target frame, m)", "y (target frame, m)");
+    let mut chart = plan_view(&plot, (x0, x1), (y0, y1), descs)?;
     let at = |set: &[(f64, f64)], i: usize| set.get(i).filter(|p| ok(p)).copied();
     for t in &folded {
         if let (Some(a), Some(b), Some(c)) =

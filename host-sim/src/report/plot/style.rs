@@ -126,6 +126,44 @@ pub(super) fn chart_on<'a, 'b, DB: DrawingBackend>(
     builder
 }
 
+/// A chart in metres on both axes.
+pub(super) type PlanView<'a, DB> = ChartContext<
+    'a,
+    DB,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// A plan view on `area`: a chart whose axes cover `x` and `y` (value ranges) with one
+/// metre the same length on both, centred on them, and the house mesh with the axis
+/// descriptions `x_desc` and `y_desc`.
+pub(super) fn plan_view<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+    (x_desc, y_desc): (&str, &str),
+) -> Result<PlanView<'a, DB>, Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    let (w, h) = area.dim_in_pixel();
+    let pw = f64::from(w.saturating_sub(2 * CHART_MARGIN + Y_LABEL_AREA).max(1));
+    let ph = f64::from(h.saturating_sub(2 * CHART_MARGIN + X_LABEL_AREA).max(1));
+    let scale = ((x1 - x0) / pw).max((y1 - y0) / ph);
+    let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
+    let (hx, hy) = (scale * pw / 2.0, scale * ph / 2.0);
+    let mut chart = chart_on(area).build_cartesian_2d(cx - hx..cx + hx, cy - hy..cy + hy)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .label_style(label_style())
+        .axis_desc_style(desc_style())
+        .bold_line_style(BLACK.mix(0.12))
+        .light_line_style(BLACK.mix(0.04))
+        .draw()?;
+    Ok(chart)
+}
+
 /// The house style of every time-series panel's mesh: axis descriptions, fonts, grid.
 pub(super) fn styled_mesh<'m, 'a, 'b, X, Y, XT, YT, DB>(
     mesh: &'m mut plotters::chart::MeshStyle<'a, 'b, X, Y, DB>,

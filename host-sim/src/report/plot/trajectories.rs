@@ -92,23 +92,7 @@ where
         .chain(run.snapshots.iter().flat_map(|s| s.pos.iter().map(|p| p.1)));
     let (x0, x1) = lin_range(xs);
     let (y0, y1) = lin_range(ys);
-    let (w, h) = plot.dim_in_pixel();
-    let pw = f64::from(w.saturating_sub(2 * CHART_MARGIN + Y_LABEL_AREA).max(1));
-    let ph = f64::from(h.saturating_sub(2 * CHART_MARGIN + X_LABEL_AREA).max(1));
-    let scale = ((x1 - x0) / pw).max((y1 - y0) / ph);
-    let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
-    let (hx, hy) = (scale * pw / 2.0, scale * ph / 2.0);
-
-    let mut chart = chart_on(&plot).build_cartesian_2d(cx - hx..cx + hx, cy - hy..cy + hy)?;
-    chart
-        .configure_mesh()
-        .x_desc("x (m)")
-        .y_desc("y (m)")
-        .label_style(label_style())
-        .axis_desc_style(desc_style())
-        .bold_line_style(BLACK.mix(0.12))
-        .light_line_style(BLACK.mix(0.04))
-        .draw()?;
+    let mut chart = plan_view(&plot, (x0, x1), (y0, y1), ("x (m)", "y (m)"))?;
 
     // Snapshot edges, then the paths over them, then the snapshot nodes, then
     // the leaders on top.
