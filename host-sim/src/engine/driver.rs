@@ -222,3 +222,30 @@ pub fn drive(
         hil: Vec::new(),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::next_instant;
+
+    /// The next instant is the nearest later tick, log instant or end, never `k` itself.
+    #[test]
+    fn next_instant_is_the_nearest_tick_log_or_end() {
+        // Ticks every 10 steps, logs every 25, 100 steps.
+        assert_eq!(next_instant(0, 10, 25, 100), 10);
+        assert_eq!(next_instant(10, 10, 25, 100), 20);
+        assert_eq!(next_instant(20, 10, 25, 100), 25);
+        assert_eq!(next_instant(25, 10, 25, 100), 30);
+        assert_eq!(next_instant(97, 10, 25, 100), 100);
+        // The end before the next tick, and a log every step.
+        assert_eq!(next_instant(95, 10, 25, 98), 98);
+        assert_eq!(next_instant(3, 10, 1, 100), 4);
+        // Walking from 0 visits every tick and every log instant.
+        let (mut k, mut seen) = (0, vec![0]);
+        while k < 100 {
+            k = next_instant(k, 10, 25, 100);
+            seen.push(k);
+        }
+        let expect: Vec<usize> = (0..=100).filter(|j| j % 10 == 0 || j % 25 == 0).collect();
+        assert_eq!(seen, expect);
+    }
+}
