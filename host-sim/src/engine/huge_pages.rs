@@ -11,69 +11,72 @@
 //! The memory is already allocated and filled when the simulator is built (the
 //! allocator's heap, in no particular order), so it is collapsed in place
 //! (`madvise(MADV_COLLAPSE)`, Linux ≥ 6.1; independent of the system's transparent
-//! huge page policy unless that is `never`). Like a prefetch, it is a hint: it never
+//! huge page policy unless that is `never`). Only ranges densely filled with the values
+//! given are collapsed (clusters whose gaps are under one huge page): allocations from
+//! different allocator arenas never make one range over whatever lies between them
+//! (other threads' stacks, libraries). Like a prefetch, it is a hint: it never
 //! changes a value, and where the kernel refuses it or on other systems nothing happens,
 //! so results never depend on it.
 
-/// A range of addresses that grows to cover every value added to it.
-#[derive(Clone, Copy, Debug)]
-pub struct Span {
-    lo: usize,
-    hi: usize,
+/// The memory of many values, collapsed cluster by cluster ([`Regions::collapse`]).
+#[derive(Clone, Debug, Default)]
+pub struct Regions {
+    /// `(start, end)` of every value added.
+    ranges: Vec<(usize, usize)>,
 }
 
-impl Default for Span {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl Span {
-    /// An empty span.
+impl Regions {
+    /// No memory yet.
     pub fn new() -> Self {
-        Self {
-            lo: usize::MAX,
-            hi: 0,
-        }
+        Self::default()
     }
 
-    /// Extends the span over the memory of `value` (its dynamic size for a trait object
-    /// or a slice).
+    /// Adds the memory of `value` (its dynamic size for a trait object or a slice).
     pub fn add<T: ?Sized>(&mut self, value: &T) {
         let addr = (value as *const T).cast::<u8>() as usize;
         self.cover(addr, std::mem::size_of_val(value));
     }
 
-    /// Extends the span over the whole allocated buffer of `v` (its capacity, not only
-    /// its length).
+    /// Adds the whole allocated buffer of `v` (its capacity, not only its length).
     pub fn add_buffer<T>(&mut self, v: &Vec<T>) {
         let len = v.capacity().saturating_mul(std::mem::size_of::<T>());
         self.cover(v.as_ptr() as usize, len);
     }
 
-    /// Extends the span over `len` bytes at `addr` (nothing if `len` is 0).
+    /// Adds `len` bytes at `addr` (nothing if `len` is 0).
     fn cover(&mut self, addr: usize, len: usize) {
         if len > 0 {
-            self.lo = self.lo.min(addr);
-            self.hi = self.hi.max(addr.saturating_add(len));
+            self.ranges.push((addr, addr.saturating_add(len)));
         }
     }
 
-    /// The whole huge pages inside the span: `(start, length)`, or `None` if there is
-    /// not one.
-    pub fn huge_pages(&self) -> Option<(usize, usize)> {
-        let start = self.lo.checked_next_multiple_of(HUGE_PAGE)?;
-        let end = self.hi - self.hi % HUGE_PAGE;
-        (end > start).then(|| (start, end - start))
+    /// The whole huge pages inside each cluster of the values added (values less than
+    /// [`JOIN_GAP`] apart join one cluster), `(start, length)` in address order; clusters
+    /// with fewer than [`MIN_HUGE_PAGES`] are left out.
+    pub fn huge_pages(&mut self) -> Vec<(usize, usize)> {
+        self.ranges.sort_unstable();
+        let mut clusters: Vec<(usize, usize)> = Vec::new();
+        for &(lo, hi) in &self.ranges {
+            match clusters.last_mut() {
+                Some(last) if lo < last.1.saturating_add(JOIN_GAP) => last.1 = last.1.max(hi),
+                _ => clusters.push((lo, hi)),
+            }
+        }
+        clusters
+            .into_iter()
+            .filter_map(|(lo, hi)| {
+                let start = lo.checked_next_multiple_of(HUGE_PAGE)?;
+                let end = hi - hi % HUGE_PAGE;
+                (end >= start + MIN_HUGE_PAGES * HUGE_PAGE).then(|| (start, end - start))
+            })
+            .collect()
     }
 
-    /// Asks the kernel to back the whole huge pages inside the span with huge pages
-    /// (nothing if there are fewer than [`MIN_HUGE_PAGES`]).
-    pub fn collapse(&self) {
-        if let Some((start, len)) = self.huge_pages() {
-            if len >= MIN_HUGE_PAGES * HUGE_PAGE {
-                collapse(start, len);
-            }
+    /// Asks the kernel to back the whole huge pages of every cluster
+    /// ([`Self::huge_pages`]) with huge pages.
+    pub fn collapse(&mut self) {
+        for (start, len) in self.huge_pages() {
+            collapse(start, len);
         }
     }
 }
@@ -81,8 +84,14 @@ impl Span {
 /// The huge page size of x86-64 and AArch64 Linux (2 MiB).
 pub const HUGE_PAGE: usize = 2 << 20;
 
-/// Spans of fewer huge pages are left alone: their translations fit the TLB anyway, and
-/// small simulations (a sweep builds thousands) save the system call.
+/// Values closer than this join one cluster (8 huge pages): the allocator's own data
+/// between a simulator's values (the model's, the tick's other buffers) is collapsed
+/// with them, while separately mapped regions (other arenas, thread stacks, libraries)
+/// lie farther apart.
+pub const JOIN_GAP: usize = 8 * HUGE_PAGE;
+
+/// Clusters of fewer huge pages are left alone: their translations fit the TLB anyway,
+/// and small simulations (a sweep builds thousands) save the system call.
 pub const MIN_HUGE_PAGES: usize = 4;
 
 #[cfg(all(target_os = "linux", target_env = "gnu"))]
@@ -103,28 +112,52 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_span_covers_what_was_added_and_rounds_inward_to_huge_pages() {
-        let mut s = Span::new();
-        assert_eq!(s.huge_pages(), None);
+    fn clusters_cover_what_was_added_rounded_inward_to_huge_pages() {
+        let mut r = Regions::new();
+        assert!(r.huge_pages().is_empty());
         let big = vec![0u8; 5 * HUGE_PAGE];
-        s.add(big.as_slice());
-        let (start, len) = s
-            .huge_pages()
-            .expect("a 10 MiB buffer holds whole huge pages");
+        r.add(big.as_slice());
+        let pages = r.huge_pages();
+        assert_eq!(pages.len(), 1, "{pages:?}");
+        let (start, len) = pages[0];
         let lo = big.as_ptr() as usize;
         assert!(start >= lo && start % HUGE_PAGE == 0);
         assert!(start + len <= lo + big.len() && len % HUGE_PAGE == 0);
         assert!(len >= 4 * HUGE_PAGE);
-        let small = [0u8; 100];
-        let mut t = Span::new();
-        t.add(&small);
+        // Small values, and nothing at all, give no huge page.
+        let mut t = Regions::new();
+        t.add(&[0u8; 100]);
         t.add(&[0u8; 0][..]);
-        assert_eq!(t.huge_pages(), None);
-        // Collapsing never changes a value.
+        assert!(t.huge_pages().is_empty());
+    }
+
+    #[test]
+    fn values_far_apart_are_separate_clusters() {
+        let p = HUGE_PAGE;
+        let mut r = Regions::new();
+        // Two dense runs of 1 KiB values 100 huge pages apart, added out of order; a
+        // lone value far beyond them.
+        for k in (0..10 * 1024).rev() {
+            r.cover(1000 * p + k * 1024, 1024);
+            r.cover(1100 * p + k * 1024, 1024);
+        }
+        r.cover(5000 * p, 64);
+        assert_eq!(r.huge_pages(), vec![(1000 * p, 5 * p), (1100 * p, 5 * p)]);
+        // Gaps under JOIN_GAP join, wider ones do not.
+        let mut j = Regions::new();
+        j.cover(10 * p, 3 * p);
+        j.cover(13 * p + JOIN_GAP - p / 2, 3 * p);
+        j.cover(30 * p + 2 * JOIN_GAP, 4 * p);
+        let joined = (10 * p, 6 * p + JOIN_GAP - p);
+        assert_eq!(j.huge_pages(), vec![joined, (30 * p + 2 * JOIN_GAP, 4 * p)]);
+    }
+
+    #[test]
+    fn collapsing_never_changes_a_value() {
         let mut data: Vec<u64> = (0..(5 * HUGE_PAGE / 8) as u64).collect();
-        let mut d = Span::new();
-        d.add(data.as_slice());
-        d.collapse();
+        let mut r = Regions::new();
+        r.add(data.as_slice());
+        r.collapse();
         data[0] += 1;
         assert!(data
             .iter()

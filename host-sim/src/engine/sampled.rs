@@ -18,7 +18,7 @@ use super::channel::ChannelStats;
 use super::controller::{local_core, AgentController, Inbox};
 use super::driver::Engine;
 use super::hil::{HilError, LinkStats};
-use super::huge_pages::Span;
+use super::huge_pages::Regions;
 use super::plant::Plant;
 use super::prefetch::{self, Footprint};
 use super::radio::{Radio, RadioFrame};
@@ -206,15 +206,14 @@ impl<'m> SampledSim<'m> {
     /// pages where the system allows it ([`huge_pages`](super::huge_pages)): a hint, no
     /// value changes.
     fn huge_pages(&self) {
-        // One span: the allocator interleaves the controllers and the frame buffers.
-        let mut span = Span::new();
+        let mut regions = Regions::new();
         for c in &self.controllers {
-            span.add(&**c);
+            regions.add(&**c);
         }
         for b in self.outboxes.iter().chain(&self.sent).chain(&self.inboxes) {
-            span.add_buffer(b);
+            regions.add_buffer(b);
         }
-        span.collapse();
+        regions.collapse();
     }
 
     /// Runs `ticks` control periods (control, then `steps_per_tick` RK4 steps) without
