@@ -276,23 +276,7 @@ impl<'s> Agents<'s> {
         (first, rest)
     }
 
-    /// Each agent's slots, in order.
-    fn slots(self) -> impl Iterator<Item = AgentSlots<'s>> {
-        let Self {
-            controllers,
-            inboxes,
-            outboxes,
-            forces,
-        } = self;
-        let each = controllers
-            .iter_mut()
-            .zip(inboxes)
-            .zip(outboxes)
-            .zip(forces);
-        each.map(AgentSlots::of)
-    }
-
-    /// Each agent's slots, on every thread.
+    /// Each agent's slots, on every thread (a block's walk takes them as one piece).
     fn par_slots(self) -> impl IndexedParallelIterator<Item = AgentSlots<'s>> {
         let Self {
             controllers,
@@ -366,12 +350,17 @@ fn pipelined(
             draw.block(lo, noise, own);
             let (noise, own) = (&*noise, &*own);
             s.spawn(move |_| {
-                for (k, a) in block.slots().enumerate() {
-                    let i = lo + k;
-                    let mine = &noise[starts[i] - starts[lo]..starts[i + 1] - starts[lo]];
-                    let next = walk.agent(i, a, Some((mine, own[k])));
-                    *sum = std::mem::take(sum).then(next);
-                }
+                // One piece (`with_min_len`): this task walks its block in agent order.
+                *sum = block
+                    .par_slots()
+                    .enumerate()
+                    .with_min_len(BLOCK)
+                    .map(|(k, a)| {
+                        let i = lo + k;
+                        let mine = &noise[starts[i] - starts[lo]..starts[i + 1] - starts[lo]];
+                        walk.agent(i, a, Some((mine, own[k])))
+                    })
+                    .reduce(TickSums::default, TickSums::then);
             });
         }
     });
