@@ -145,6 +145,33 @@ fn frames_carry_the_counter_when_it_fits_and_a_tag_over_counter_and_bytes() {
     }
 }
 
+/// `verify` accepts exactly the tag: every single-bit change of the received tag, of the
+/// counter or of a signed byte is refused.
+#[test]
+fn verify_accepts_the_tag_and_refuses_every_bit_flip() {
+    let key = SwarmKey::new(*b"0123456789abcdef");
+    let bytes: Vec<u8> = (0..40u8).map(|i| i.wrapping_mul(37)).collect();
+    let c = counter(7, 123_456);
+    let t = auth::tag(&key, c, &bytes);
+    assert!(auth::verify(&key, c, &bytes, &t));
+    for bit in 0..8 * TAG_LEN {
+        let mut bad = t;
+        bad[bit / 8] ^= 1 << (bit % 8);
+        assert!(!auth::verify(&key, c, &bytes, &bad), "tag bit {bit}");
+    }
+    for bit in 0..64 {
+        assert!(
+            !auth::verify(&key, c ^ (1 << bit), &bytes, &t),
+            "counter bit {bit}"
+        );
+    }
+    for bit in 0..8 * bytes.len() {
+        let mut b = bytes.clone();
+        b[bit / 8] ^= 1 << (bit % 8);
+        assert!(!auth::verify(&key, c, &b, &t), "byte bit {bit}");
+    }
+}
+
 #[test]
 fn reconstruction_recovers_every_counter_within_half_the_sequence_space() {
     for last in [
