@@ -1,6 +1,6 @@
 //! The frames' CRC: CRC-16/IBM-SDLC (also called CRC-16/X-25, the HDLC frame check
 //! sequence: polynomial 0x1021 reflected, initial value 0xFFFF, final XOR 0xFFFF), four
-//! bytes per step ("slice-by-4").
+//! bytes per step ("slice-by-4") on a microcontroller; hosts first take 16-byte blocks.
 //!
 //! Frames are short (≤ 60 bytes) and every tick checks every neighbour's frames, so the
 //! CRC is the largest part of the wire cost on target. The `crc` crate's byte-wise table
@@ -9,7 +9,8 @@
 //! tables, built at compile time) takes one 32-bit load and four table look-ups per four
 //! bytes. The reflected (LSB-first) variant needs no byte swap of the little-endian load,
 //! one instruction less per word than CRC-16/IBM-3740 with the same polynomial.
-//! `tests/wire.rs` checks it against the `crc` crate on random inputs of every length.
+//! `tests/wire.rs` checks it against the `crc` crate on random inputs of every length,
+//! and the unit tests below both paths against the bitwise definition.
 
 /// Polynomial x¹⁶ + x¹² + x⁵ + 1, reflected (LSB first: 0x1021 bit-reversed).
 const POLY: u16 = 0x8408;
