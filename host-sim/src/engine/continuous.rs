@@ -8,7 +8,7 @@
 
 use super::driver::Engine;
 use super::plant::acceleration;
-use super::sensors::{Sensors, Sight};
+use super::sensors::{quiet_bearing, Sight};
 use super::slot_order::SlotOrder;
 use super::stats::{ControlStats, FrameCounts};
 use crate::model::{
@@ -35,7 +35,7 @@ fn pair_mut<T>(v: &mut [T], i: usize, j: usize) -> Option<(&mut T, &T)> {
 /// The right-hand side: the cores and their scratch buffers.
 struct Rhs {
     agents: Vec<CoreAgent>,
-    sensors: Sensors,
+    sensors: SensorModel,
     bearings: Vec<BearingMeasurement<f64>>,
     /// Each agent's bearings go to its core in slot order ([`SlotOrder`]).
     slot_order: SlotOrder,
@@ -71,7 +71,7 @@ impl Rhs {
                     v_self: &vi,
                     v_other: &vj,
                 };
-                if let Some(b) = self.sensors.bearing(&sight, true, ranged) {
+                if let Some(b) = quiet_bearing(&self.sensors, &sight, true, ranged) {
                     self.bearings.push(b);
                 }
             }
@@ -178,7 +178,7 @@ impl<'m> ContinuousSim<'m> {
             model,
             rhs: Rhs {
                 agents,
-                sensors: Sensors::new(&SensorModel::ideal(BearingRate::Exact), model.seed),
+                sensors: SensorModel::ideal(BearingRate::Exact),
                 bearings: Vec::with_capacity(model.graph.triangle.max_degree()),
                 slot_order,
                 partner,

@@ -6,10 +6,9 @@
 //! ([`direct_radio`]), each receiver reads its radio neighbours' frames of the previous
 //! tick straight from their outboxes, in sender order, which is exactly what the radio's
 //! queue would have delivered. Large runs with local controllers compute the agents'
-//! ticks and the plant in parallel ([`PARALLEL_MIN_AGENTS`], `sampled/parallel.rs`): the
-//! random streams are drawn in agent order (a block of agents at a time, while the other
-//! threads tick the blocks drawn before), so the result does not depend on the number of
-//! threads.
+//! ticks and the plant in parallel ([`PARALLEL_MIN_AGENTS`], `sampled/parallel.rs`): every
+//! agent draws its sensors' noise from its own stream of the tick ([`Sensors::stream`]), so
+//! the result does not depend on the number of threads.
 
 mod parallel;
 
@@ -22,11 +21,11 @@ use super::huge_pages::Regions;
 use super::plant::Plant;
 use super::prefetch::{self, Footprint};
 use super::radio::{Radio, RadioFrame};
-use super::sensors::{offset_with, quiet_bearing, velocity_with, BearingNoise, Sensors, Sight};
+use super::sensors::{offset_with, quiet_bearing, velocity_with, Sensors, Sight};
 use super::slot_order::SlotOrder;
 use super::stats::{add_frame_stats, ControlStats, FrameCounts};
 use crate::model::graph::Adjacency;
-use crate::model::{resolve_estimates, BearingRate, EstimateInfo, Estimator, Model, SensorModel};
+use crate::model::{resolve_estimates, BearingRate, EstimateInfo, Estimator, Model};
 use controller_core::{BearingMeasurement, FrameStats, Measurements, StepOutput, Vec2};
 
 /// Runs of at least this many agents compute ticks and plant steps on every thread of the
@@ -79,23 +78,13 @@ pub struct SampledSim<'m> {
     est_start: Vec<usize>,
     info: Vec<EstimateInfo>,
     last_tick: Option<f64>,
+    /// Control ticks so far (the index of the sensors' streams, [`Sensors::stream`]).
+    ticks: u64,
     stats: ControlStats,
     /// Frames bypass [`Radio`]'s queue ([`direct_radio`]).
     direct: bool,
     /// Every controller is a [`LocalCore`](super::LocalCore) (ticks may run in parallel).
     local: bool,
-    /// The bearings' noise of every agent (parallel path), drawn in agent order: agent
-    /// `i`'s `k`-th triangle neighbour at `noise_start[i] + k` (`noise_start`: `n + 1`
-    /// offsets, fixed).
-    noise_all: Vec<Option<BearingNoise>>,
-    noise_start: Vec<usize>,
-    /// Velocity and partner offset measured for every agent (parallel path).
-    measured: Vec<(Vec2<f64>, Option<Vec2<f64>>)>,
-    /// For every agent, bit `k`: its `k`-th triangle neighbour is in sight
-    /// ([`in_sight`], parallel path).
-    in_sight: Vec<u64>,
-    /// The sums of each block of agents of a noisy parallel tick (reused).
-    block_sums: Vec<parallel::TickSums>,
 }
 
 /// Frames one agent emits per tick, at most (used to preallocate).
@@ -184,19 +173,10 @@ impl<'m> SampledSim<'m> {
             est_start,
             info,
             last_tick: None,
+            ticks: 0,
             stats: ControlStats::default(),
             direct,
             local: false,
-            noise_all: vec![None; model.graph.triangle.total()],
-            noise_start: std::iter::once(0)
-                .chain((0..n).scan(0, |at, i| {
-                    *at += model.graph.triangle.of(i).len();
-                    Some(*at)
-                }))
-                .collect(),
-            measured: vec![(Vec2::zeros(), None); n],
-            in_sight: vec![0; n],
-            block_sums: Vec::new(),
         };
         sim.huge_pages();
         Ok(sim)
@@ -282,28 +262,6 @@ impl SampledSim<'_> {
         }
     }
 
-    /// Measures agent `i` (drawing its noise from the sensors' stream) into `bearings`,
-    /// in its core's slot order; with `m.quiet` (the sensors draw nothing:
-    /// [`Sensors::draws`]) the same measurements without the stream.
-    fn measure(&mut self, i: usize, m: MeasureMode) -> (Vec2<f64>, Option<Vec2<f64>>) {
-        let (q, v) = (&self.plant.q, &self.plant.v);
-        for &j in self.model.graph.triangle.of(i) {
-            let sight = Sight::between(&self.ids, q, v, i, j);
-            let b = match m.quiet {
-                true => quiet_bearing(self.sensors.model(), &sight, m.exact, m.ranged),
-                false => self.sensors.bearing(&sight, m.exact, m.ranged),
-            };
-            if let Some(b) = b {
-                self.bearings.push(b);
-            }
-        }
-        self.slot_order.apply(i, &mut self.bearings);
-        match m.quiet {
-            true => quiet_own(self.sensors.model(), q, v, &self.partner, i),
-            false => self.measure_own(i),
-        }
-    }
-
     /// How this run's agents measure.
     fn measure_mode(&self) -> MeasureMode {
         let ranged = self.model.estimator == Estimator::Measured;
@@ -314,26 +272,27 @@ impl SampledSim<'_> {
         }
     }
 
-    /// Agent `i`'s own velocity and (a leader) its partner offset, drawn after its
-    /// bearings ([`own_measurement`]).
-    fn measure_own(&mut self, i: usize) -> (Vec2<f64>, Option<Vec2<f64>>) {
-        own_measurement(
-            &mut self.sensors,
-            &self.plant.q,
-            &self.plant.v,
-            &self.partner,
-            i,
-        )
-    }
-
     /// Every agent measured and its tick started, in agent order.
-    fn tick_sequential(&mut self, t: f64, dt: f64) -> Result<(), HilError> {
+    fn tick_sequential(&mut self, t: f64, dt: f64, tick: u64) -> Result<(), HilError> {
         let mode = self.measure_mode();
         let mut delivered = 0;
-        for i in 0..self.model.n() {
+        let model = self.model;
+        // Field by field: the scene reads the state while the loop writes the mailboxes.
+        let scene = Scene {
+            graph: &model.graph.triangle,
+            ids: &self.ids,
+            q: &self.plant.q,
+            v: &self.plant.v,
+            partner: &self.partner,
+            sensors: &self.sensors,
+            tick,
+            mode,
+        };
+        for i in 0..model.n() {
             prefetch_agent(&self.footprints, &self.sent, i + prefetch::AHEAD);
             self.bearings.clear();
-            let (velocity, partner_offset) = self.measure(i, mode);
+            let (velocity, partner_offset) = scene.measure(i, |b| self.bearings.push(b));
+            self.slot_order.apply(i, &mut self.bearings);
             let m = Measurements {
                 time: t,
                 dt,
@@ -342,7 +301,7 @@ impl SampledSim<'_> {
                 partner_offset,
             };
             self.outboxes[i].clear();
-            let inbox = Self::inbox(&self.inboxes[i], &self.sent, &self.model.graph.radio, i);
+            let inbox = Self::inbox(&self.inboxes[i], &self.sent, &model.graph.radio, i);
             delivered += inbox.len() as u64;
             self.outputs[i] = self.controllers[i].start_tick(inbox, &m, &mut self.outboxes[i])?;
             self.inboxes[i].clear();
@@ -397,10 +356,13 @@ impl Engine for SampledSim<'_> {
             self.radio.deliver(t, &mut self.inboxes);
         }
         let dt = self.last_tick.map_or(0.0, |p| t - p);
+        // Measured with this tick's streams; the next tick draws from new ones.
+        let tick = self.ticks;
+        self.ticks += 1;
         if parallel {
             // Forces, counters and statistics kept on every thread: only the radio's
             // broadcasts (one random stream, in agent order) remain.
-            self.tick_parallel(t, dt);
+            self.tick_parallel(t, dt, tick);
             if !self.direct {
                 for i in 0..model.n() {
                     self.broadcast(t, i);
@@ -409,7 +371,7 @@ impl Engine for SampledSim<'_> {
             self.last_tick = Some(t);
             return;
         }
-        if let Err(e) = self.tick_sequential(t, dt) {
+        if let Err(e) = self.tick_sequential(t, dt, tick) {
             self.error = Some(e);
             return;
         }
@@ -552,34 +514,56 @@ struct MeasureMode {
     quiet: bool,
 }
 
-/// [`own_measurement`] when the sensors draw nothing ([`Sensors::draws`]): the same
-/// values, without the stream.
-fn quiet_own(
-    model: &SensorModel,
-    q: &[Vec2<f64>],
-    v: &[Vec2<f64>],
-    partner: &[Option<usize>],
-    i: usize,
-) -> (Vec2<f64>, Option<Vec2<f64>>) {
-    let velocity = velocity_with(model, &v[i], [0.0; 2]);
-    (
-        velocity,
-        partner[i].map(|p| offset_with(&q[i], &q[p], [0.0; 2])),
-    )
+/// What one tick's measurements read: the state, who sees whom, the sensors and the
+/// tick's index (of the agents' random streams).
+struct Scene<'a> {
+    graph: &'a Adjacency,
+    ids: &'a [u8],
+    q: &'a [Vec2<f64>],
+    v: &'a [Vec2<f64>],
+    partner: &'a [Option<usize>],
+    sensors: &'a Sensors,
+    tick: u64,
+    mode: MeasureMode,
 }
 
-/// Agent `i`'s measured own velocity, then (a leader) its partner offset, from the
-/// sensors' stream in that order.
-fn own_measurement(
-    sensors: &mut Sensors,
-    q: &[Vec2<f64>],
-    v: &[Vec2<f64>],
-    partner: &[Option<usize>],
-    i: usize,
-) -> (Vec2<f64>, Option<Vec2<f64>>) {
-    let velocity = sensors.velocity(&v[i]);
-    let partner_offset = partner[i].map(|p| sensors.offset(&q[i], &q[p]));
-    (velocity, partner_offset)
+impl Scene<'_> {
+    /// Agent `i`'s measurements: its bearings in graph order (to `push`), then its own
+    /// velocity and (a leader) its partner offset, drawn in that order from its stream of
+    /// this tick ([`Sensors::stream`]); with sensors that draw nothing
+    /// ([`MeasureMode::quiet`]) the same values from the state alone, without a stream.
+    #[inline]
+    fn measure(
+        &self,
+        i: usize,
+        mut push: impl FnMut(BearingMeasurement<f64>),
+    ) -> (Vec2<f64>, Option<Vec2<f64>>) {
+        let (q, v, m) = (self.q, self.v, self.mode);
+        let model = self.sensors.model();
+        let partner = self.partner[i];
+        let sight = |j: usize| Sight::between(self.ids, q, v, i, j);
+        // Two loops rather than a test per bearing: the quiet one is the common case.
+        if m.quiet {
+            for &j in self.graph.of(i) {
+                if let Some(b) = quiet_bearing(model, &sight(j), m.exact, m.ranged) {
+                    push(b);
+                }
+            }
+            let velocity = velocity_with(model, &v[i], [0.0; 2]);
+            return (
+                velocity,
+                partner.map(|p| offset_with(&q[i], &q[p], [0.0; 2])),
+            );
+        }
+        let mut draws = self.sensors.stream(i, self.tick);
+        for &j in self.graph.of(i) {
+            if let Some(b) = draws.bearing(&sight(j), m.exact, m.ranged) {
+                push(b);
+            }
+        }
+        let velocity = draws.velocity(&v[i]);
+        (velocity, partner.map(|p| draws.offset(&q[i], &q[p])))
+    }
 }
 
 /// Prefetches what agent `i`'s tick will read: its controller and, with direct delivery,

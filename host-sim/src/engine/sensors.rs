@@ -1,14 +1,20 @@
 //! Each agent's own sensors: bearings from the true state plus rotation noise and bias,
 //! optional exact bearing rates (S2), own velocity with noise and bias, the leaders'
 //! relative position, and ranges for the `measured` estimator.
+//!
+//! Noise: every agent draws its measurements of one tick from its own random stream
+//! ([`Sensors::stream`]: a xoshiro256++ generator seeded from the run's seed, the agent's
+//! index and the tick's), so that a tick's agents can be measured on any thread in any
+//! order and give the same bits.
 
 use crate::model::SensorModel;
 use controller_core::{geometry, BearingMeasurement, Vec2};
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
+use rand::{Rng, RngCore, SeedableRng};
 use rand_distr::StandardNormal;
+use rand_xoshiro::{SplitMix64, Xoshiro256PlusPlus};
 
-/// Random stream of the sensors (independent of the radio's stream).
+/// Tag of the sensors' streams (mixed into the run's seed: the radio's faults draw from
+/// generators of their own).
 const SENSOR_STREAM: u64 = 1;
 
 /// Between whom a bearing is measured: an agent at `q_self` (velocity `v_self`) and its
@@ -41,30 +47,30 @@ impl<'a> Sight<'a> {
     }
 }
 
-/// The random part of one bearing measurement ([`Sensors::draw_noise`]).
+/// The random part of one bearing measurement.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct BearingNoise {
+struct BearingNoise {
     /// Rotation noise (rad), without the bias.
-    pub angle: f64,
+    angle: f64,
     /// Range error (m), when a range is measured.
-    pub range: Option<f64>,
+    range: Option<f64>,
 }
 
-/// The sensor model with its random number generator.
+/// The sensor model and the key of its random streams.
 #[derive(Clone, Debug)]
 pub struct Sensors {
     model: SensorModel,
-    rng: ChaCha8Rng,
+    /// The run's seed mixed with [`SENSOR_STREAM`].
+    key: u64,
 }
 
 impl Sensors {
     /// Seeded sensors.
     pub fn new(model: &SensorModel, seed: u64) -> Self {
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        rng.set_stream(SENSOR_STREAM);
+        let key = SplitMix64::seed_from_u64(seed ^ SENSOR_STREAM).next_u64();
         Self {
             model: model.clone(),
-            rng,
+            key,
         }
     }
 
@@ -73,80 +79,23 @@ impl Sensors {
         &self.model
     }
 
-    fn gauss(&mut self, sigma: f64) -> f64 {
-        if sigma > 0.0 {
-            sigma * self.rng.sample::<f64, _>(StandardNormal)
-        } else {
-            0.0
+    /// Agent `agent`'s random stream at tick `tick` (draw its bearings in graph order,
+    /// then its velocity, then its partner offset). A different generator for every
+    /// agent index below 2³² and tick below 2³² (497 days at 100 Hz; ticks wrap after),
+    /// seeded by SplitMix64 from `key ^ (agent · 2³² + tick)`.
+    #[inline]
+    pub fn stream(&self, agent: usize, tick: u64) -> Draws<'_> {
+        let word = ((agent as u64) << 32) | (tick & 0xFFFF_FFFF);
+        Draws {
+            model: &self.model,
+            rng: Xoshiro256PlusPlus::seed_from_u64(self.key ^ word),
         }
-    }
-
-    /// The bearing measured along `sight` (tagged with the neighbour's id), `None` if
-    /// the agents coincide. `exact_rate` adds the S2 rate of the true state;
-    /// `with_range` the (noisy) distance. (What [`in_sight`], [`Sensors::draw_noise`]
-    /// and [`Sensors::bearing_with`] give, with the distance computed once: the draws in
-    /// agent order and the geometry on any thread can be apart.)
-    #[inline]
-    pub fn bearing(
-        &mut self,
-        sight: &Sight<'_>,
-        exact_rate: bool,
-        with_range: bool,
-    ) -> Option<BearingMeasurement<f64>> {
-        let (d, r) = separation(sight)?;
-        let noise = self.draw_noise(with_range);
-        Some(measured(&self.model, noise, sight, d, r, exact_rate))
-    }
-
-    /// The bearing with the given noise (no random draws): the true bearing rotated by
-    /// `bearing_bias + noise.angle`, the exact S2 rate with `exact_rate`, the distance
-    /// plus `noise.range` when drawn. The agents must not coincide ([`in_sight`]).
-    #[inline]
-    pub fn bearing_with(
-        model: &SensorModel,
-        noise: BearingNoise,
-        sight: &Sight<'_>,
-        exact_rate: bool,
-    ) -> BearingMeasurement<f64> {
-        let d = sight.q_other - sight.q_self;
-        let r = d.norm();
-        measured(model, noise, sight, d, r, exact_rate)
-    }
-
-    /// The noise of one bearing: the rotation, then the range error if `with_range` (what
-    /// [`Sensors::bearing`] draws for a sight [`in_sight`]).
-    #[inline]
-    pub fn draw_noise(&mut self, with_range: bool) -> BearingNoise {
-        let angle = self.gauss(self.model.bearing_noise);
-        let range = if with_range {
-            Some(self.gauss(self.model.range_noise))
-        } else {
-            None
-        };
-        BearingNoise { angle, range }
-    }
-
-    /// The agent's measured own velocity.
-    #[inline]
-    pub fn velocity(&mut self, v: &Vec2<f64>) -> Vec2<f64> {
-        let s = self.model.velocity_noise;
-        let noise = [self.gauss(s), self.gauss(s)];
-        velocity_with(&self.model, v, noise)
-    }
-
-    /// A leader's measured partner offset `q_partner − q_self`.
-    #[inline]
-    pub fn offset(&mut self, q_self: &Vec2<f64>, q_partner: &Vec2<f64>) -> Vec2<f64> {
-        let s = self.model.offset_noise;
-        let noise = [self.gauss(s), self.gauss(s)];
-        offset_with(q_self, q_partner, noise)
     }
 
     /// Whether measuring draws from the random stream: some noise that applies is not
     /// zero (`with_range`: ranges are measured). When none does, every measurement is
-    /// a function of the state alone ([`quiet_noise`], [`velocity_with`], [`offset_with`] with
-    /// zero noise give what the drawing methods give, bit for bit) and can be taken on
-    /// any thread in any order.
+    /// a function of the state alone ([`quiet_bearing`], [`velocity_with`],
+    /// [`offset_with`] with zero noise give what the drawing methods give, bit for bit).
     pub fn draws(&self, with_range: bool) -> bool {
         let m = &self.model;
         m.bearing_noise > 0.0
@@ -156,10 +105,65 @@ impl Sensors {
     }
 }
 
-/// The noise of a bearing when [`Sensors::draws`] is false (what
-/// [`Sensors::draw_noise`] then returns): no rotation, and a zero range error when
-/// ranges are measured.
-pub fn quiet_noise(with_range: bool) -> BearingNoise {
+/// One agent's random stream of one tick ([`Sensors::stream`]) and the sensor model.
+#[derive(Clone, Debug)]
+pub struct Draws<'a> {
+    model: &'a SensorModel,
+    rng: Xoshiro256PlusPlus,
+}
+
+impl Draws<'_> {
+    fn gauss(&mut self, sigma: f64) -> f64 {
+        if sigma > 0.0 {
+            sigma * self.rng.sample::<f64, _>(StandardNormal)
+        } else {
+            0.0
+        }
+    }
+
+    /// The bearing measured along `sight` (tagged with the neighbour's id), `None` (and
+    /// no draw) if the agents coincide. `exact_rate` adds the S2 rate of the true state;
+    /// `with_range` the (noisy) distance.
+    #[inline]
+    pub fn bearing(
+        &mut self,
+        sight: &Sight<'_>,
+        exact_rate: bool,
+        with_range: bool,
+    ) -> Option<BearingMeasurement<f64>> {
+        let (d, r) = separation(sight)?;
+        let angle = self.gauss(self.model.bearing_noise);
+        let range = with_range.then(|| self.gauss(self.model.range_noise));
+        Some(measured(
+            self.model,
+            BearingNoise { angle, range },
+            sight,
+            d,
+            r,
+            exact_rate,
+        ))
+    }
+
+    /// The agent's measured own velocity.
+    #[inline]
+    pub fn velocity(&mut self, v: &Vec2<f64>) -> Vec2<f64> {
+        let s = self.model.velocity_noise;
+        let noise = [self.gauss(s), self.gauss(s)];
+        velocity_with(self.model, v, noise)
+    }
+
+    /// A leader's measured partner offset `q_partner − q_self`.
+    #[inline]
+    pub fn offset(&mut self, q_self: &Vec2<f64>, q_partner: &Vec2<f64>) -> Vec2<f64> {
+        let s = self.model.offset_noise;
+        let noise = [self.gauss(s), self.gauss(s)];
+        offset_with(q_self, q_partner, noise)
+    }
+}
+
+/// The noise of a bearing when [`Sensors::draws`] is false (what [`Draws::bearing`]
+/// then draws): no rotation, and a zero range error when ranges are measured.
+fn quiet_noise(with_range: bool) -> BearingNoise {
     BearingNoise {
         angle: 0.0,
         range: with_range.then_some(0.0),
@@ -167,7 +171,7 @@ pub fn quiet_noise(with_range: bool) -> BearingNoise {
 }
 
 /// The bearing along `sight` when [`Sensors::draws`] is false: what
-/// [`Sensors::bearing`] then gives, without the stream (`None` if the agents coincide).
+/// [`Draws::bearing`] then gives, without a stream (`None` if the agents coincide).
 #[inline]
 pub fn quiet_bearing(
     model: &SensorModel,
@@ -198,13 +202,6 @@ pub fn velocity_with(model: &SensorModel, v: &Vec2<f64>, noise: [f64; 2]) -> Vec
 pub fn offset_with(q_self: &Vec2<f64>, q_partner: &Vec2<f64>, noise: [f64; 2]) -> Vec2<f64> {
     let d = q_partner - q_self;
     Vec2::new(d.x + noise[0], d.y + noise[1])
-}
-
-/// Whether a bearing can be measured along `sight`: the agents do not coincide (and
-/// their distance is finite). No random draw.
-#[inline]
-pub fn in_sight(sight: &Sight<'_>) -> bool {
-    separation(sight).is_some()
 }
 
 /// The displacement `d = q_other − q_self` and distance `r = |d|` of a sight, `None` when
@@ -254,7 +251,7 @@ mod tests {
 
     #[test]
     fn ideal_bearing_is_exact() {
-        let mut s = Sensors::new(&SensorModel::ideal(BearingRate::Exact), 1);
+        let s = Sensors::new(&SensorModel::ideal(BearingRate::Exact), 1);
         let sight = Sight {
             neighbour: 2,
             q_self: &Vec2::new(0.0, 0.0),
@@ -262,7 +259,7 @@ mod tests {
             v_self: &Vec2::zeros(),
             v_other: &Vec2::new(1.0, 0.0),
         };
-        let b = s.bearing(&sight, true, true).unwrap();
+        let b = s.stream(0, 0).bearing(&sight, true, true).unwrap();
         assert_eq!(b.bearing, Vec2::new(0.6, 0.8));
         assert_eq!(b.range, Some(5.0));
         // P(s) v / r with s = (0.6, 0.8), v = (1, 0): (1 − 0.36, −0.48) / 5.
@@ -279,7 +276,7 @@ mod tests {
         m.bearing_bias = 0.01;
         m.velocity_bias = [0.02, -0.03];
         m.range_noise = 0.5; // applies only with ranges
-        let mut s = Sensors::new(&m, 7);
+        let s = Sensors::new(&m, 7);
         assert!(!s.draws(false) && s.draws(true));
         let (q, v) = (
             [Vec2::new(0.1, -0.0), Vec2::new(3.0, 4.0)],
@@ -292,21 +289,19 @@ mod tests {
             v_self: &v,
             v_other: &Vec2::new(1.0, 0.0),
         };
+        let mut d = s.stream(3, 5);
         for exact in [true, false] {
             assert_eq!(
-                s.bearing(&sight, exact, false),
+                d.bearing(&sight, exact, false),
                 quiet_bearing(&m, &sight, exact, false)
             );
         }
         let bits = |x: Vec2<f64>| [x.x.to_bits(), x.y.to_bits()];
-        assert_eq!(bits(s.velocity(&v)), bits(velocity_with(&m, &v, [0.0; 2])));
+        assert_eq!(bits(d.velocity(&v)), bits(velocity_with(&m, &v, [0.0; 2])));
         let offset = offset_with(&q[0], &q[1], [0.0; 2]);
-        assert_eq!(bits(s.offset(&q[0], &q[1])), bits(offset));
+        assert_eq!(bits(d.offset(&q[0], &q[1])), bits(offset));
         // Nothing was drawn: the stream is where a fresh one starts.
-        assert_eq!(
-            s.gauss(1.0).to_bits(),
-            Sensors::new(&m, 7).gauss(1.0).to_bits()
-        );
+        assert_eq!(d.gauss(1.0).to_bits(), s.stream(3, 5).gauss(1.0).to_bits());
         for noisy in [0, 1, 2] {
             let mut n = SensorModel::ideal(BearingRate::Exact);
             match noisy {
@@ -322,7 +317,7 @@ mod tests {
     fn noisy_bearing_stays_unit() {
         let mut m = SensorModel::ideal(BearingRate::FiniteDifference);
         m.bearing_noise = 0.05;
-        let mut s = Sensors::new(&m, 1);
+        let s = Sensors::new(&m, 1);
         let sight = Sight {
             neighbour: 1,
             q_self: &Vec2::zeros(),
@@ -330,53 +325,49 @@ mod tests {
             v_self: &Vec2::zeros(),
             v_other: &Vec2::zeros(),
         };
+        let mut d = s.stream(0, 0);
         for _ in 0..100 {
-            let b = s.bearing(&sight, false, false).unwrap();
+            let b = d.bearing(&sight, false, false).unwrap();
             assert!((b.bearing.norm() - 1.0).abs() < 1e-12);
             assert!(b.rate.is_none());
         }
     }
 
-    /// Drawing the noise and computing the bearing apart (the parallel path) gives the
-    /// same bits and leaves the stream where `bearing` leaves it, ranges and coincident
-    /// agents (no draw) included.
+    /// A stream is a function of seed, agent and tick alone: the same draws whenever it
+    /// is made (so agents can be measured in any order), and different draws for another
+    /// seed, agent or tick. Coincident agents measure nothing and draw nothing.
     #[test]
-    fn noise_then_geometry_is_the_same_bearing() {
+    fn each_agent_and_tick_has_its_own_reproducible_stream() {
         let mut m = SensorModel::ideal(BearingRate::Exact);
         m.bearing_noise = 0.05;
-        m.bearing_bias = 0.01;
-        m.range_noise = 0.02;
-        let (mut one, mut two) = (Sensors::new(&m, 7), Sensors::new(&m, 7));
-        let q = [
-            Vec2::new(0.0, 0.0),
-            Vec2::new(1.0, 2.0),
-            Vec2::new(1.0, 2.0),
-        ];
-        let v = [
-            Vec2::new(0.1, 0.0),
-            Vec2::new(0.0, -0.3),
-            Vec2::new(0.2, 0.2),
-        ];
-        let mut drawn = 0;
-        for k in 0..300 {
-            let (i, j) = [(0, 1), (1, 2), (2, 0)][k % 3];
-            let ranged = k % 2 == 0;
-            let sight = Sight {
-                neighbour: 9,
-                q_self: &q[i],
-                q_other: &q[j],
-                v_self: &v[i],
-                v_other: &v[j],
-            };
-            let a = one.bearing(&sight, true, ranged);
-            let b = in_sight(&sight)
-                .then(|| two.draw_noise(ranged))
-                .map(|n| Sensors::bearing_with(&m, n, &sight, true));
-            assert_eq!(a, b, "draw {k}");
-            drawn += usize::from(a.is_some());
+        let first = |s: &Sensors, agent, tick| s.stream(agent, tick).gauss(1.0).to_bits();
+        let s = Sensors::new(&m, 7);
+        let mut seen = std::collections::HashSet::new();
+        for agent in [0, 1, 2, 99_999, (1 << 32) - 1] {
+            for tick in [0, 1, 2, 10_000, (1 << 32) - 1] {
+                assert_eq!(first(&s, agent, tick), first(&s, agent, tick));
+                assert!(seen.insert(first(&s, agent, tick)), "{agent} {tick}");
+            }
         }
-        // Agents 1 and 2 coincide: a third of the sights measure nothing.
-        assert_eq!(drawn, 200);
-        assert_eq!(one.gauss(1.0).to_bits(), two.gauss(1.0).to_bits());
+        assert_ne!(first(&s, 4, 4), first(&Sensors::new(&m, 8), 4, 4));
+        // Normal draws: mean ≈ 0 and variance ≈ 1 over many agents' first draws.
+        let x: Vec<f64> = (0..20_000).map(|a| s.stream(a, 3).gauss(1.0)).collect();
+        let mean = x.iter().sum::<f64>() / x.len() as f64;
+        let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / x.len() as f64;
+        assert!(
+            mean.abs() < 0.03 && (var - 1.0).abs() < 0.05,
+            "{mean} {var}"
+        );
+        let same = Vec2::new(1.0, 2.0);
+        let sight = Sight {
+            neighbour: 9,
+            q_self: &same,
+            q_other: &same,
+            v_self: &same,
+            v_other: &same,
+        };
+        let mut d = s.stream(5, 6);
+        assert_eq!(d.bearing(&sight, true, true), None);
+        assert_eq!(d.gauss(1.0).to_bits(), first(&s, 5, 6));
     }
 }
