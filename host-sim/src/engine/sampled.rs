@@ -58,7 +58,8 @@ pub struct SampledSim<'m> {
     footprints: Vec<Footprint>,
     /// The plant state.
     pub plant: Plant,
-    sensors: Sensors,
+    /// Who measures whom, and with which sensors.
+    senses: Senses,
     radio: Radio,
     attacks: Attacks,
     inboxes: Vec<Vec<RadioFrame>>,
@@ -72,8 +73,6 @@ pub struct SampledSim<'m> {
     bearings: Vec<BearingMeasurement<f64>>,
     /// Each agent's bearings go to its core in slot order ([`SlotOrder`]).
     slot_order: SlotOrder,
-    partner: Vec<Option<usize>>,
-    ids: Vec<u8>,
     estimates: Vec<f64>,
     est_start: Vec<usize>,
     info: Vec<EstimateInfo>,
@@ -147,7 +146,6 @@ impl<'m> SampledSim<'m> {
             })
             .collect();
         let outbox = || Vec::with_capacity(4 * FRAMES_PER_TICK);
-        let partner = model.partners();
         let slot_order = SlotOrder::for_model(model, |i| controllers[i].neighbour_order());
         let mut radio = Radio::new(&model.radio, n, model.seed, capacity);
         radio.attach_channel(&model.graph.radio, period);
@@ -156,7 +154,11 @@ impl<'m> SampledSim<'m> {
             footprints: controllers.iter().map(|c| Footprint::of(&**c)).collect(),
             controllers,
             plant: Plant::new(model),
-            sensors: Sensors::new(&model.sensors, model.seed),
+            senses: Senses {
+                sensors: Sensors::new(&model.sensors, model.seed),
+                ids: model.agents.iter().map(|a| a.id).collect(),
+                partner: model.partners(),
+            },
             radio,
             attacks: Attacks::new(model),
             inboxes,
@@ -167,8 +169,6 @@ impl<'m> SampledSim<'m> {
             forces: vec![Vec2::zeros(); n],
             bearings: Vec::with_capacity(model.graph.triangle.max_degree()),
             slot_order,
-            partner,
-            ids: model.agents.iter().map(|a| a.id).collect(),
             estimates: vec![model.initial_estimate; info.len()],
             est_start,
             info,
@@ -262,32 +262,12 @@ impl SampledSim<'_> {
         }
     }
 
-    /// How this run's agents measure.
-    fn measure_mode(&self) -> MeasureMode {
-        let ranged = self.model.estimator == Estimator::Measured;
-        MeasureMode {
-            exact: self.model.sensors.bearing_rate == BearingRate::Exact,
-            ranged,
-            quiet: !self.sensors.draws(ranged),
-        }
-    }
-
     /// Every agent measured and its tick started, in agent order.
     fn tick_sequential(&mut self, t: f64, dt: f64, tick: u64) -> Result<(), HilError> {
-        let mode = self.measure_mode();
         let mut delivered = 0;
         let model = self.model;
         // Field by field: the scene reads the state while the loop writes the mailboxes.
-        let scene = Scene {
-            graph: &model.graph.triangle,
-            ids: &self.ids,
-            q: &self.plant.q,
-            v: &self.plant.v,
-            partner: &self.partner,
-            sensors: &self.sensors,
-            tick,
-            mode,
-        };
+        let scene = Scene::of(model, &self.plant, &self.senses, tick);
         for i in 0..model.n() {
             prefetch_agent(&self.footprints, &self.sent, i + prefetch::AHEAD);
             self.bearings.clear();
@@ -514,20 +494,44 @@ struct MeasureMode {
     quiet: bool,
 }
 
+/// What a run's agents measure with: the sensors, every agent's wire id (a bearing's
+/// tag) and leader partner.
+struct Senses {
+    sensors: Sensors,
+    ids: Vec<u8>,
+    partner: Vec<Option<usize>>,
+}
+
 /// What one tick's measurements read: the state, who sees whom, the sensors and the
 /// tick's index (of the agents' random streams).
 struct Scene<'a> {
     graph: &'a Adjacency,
-    ids: &'a [u8],
     q: &'a [Vec2<f64>],
     v: &'a [Vec2<f64>],
-    partner: &'a [Option<usize>],
-    sensors: &'a Sensors,
+    senses: &'a Senses,
     tick: u64,
     mode: MeasureMode,
 }
 
-impl Scene<'_> {
+impl<'a> Scene<'a> {
+    /// Tick `tick`'s scene of a simulator's parts (taken one by one, so that the caller
+    /// may write its other fields meanwhile).
+    fn of(model: &'a Model, plant: &'a Plant, senses: &'a Senses, tick: u64) -> Self {
+        let ranged = model.estimator == Estimator::Measured;
+        Self {
+            graph: &model.graph.triangle,
+            q: &plant.q,
+            v: &plant.v,
+            senses,
+            tick,
+            mode: MeasureMode {
+                exact: model.sensors.bearing_rate == BearingRate::Exact,
+                ranged,
+                quiet: !senses.sensors.draws(ranged),
+            },
+        }
+    }
+
     /// Agent `i`'s measurements: its bearings in graph order (to `push`), then its own
     /// velocity and (a leader) its partner offset, drawn in that order from its stream of
     /// this tick ([`Sensors::stream`]); with sensors that draw nothing
@@ -539,9 +543,14 @@ impl Scene<'_> {
         mut push: impl FnMut(BearingMeasurement<f64>),
     ) -> (Vec2<f64>, Option<Vec2<f64>>) {
         let (q, v, m) = (self.q, self.v, self.mode);
-        let model = self.sensors.model();
-        let partner = self.partner[i];
-        let sight = |j: usize| Sight::between(self.ids, q, v, i, j);
+        let Senses {
+            sensors,
+            ids,
+            partner,
+        } = self.senses;
+        let model = sensors.model();
+        let partner = partner[i];
+        let sight = |j: usize| Sight::between(ids, q, v, i, j);
         // Two loops rather than a test per bearing: the quiet one is the common case.
         if m.quiet {
             for &j in self.graph.of(i) {
@@ -555,7 +564,7 @@ impl Scene<'_> {
                 partner.map(|p| offset_with(&q[i], &q[p], [0.0; 2])),
             );
         }
-        let mut draws = self.sensors.stream(i, self.tick);
+        let mut draws = sensors.stream(i, self.tick);
         for &j in self.graph.of(i) {
             if let Some(b) = draws.bearing(&sight(j), m.exact, m.ranged) {
                 push(b);

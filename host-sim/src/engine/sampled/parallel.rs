@@ -100,21 +100,11 @@ impl SampledSim<'_> {
     /// Every agent's tick on every thread ([`Walk::agent`]), its force, and the counters
     /// and statistics of all, summed in agent order.
     pub(super) fn tick_parallel(&mut self, t: f64, dt: f64, tick: u64) {
-        let mode = self.measure_mode();
         let model = self.model;
         let walk = Walk {
             t,
             dt,
-            scene: Scene {
-                graph: &model.graph.triangle,
-                ids: &self.ids,
-                q: &self.plant.q,
-                v: &self.plant.v,
-                partner: &self.partner,
-                sensors: &self.sensors,
-                tick,
-                mode,
-            },
+            scene: Scene::of(model, &self.plant, &self.senses, tick),
             radio: &model.graph.radio,
             slot_order: &self.slot_order,
             sent: &self.sent,
