@@ -12,7 +12,7 @@
 //! allocator's heap, in no particular order), so it is collapsed in place
 //! (`madvise(MADV_COLLAPSE)`, Linux ≥ 6.1; independent of the system's transparent
 //! huge page policy unless that is `never`). Only ranges densely filled with the values
-//! given are collapsed (clusters whose gaps are under one huge page): allocations from
+//! given are collapsed (clusters whose gaps are under [`JOIN_GAP`]): allocations from
 //! different allocator arenas never make one range over whatever lies between them
 //! (other threads' stacks, libraries). Like a prefetch, it is a hint: it never
 //! changes a value, and where the kernel refuses it or on other systems nothing happens,

@@ -106,7 +106,8 @@ impl Sensors {
 }
 
 /// One agent's random stream of one tick ([`Sensors::stream`]) and the sensor model.
-#[derive(Clone, Debug)]
+/// (Not `Clone`: a copy would draw the same numbers twice.)
+#[derive(Debug)]
 pub struct Draws<'a> {
     model: &'a SensorModel,
     rng: Xoshiro256PlusPlus,

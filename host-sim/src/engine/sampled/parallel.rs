@@ -110,69 +110,29 @@ impl SampledSim<'_> {
             sent: &self.sent,
             footprints: &self.footprints,
         };
-        let agents = Agents {
-            controllers: &mut self.controllers,
-            inboxes: &mut self.inboxes,
-            outboxes: &mut self.outboxes,
-            forces: &mut self.forces,
-        };
-        let sums = agents
-            .par_slots()
+        // Each agent's four parts, zipped (the slices are disjoint fields).
+        let sums = self
+            .controllers
+            .par_iter_mut()
+            .zip(&mut self.inboxes)
+            .zip(&mut self.outboxes)
+            .zip(&mut self.forces)
             .enumerate()
             .with_min_len(CHUNK)
-            .map(|(i, a)| walk.agent(i, a))
+            .map(|(i, (((controller, inbox), outbox), force))| {
+                let slots = AgentSlots {
+                    controller,
+                    inbox,
+                    outbox,
+                    force,
+                };
+                walk.agent(i, slots)
+            })
             .reduce(TickSums::default, TickSums::then);
         self.count_direct(sums.delivered);
         if self.direct {
             self.radio.count_direct_sums(sums.broadcasts, sums.copies);
         }
         self.stats.merge(&sums.stats);
-    }
-}
-
-/// Every agent's part of a tick, as slices in agent order.
-struct Agents<'s> {
-    controllers: &'s mut [Box<dyn AgentController>],
-    inboxes: &'s mut [Vec<RadioFrame>],
-    outboxes: &'s mut [Vec<RadioFrame>],
-    forces: &'s mut [Vec2<f64>],
-}
-
-impl<'s> Agents<'s> {
-    /// Each agent's slots, on every thread.
-    fn par_slots(self) -> impl IndexedParallelIterator<Item = AgentSlots<'s>> {
-        let Self {
-            controllers,
-            inboxes,
-            outboxes,
-            forces,
-        } = self;
-        let each = controllers
-            .par_iter_mut()
-            .zip(inboxes)
-            .zip(outboxes)
-            .zip(forces);
-        each.map(AgentSlots::of)
-    }
-}
-
-/// One agent's four parts, as the zipped walks give them.
-type Zipped<'s> = (
-    (
-        (&'s mut Box<dyn AgentController>, &'s mut Vec<RadioFrame>),
-        &'s mut Vec<RadioFrame>,
-    ),
-    &'s mut Vec2<f64>,
-);
-
-impl<'s> AgentSlots<'s> {
-    /// The slots of one zipped agent.
-    fn of((((controller, inbox), outbox), force): Zipped<'s>) -> Self {
-        Self {
-            controller,
-            inbox,
-            outbox,
-            force,
-        }
     }
 }
