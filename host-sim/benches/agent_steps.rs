@@ -11,8 +11,8 @@
 //! * `agent_steps_parallel/strip_nN`: the same on every core (rayon's global pool); the
 //!   result is bit-identical to one thread (`tests/scaling.rs`).
 //! * `…/strip_noisy_nN` (N = 10,000 and 100,000): the strip with sensor noise (bearings
-//!   0.5°, velocities 0.01 m/s): the random draws, one stream in agent order, stay
-//!   sequential on every core.
+//!   0.5°, velocities 0.01 m/s): every agent draws from its own stream of the tick
+//!   (`Sensors::stream`), on whichever thread ticks it.
 //!
 //! `cargo bench -p host-sim --bench agent_steps -- --quick` runs all in a few minutes;
 //! docs/performance.md has the figures and the log-log slope.
