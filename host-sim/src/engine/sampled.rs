@@ -86,7 +86,10 @@ pub struct SampledSim<'m> {
     local: bool,
 }
 
-/// Frames one agent emits per tick, at most (used to preallocate).
+/// Frames one agent emits per tick, at most (used to preallocate): an apex of `MT ≤ 8`
+/// angles fills at most `⌈8 / 4⌉ = 2` frames of four angle items, plus an `auth` sync
+/// frame (`controller_core::Agent::frames`). An outbox holds one tick's frames (a larger
+/// one would only grow the memory a large run walks: 1 KB per agent and box before).
 const FRAMES_PER_TICK: usize = 4;
 
 impl<'m> SampledSim<'m> {
@@ -145,7 +148,7 @@ impl<'m> SampledSim<'m> {
                 Vec::with_capacity(if direct { 0 } else { frames })
             })
             .collect();
-        let outbox = || Vec::with_capacity(4 * FRAMES_PER_TICK);
+        let outbox = || Vec::with_capacity(FRAMES_PER_TICK);
         let slot_order = SlotOrder::for_model(model, |i| controllers[i].neighbour_order());
         let mut radio = Radio::new(&model.radio, n, model.seed, capacity);
         radio.attach_channel(&model.graph.radio, period);
