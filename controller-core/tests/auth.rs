@@ -309,3 +309,31 @@ fn full_broadcasts_add_a_sync_frame_and_receivers_sync_on_it() {
     }
     assert_eq!(rim.stats().unsynced, 1);
 }
+
+#[test]
+fn the_centre_of_a_full_fan_sends_at_most_max_frames_per_tick() {
+    // A fan of MAX_TRIANGLES triangles under `auth`: agent 0 is the apex of one angle
+    // per triangle, items fill whole frames, and every eighth broadcast adds a sync frame:
+    // the bound of `MAX_FRAMES_PER_TICK` is reached and never passed.
+    let k = controller_core::MAX_TRIANGLES;
+    let mut r = rng(11);
+    let tris = fan(k);
+    let q = fan_positions(k, 0.05, &mut r);
+    let f = Formation::random(k + 2, tris, &q, &mut r);
+    let s = State {
+        q: q.clone(),
+        v: vec![controller_core::Vec2::new(0.1, 0.0); k + 2],
+    };
+    let mut agents: Vec<HostAgent<f64>> = (0..k + 2)
+        .map(|i| {
+            let mut c = f.config::<f64>(i);
+            c.integrity = Integrity::Auth(KEY);
+            HostAgent::new(c).expect("valid")
+        })
+        .collect();
+    sense_and_exchange(&f, &s, &mut agents, 0.0, 0.0);
+    let counts: Vec<usize> = (0..9).map(|_| agents[0].frames(|_| ())).collect();
+    let bound = HostAgent::<f64>::MAX_FRAMES_PER_TICK;
+    assert_eq!(bound, 3);
+    assert_eq!(counts.iter().max(), Some(&bound), "{counts:?}");
+}

@@ -60,6 +60,12 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         self.frames_checked(|bytes, _| send(bytes))
     }
 
+    /// The most frames [`Agent::frames`] sends in one tick, in any integrity mode: the
+    /// items of at most `MT` angles of which this agent is the apex (one per triangle),
+    /// as few per frame as `auth` holds ([`crate::wire::MIN_ANGLES_PER_FRAME`]), plus an
+    /// `auth` sync frame after a full last frame. For buffers sized once (simulators).
+    pub const MAX_FRAMES_PER_TICK: usize = MT.div_ceil(crate::wire::MIN_ANGLES_PER_FRAME) + 1;
+
     /// [`Agent::frames`], each frame with its [`CrcCheck`] (`crc16` integrity; `None`
     /// otherwise), known without computing the CRC again since this agent has just written
     /// it: for simulators that hand each broadcast to [`Agent::receive_checked`] of every

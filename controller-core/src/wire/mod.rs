@@ -103,7 +103,15 @@ pub const ANGLE_ITEM_LEN: usize = 10;
 /// Bytes before the angle items (header and velocity).
 pub const FIXED_LEN: usize = offset::ANGLES;
 /// Most angle items one frame can hold (on a link without trailer).
-pub const MAX_ANGLES_PER_FRAME: usize = (MAX_FRAME_LEN - FIXED_LEN) / ANGLE_ITEM_LEN;
+pub const MAX_ANGLES_PER_FRAME: usize = angles_fitting(0);
+/// Most angle items a frame holds with the longest trailer (`auth`'s tag): the fewest of
+/// any integrity mode.
+pub const MIN_ANGLES_PER_FRAME: usize = angles_fitting(auth::TAG_LEN);
+
+/// Angle items that fit in a frame with a trailer of `trailer` bytes.
+const fn angles_fitting(trailer: usize) -> usize {
+    (MAX_FRAME_LEN - FIXED_LEN - trailer) / ANGLE_ITEM_LEN
+}
 
 /// How frames are protected against corruption. Chosen per deployment in
 /// [`crate::AgentConfig::integrity`]; every agent of a swarm must use the same (the mode
@@ -157,7 +165,7 @@ impl Integrity {
 
     /// Most angle items in one frame.
     pub const fn max_angles(self) -> usize {
-        (MAX_FRAME_LEN - FIXED_LEN - self.trailer_len()) / ANGLE_ITEM_LEN
+        angles_fitting(self.trailer_len())
     }
 }
 

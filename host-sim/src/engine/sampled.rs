@@ -86,11 +86,9 @@ pub struct SampledSim<'m> {
     local: bool,
 }
 
-/// Frames one agent emits per tick, at most (used to preallocate): an apex of `MT ≤ 8`
-/// angles fills at most `⌈8 / 4⌉ = 2` frames of four angle items, plus an `auth` sync
-/// frame (`controller_core::Agent::frames`). An outbox holds one tick's frames (a larger
-/// one would only grow the memory a large run walks: 1 KB per agent and box before).
-const FRAMES_PER_TICK: usize = 4;
+/// Frames one agent emits per tick, at most, in the standard capacity (used to
+/// preallocate; an outbox holds one tick's frames).
+const FRAMES_PER_TICK: usize = controller_core::StandardAgent::<f64>::MAX_FRAMES_PER_TICK;
 
 impl<'m> SampledSim<'m> {
     /// A sampled simulation with a [`LocalCore`](super::LocalCore) for every agent, each
