@@ -264,22 +264,7 @@ fn a_rebooted_neighbour_is_heard_again_only_with_a_larger_epoch() {
 fn full_broadcasts_add_a_sync_frame_and_receivers_sync_on_it() {
     // A fan of 4 triangles: agent 0 is the apex of 4 angles, one full frame per
     // broadcast with no room for the counter extension.
-    let mut r = rng(10);
-    let tris = fan(4);
-    let q = fan_positions(4, 0.05, &mut r);
-    let f = Formation::random(6, tris, &q, &mut r);
-    let s = State {
-        q: q.clone(),
-        v: vec![controller_core::Vec2::new(0.1, 0.0); 6],
-    };
-    let mut agents: Vec<HostAgent<f64>> = (0..6)
-        .map(|i| {
-            let mut c = f.config::<f64>(i);
-            c.integrity = Integrity::Auth(KEY);
-            HostAgent::new(c).expect("valid")
-        })
-        .collect();
-    sense_and_exchange(&f, &s, &mut agents, 0.0, 0.0);
+    let mut agents = auth_fan(4, 10);
     let (centre, rims) = agents.split_at_mut(1);
     let centre = &mut centre[0];
     centre.set_boot_epoch(2);
@@ -315,11 +300,19 @@ fn the_centre_of_a_full_fan_sends_at_most_max_frames_per_tick() {
     // A fan of MAX_TRIANGLES triangles under `auth`: agent 0 is the apex of one angle
     // per triangle, items fill whole frames, and every eighth broadcast adds a sync frame:
     // the bound of `MAX_FRAMES_PER_TICK` is reached and never passed.
-    let k = controller_core::MAX_TRIANGLES;
-    let mut r = rng(11);
-    let tris = fan(k);
+    let mut agents = auth_fan(controller_core::MAX_TRIANGLES, 11);
+    let counts: Vec<usize> = (0..9).map(|_| agents[0].frames(|_| ())).collect();
+    let bound = HostAgent::<f64>::MAX_FRAMES_PER_TICK;
+    assert_eq!(bound, 3);
+    assert_eq!(counts.iter().max(), Some(&bound), "{counts:?}");
+}
+
+/// The agents of a fan of `k` triangles around agent 0 (random formation from `seed`)
+/// with `auth` integrity, after one sensing and exchange.
+fn auth_fan(k: usize, seed: u64) -> Vec<HostAgent<f64>> {
+    let mut r = rng(seed);
     let q = fan_positions(k, 0.05, &mut r);
-    let f = Formation::random(k + 2, tris, &q, &mut r);
+    let f = Formation::random(k + 2, fan(k), &q, &mut r);
     let s = State {
         q: q.clone(),
         v: vec![controller_core::Vec2::new(0.1, 0.0); k + 2],
@@ -332,8 +325,5 @@ fn the_centre_of_a_full_fan_sends_at_most_max_frames_per_tick() {
         })
         .collect();
     sense_and_exchange(&f, &s, &mut agents, 0.0, 0.0);
-    let counts: Vec<usize> = (0..9).map(|_| agents[0].frames(|_| ())).collect();
-    let bound = HostAgent::<f64>::MAX_FRAMES_PER_TICK;
-    assert_eq!(bound, 3);
-    assert_eq!(counts.iter().max(), Some(&bound), "{counts:?}");
+    agents
 }
