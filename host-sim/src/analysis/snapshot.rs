@@ -59,6 +59,8 @@ pub struct Diagnostics {
     min_distance: MinDistance,
     /// Scratch: `½ c ỹ²` of every angle, model order.
     angle_energy: Vec<f64>,
+    /// `cos α*` of every angle, model order (computed once, not at every instant).
+    cos_desired: Vec<f64>,
 }
 
 fn unit(d: Vec2<f64>) -> Vec2<f64> {
@@ -83,6 +85,11 @@ impl Diagnostics {
             snap,
             min_distance: MinDistance::new(model.n()),
             angle_energy: vec![0.0; 2 * model.triangles.len()],
+            cos_desired: model
+                .triangles
+                .iter()
+                .flat_map(|t| t.angles.iter().map(|a| a.desired.cos()))
+                .collect(),
         }
     }
 
@@ -113,28 +120,33 @@ impl Diagnostics {
         }
         // Each angle's error and energy (independent: in parallel for large formations),
         // then the sum and the maximum in model order.
-        let angles = |(tri, (err, en)): (&TriangleModel, (&mut [f64], &mut [f64]))| {
-            for ((a, err), en) in tri.angles.iter().zip(err).zip(en) {
+        type Out<'a> = (&'a mut [f64], (&'a mut [f64], &'a [f64]));
+        let angles = |(tri, (err, (en, cos_desired))): (&TriangleModel, Out<'_>)| {
+            let each = tri.angles.iter().zip(err).zip(en).zip(cos_desired);
+            for (((a, err), en), cos_desired) in each {
                 let su = unit(q[a.far[0]] - q[a.apex]);
                 let sw = unit(q[a.far[1]] - q[a.apex]);
                 let y = su.dot(&sw);
-                *en = energy::angle(a.stiffness, y - a.desired.cos());
+                *en = energy::angle(a.stiffness, y - cos_desired);
                 *err = y.clamp(-1.0, 1.0).acos() - a.desired;
             }
         };
-        let (errs, energies) = (&mut s.angle_err, &mut self.angle_energy);
+        let (errs, energies, cosines) =
+            (&mut s.angle_err, &mut self.angle_energy, &self.cos_desired);
         if model.triangles.len() >= PARALLEL_MIN_TRIANGLES && rayon::current_num_threads() > 1 {
+            let per_angle = energies.par_chunks_mut(2).zip(cosines.par_chunks(2));
             model
                 .triangles
                 .par_iter()
-                .zip(errs.par_chunks_mut(2).zip(energies.par_chunks_mut(2)))
+                .zip(errs.par_chunks_mut(2).zip(per_angle))
                 .with_min_len(CHUNK)
                 .for_each(angles);
         } else {
+            let per_angle = energies.chunks_mut(2).zip(cosines.chunks(2));
             model
                 .triangles
                 .iter()
-                .zip(errs.chunks_mut(2).zip(energies.chunks_mut(2)))
+                .zip(errs.chunks_mut(2).zip(per_angle))
                 .for_each(angles);
         }
         s.v_ang = 0.0;
