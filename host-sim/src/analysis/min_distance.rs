@@ -3,12 +3,13 @@
 use controller_core::Vec2;
 
 /// Exact minimum pairwise distance on a uniform grid: agents are keyed by their cell
-/// `(⌊x/h⌋, ⌊y/h⌋)` and sorted (the order changes little between calls, and the key vector
-/// is reused: no allocation), and each agent is compared with the agents of its own and
+/// `(⌊x/h⌋, ⌊y/h⌋)` and sorted (the key vector is reused: no allocation; `h` is kept while
+/// it fits the answer, so between calls only the agents that changed cell are out of
+/// order, and sorting them by insertion takes about linear time), and each agent is compared with the agents of its own and
 /// the next cells (the half-neighbourhood: every pair once). Two agents closer than `h`
 /// are in neighbouring cells, so when the closest pair found is within `h` it is the
 /// closest of all; otherwise `h` doubles and the search repeats. `h` follows the answer
-/// (1.5 × the last distance), so a call costs O(N) plus the pairs in neighbouring cells,
+/// (1.5 × the last distance, again when the answer falls below `h / 2`), so a call costs O(N) plus the pairs in neighbouring cells,
 /// for lines, lattices or any spread of the agents (a sweep along `x` alone costs
 /// O(N √N) on a 2-D lattice, whose columns share one `x`). Equal distances go to the
 /// smallest pair `(i, j)`, whatever the order of the search.
@@ -18,6 +19,8 @@ pub struct MinDistance {
     h: f64,
     /// `(cell x, cell y, agent)`, sorted.
     keys: Vec<(i64, i64, usize)>,
+    /// The cell size `keys` was last sorted for (0: none).
+    sorted_h: f64,
 }
 
 /// The smallest cell size the grid uses (m): coincident agents would otherwise shrink it
@@ -30,6 +33,7 @@ impl MinDistance {
         Self {
             h: 0.0,
             keys: Vec::with_capacity(n),
+            sorted_h: 0.0,
         }
     }
 
@@ -50,7 +54,14 @@ impl MinDistance {
             // Within h: exact. With h beyond the extent every pair of finite agents was
             // compared (they share neighbouring cells): exact too, or none is finite.
             if best.0 <= h || h >= side || !h.is_finite() {
-                self.h = (1.5 * best.0).max(MIN_CELL);
+                // The same cells next time while they still fit the answer (at most a
+                // few agents per cell): the keys then stay nearly sorted between calls.
+                let fits = best.0 <= h && best.0 >= 0.5 * h;
+                self.h = if fits {
+                    h
+                } else {
+                    (1.5 * best.0).max(MIN_CELL)
+                };
                 return if best.0.is_finite() { best } else { none };
             }
             h *= 2.0;
@@ -61,12 +72,26 @@ impl MinDistance {
     fn search(&mut self, q: &[Vec2<f64>], h: f64) -> (f64, usize, usize) {
         // `as` saturates (NaN → 0): such agents only give NaN distances, never the best.
         let cell = |p: &Vec2<f64>| ((p.x / h).floor() as i64, (p.y / h).floor() as i64);
-        self.keys.clear();
-        self.keys.extend(q.iter().enumerate().map(|(i, p)| {
-            let (cx, cy) = cell(p);
-            (cx, cy, i)
-        }));
-        self.keys.sort_unstable();
+        if self.keys.len() == q.len() {
+            // The agents in the order of the last call, with their new cells.
+            for k in &mut self.keys {
+                (k.0, k.1) = cell(&q[k.2]);
+            }
+        } else {
+            self.keys.clear();
+            self.keys.extend(q.iter().enumerate().map(|(i, p)| {
+                let (cx, cy) = cell(p);
+                (cx, cy, i)
+            }));
+        }
+        // With the cells of the last call, only the agents that changed cell are out of
+        // order: insertion takes about linear time (keys are distinct, so every sort gives
+        // the same order).
+        let budget = 4 * self.keys.len();
+        if self.sorted_h != h || !insertion_sort_within(&mut self.keys, budget) {
+            self.keys.sort_unstable();
+        }
+        self.sorted_h = h;
         let keys = &self.keys;
         let mut best = (f64::INFINITY, 0, 0);
         let mut consider = |i: usize, j: usize| {
@@ -104,6 +129,26 @@ impl MinDistance {
         }
         best
     }
+}
+
+/// Sorts `v` by insertion when that takes at most `budget` moves and returns `true`;
+/// otherwise stops and returns `false`, with `v` still a permutation of itself.
+fn insertion_sort_within<T: Ord + Copy>(v: &mut [T], budget: usize) -> bool {
+    let mut moves = 0;
+    for i in 1..v.len() {
+        let x = v[i];
+        let mut j = i;
+        while j > 0 && v[j - 1] > x {
+            v[j] = v[j - 1];
+            j -= 1;
+        }
+        v[j] = x;
+        moves += i - j;
+        if moves > budget {
+            return false;
+        }
+    }
+    true
 }
 
 /// The larger side of the bounding box of the finite agents (0 for none, so that the
@@ -150,6 +195,52 @@ mod tests {
         }
     }
 
+    /// Small moves over many calls (the cells kept, the keys sorted by insertion), a jump
+    /// (the insertion budget exceeded), and a contraction (the cells re-sized): the brute
+    /// force answer every time.
+    #[test]
+    fn small_moves_jumps_and_contraction() {
+        let mut md = MinDistance::new(0);
+        let mut q: Vec<Vec2<f64>> = (0..300)
+            .map(|k| Vec2::new(f64::from(k % 15) * 1.1, f64::from(k / 15)))
+            .collect();
+        for round in 0..40 {
+            let f = f64::from(round);
+            for (k, p) in q.iter_mut().enumerate() {
+                let k = k as f64;
+                *p += Vec2::new(0.05 * (k * 1.7 + f).sin(), 0.05 * (k * 0.9 - f).cos());
+            }
+            if round == 20 {
+                q.reverse();
+                q[17].x += 40.0;
+            }
+            if round >= 30 {
+                q.iter_mut().for_each(|p| *p *= 0.8);
+            }
+            assert_eq!(md.compute(&q), brute(&q), "round {round}");
+        }
+    }
+
+    #[test]
+    fn insertion_sort_within_its_budget() {
+        let mut v = [2, 1, 4, 3, 5, 7, 6, 0];
+        assert!(insertion_sort_within(&mut v, 10));
+        assert_eq!(v, [0, 1, 2, 3, 4, 5, 6, 7]);
+        // Every permutation of five: sorted within a budget of the inversions (≤ 10).
+        let mut p = [0u8, 1, 2, 3, 4];
+        for k in 0..120u32 {
+            let mut x = p;
+            assert!(insertion_sort_within(&mut x, 10), "{p:?}");
+            assert_eq!(x, [0, 1, 2, 3, 4], "{p:?}");
+            p.swap(k as usize % 4, k as usize % 4 + 1);
+            p.rotate_left((k % 3) as usize);
+        }
+        let mut w: Vec<u32> = (0..50).rev().collect();
+        assert!(!insertion_sort_within(&mut w, 100));
+        w.sort_unstable();
+        assert_eq!(w, (0..50).collect::<Vec<_>>());
+    }
+
     /// The closest pair by comparing every pair, ties to the smallest `(i, j)`.
     fn brute(q: &[Vec2<f64>]) -> (f64, usize, usize) {
         let mut best = (f64::INFINITY, 0, 0);
@@ -189,6 +280,9 @@ mod tests {
         for (k, p) in q.iter_mut().enumerate() {
             *p *= 3.0 + (k as f64 * 0.37).sin();
         }
+        assert_eq!(md.compute(&q), brute(&q));
+        // Fewer agents than the last call, then all of them again.
+        assert_eq!(md.compute(&q[..57]), brute(&q[..57]));
         assert_eq!(md.compute(&q), brute(&q));
         q[7] = Vec2::new(f64::NAN, 1.0);
         let (d, i, j) = md.compute(&q);
