@@ -61,6 +61,11 @@ pub struct Diagnostics {
     angle_energy: Vec<f64>,
     /// `cos α*` of every angle, model order (computed once, not at every instant).
     cos_desired: Vec<f64>,
+    /// Every agent's mass, and every estimate's edge `(apex, far, c_e)` in layout order:
+    /// what an instant reads of the model's agents and estimates, packed (at 100,000
+    /// agents each instant walks them all).
+    masses: Vec<f64>,
+    edges: Vec<(usize, usize, f64)>,
 }
 
 fn unit(d: Vec2<f64>) -> Vec2<f64> {
@@ -81,6 +86,8 @@ impl Diagnostics {
             ..Snapshot::default()
         };
         Self {
+            masses: model.agents.iter().map(|a| a.mass).collect(),
+            edges: estimates.iter().map(|e| (e.apex, e.far, e.gain)).collect(),
             estimates,
             snap,
             min_distance: MinDistance::new(model.n()),
@@ -111,8 +118,8 @@ impl Diagnostics {
         s.vel_err = 0.0;
         s.max_speed = 0.0;
         s.finite = true;
-        for ((a, qi), vi) in model.agents.iter().zip(q).zip(v) {
-            s.v_kin += energy::kinetic(a.mass, vi, &v_star);
+        for ((&mass, qi), vi) in self.masses.iter().zip(q).zip(v) {
+            s.v_kin += energy::kinetic(mass, vi, &v_star);
             s.vel_err = s.vel_err.max((vi - v_star).norm());
             s.max_speed = s.max_speed.max(vi.norm());
             s.finite &=
@@ -168,9 +175,11 @@ impl Diagnostics {
             s.disp_err = zt.norm();
         }
         s.v_est = 0.0;
-        for ((e, r_hat), r_true) in self.estimates.iter().zip(est).zip(s.est_true.iter_mut()) {
-            *r_true = (q[e.apex] - q[e.far]).norm();
-            s.v_est += energy::estimate(e.gain, *r_hat, *r_true);
+        for (&(apex, far, gain), (r_hat, r_true)) in
+            self.edges.iter().zip(est.iter().zip(s.est_true.iter_mut()))
+        {
+            *r_true = (q[apex] - q[far]).norm();
+            s.v_est += energy::estimate(gain, *r_hat, *r_true);
         }
         s.v = s.v_kin + s.v_ang + s.v_lead + s.v_est;
         let (d, i, j) = self.min_distance.compute(q);
