@@ -3,16 +3,17 @@
 use controller_core::Vec2;
 
 /// Exact minimum pairwise distance on a uniform grid: agents are keyed by their cell
-/// `(⌊x/h⌋, ⌊y/h⌋)` and sorted (the key vector is reused: no allocation; `h` is kept while
-/// it fits the answer, so between calls only the agents that changed cell are out of
-/// order, and sorting them by insertion takes about linear time), and each agent is compared with the agents of its own and
+/// `(⌊x/h⌋, ⌊y/h⌋)` and sorted, and each agent is compared with the agents of its own and
 /// the next cells (the half-neighbourhood: every pair once). Two agents closer than `h`
 /// are in neighbouring cells, so when the closest pair found is within `h` it is the
 /// closest of all; otherwise `h` doubles and the search repeats. `h` follows the answer
-/// (1.5 × the last distance, again when the answer falls below `h / 2`), so a call costs O(N) plus the pairs in neighbouring cells,
-/// for lines, lattices or any spread of the agents (a sweep along `x` alone costs
-/// O(N √N) on a 2-D lattice, whose columns share one `x`). Equal distances go to the
-/// smallest pair `(i, j)`, whatever the order of the search.
+/// (1.5 × the last distance, again when the answer falls below `h / 2`), so a call costs
+/// O(N) plus the pairs in neighbouring cells, for lines, lattices or any spread of the
+/// agents (a sweep along `x` alone costs O(N √N) on a 2-D lattice, whose columns share
+/// one `x`). The key vector is reused (no allocation) and kept in the last call's order:
+/// with the same `h`, only the agents that changed cell are out of order, and sorting
+/// them by insertion takes about linear time. Equal distances go to the smallest pair
+/// `(i, j)`, whatever the order of the search.
 #[derive(Clone, Debug, Default)]
 pub struct MinDistance {
     /// Cell size of the next call (0: not known yet).
