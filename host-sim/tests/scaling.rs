@@ -97,6 +97,38 @@ fn a_large_run_on_two_threads_is_bit_identical_to_one() {
     assert!(start.0 != one.0);
 }
 
+/// The estimates [`Engine::view`] shows after ticks are every controller's current
+/// values (each tick copies them while the agent's state is in cache, instead of a
+/// second walk over every controller), on one thread and on two, and they moved.
+#[test]
+fn the_estimates_a_run_shows_are_the_controllers_values() {
+    let m = strip_model(PARALLEL_MIN_AGENTS + 100, 1.0);
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool");
+        pool.install(|| {
+            let mut sim = SampledSim::new(&m).expect("sim");
+            sim.advance_ticks(0.0, 5);
+            let mut read = Vec::new();
+            for i in 0..m.n() {
+                let c = sim.controller(i).expect("one per agent");
+                let mut own = vec![f64::NAN; c.estimate_layout().len()];
+                assert_eq!(c.read_estimates(&mut own), own.len());
+                read.extend(own);
+            }
+            let shown = sim.view().2;
+            assert_eq!(shown.len(), read.len());
+            for (k, (s, r)) in shown.iter().zip(&read).enumerate() {
+                assert_eq!(s.to_bits(), r.to_bits(), "{threads} threads, estimate {k}");
+            }
+            let moved = read.iter().filter(|&&r| r != m.initial_estimate).count();
+            assert!(moved > read.len() / 2, "{threads} threads: {moved} moved");
+        });
+    }
+}
+
 /// A large run on two threads is bit-identical to one thread (state, counters and
 /// statistics) with sensors that draw random numbers (bearings, ranges, velocities and
 /// the leader's partner offset: drawn in agent order) and with sensors that draw none

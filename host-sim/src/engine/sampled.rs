@@ -75,6 +75,9 @@ pub struct SampledSim<'m> {
     slot_order: SlotOrder,
     estimates: Vec<f64>,
     est_start: Vec<usize>,
+    /// `estimates` holds every controller's current values: the tick copied them (an
+    /// estimate changes only at a tick), so [`Engine::view`] need not.
+    estimates_fresh: bool,
     info: Vec<EstimateInfo>,
     last_tick: Option<f64>,
     /// Control ticks so far (the index of the sensors' streams, [`Sensors::stream`]).
@@ -172,6 +175,7 @@ impl<'m> SampledSim<'m> {
             slot_order,
             estimates: vec![model.initial_estimate; info.len()],
             est_start,
+            estimates_fresh: false,
             info,
             last_tick: None,
             ticks: 0,
@@ -215,6 +219,11 @@ impl<'m> SampledSim<'m> {
             c.finish()?;
         }
         Ok(())
+    }
+
+    /// Agent `i`'s controller (`None` beyond the last agent).
+    pub fn controller(&self, i: usize) -> Option<&dyn AgentController> {
+        self.controllers.get(i).map(|c| &**c)
     }
 
     /// The link figures of the remote controllers, in agent order.
@@ -285,6 +294,11 @@ impl SampledSim<'_> {
             let inbox = Self::inbox(&self.inboxes[i], &self.sent, &model.graph.radio, i);
             delivered += inbox.len() as u64;
             self.outputs[i] = self.controllers[i].start_tick(inbox, &m, &mut self.outboxes[i])?;
+            if self.outputs[i].is_some() {
+                // Done: its estimates while its state is in cache.
+                let c = &*self.controllers[i];
+                Self::read_estimates_of(c, &mut self.estimates, &self.est_start, i);
+            }
             self.inboxes[i].clear();
         }
         self.count_direct(delivered);
@@ -302,6 +316,20 @@ impl SampledSim<'_> {
                 self.attacks
                     .overhear(t, i, f.as_bytes(), &self.plant.q, model, &mut self.radio);
             }
+        }
+    }
+
+    /// Copies agent `i`'s current estimates into `estimates` (field by field, like
+    /// [`Scene::of`]).
+    fn read_estimates_of(
+        controller: &dyn AgentController,
+        estimates: &mut [f64],
+        est_start: &[usize],
+        i: usize,
+    ) {
+        let (a, b) = (est_start[i], est_start[i + 1]);
+        if let Some(slot) = estimates.get_mut(a..b) {
+            controller.read_estimates(slot);
         }
     }
 
@@ -324,6 +352,8 @@ impl Engine for SampledSim<'_> {
         }
         let model = self.model;
         let parallel = self.parallel();
+        // Set again once every agent's tick copied its estimates.
+        self.estimates_fresh = false;
         if self.direct {
             // The frames of the last tick are read where their senders left them.
             std::mem::swap(&mut self.outboxes, &mut self.sent);
@@ -360,7 +390,11 @@ impl Engine for SampledSim<'_> {
             let out = match self.outputs[i].take() {
                 Some(out) => out,
                 None => match self.controllers[i].finish_tick(&mut self.outboxes[i]) {
-                    Ok(out) => out,
+                    Ok(out) => {
+                        let c = &*self.controllers[i];
+                        Self::read_estimates_of(c, &mut self.estimates, &self.est_start, i);
+                        out
+                    }
                     Err(e) => {
                         self.error = Some(e);
                         return;
@@ -384,6 +418,7 @@ impl Engine for SampledSim<'_> {
                 out.force.norm(),
             );
         }
+        self.estimates_fresh = true;
         self.last_tick = Some(t);
     }
 
@@ -397,13 +432,16 @@ impl Engine for SampledSim<'_> {
     }
 
     fn view(&mut self) -> (&[Vec2<f64>], &[Vec2<f64>], &[f64]) {
-        let parallel = self.parallel();
-        read_estimates(
-            &mut self.controllers,
-            &mut self.estimates,
-            &self.est_start,
-            parallel,
-        );
+        if !self.estimates_fresh {
+            let parallel = self.parallel();
+            read_estimates(
+                &mut self.controllers,
+                &mut self.estimates,
+                &self.est_start,
+                parallel,
+            );
+            self.estimates_fresh = true;
+        }
         (&self.plant.q, &self.plant.v, &self.estimates)
     }
 

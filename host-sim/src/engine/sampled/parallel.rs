@@ -2,7 +2,9 @@
 //! counters on every thread of the current rayon pool, bit-identical to the sequential
 //! tick (`tests/scaling.rs`): each agent draws its sensors' noise from its own stream of
 //! the tick ([`crate::engine::sensors::Sensors::stream`]). Only the radio's broadcasts
-//! (one random stream, in agent order) stay sequential.
+//! (one random stream, in agent order) stay sequential. Each agent also copies its
+//! estimates for the diagnostics while its state is in cache (a separate pass over
+//! 100,000 agents' states costs a second walk through memory).
 
 use super::{prefetch_agent, SampledSim, Scene, CHUNK};
 use crate::engine::controller::AgentController;
@@ -11,7 +13,6 @@ use crate::engine::radio::RadioFrame;
 use crate::engine::stats::ControlStats;
 use crate::model::graph::Adjacency;
 use controller_core::{BearingMeasurement, Measurements, Vec2, MAX_NEIGHBOURS};
-use rayon::prelude::*;
 
 /// What the parallel walk of a tick sums over the agents (in agent order).
 #[derive(Clone, Copy, Debug, Default)]
@@ -48,12 +49,59 @@ struct Walk<'a> {
     footprints: &'a [crate::engine::prefetch::Footprint],
 }
 
-/// One agent's part of a tick: its controller, mailboxes and force.
+/// One agent's part of a tick: its controller, mailboxes, force and estimates.
 struct AgentSlots<'s> {
     controller: &'s mut Box<dyn AgentController>,
     inbox: &'s mut Vec<RadioFrame>,
     outbox: &'s mut Vec<RadioFrame>,
     force: &'s mut Vec2<f64>,
+    estimates: &'s mut [f64],
+}
+
+/// The agents `first..first + controllers.len()` with their parts of the simulator's
+/// per-agent buffers: disjoint from every other `Agents`, so halves go to different
+/// threads.
+struct Agents<'s> {
+    first: usize,
+    controllers: &'s mut [Box<dyn AgentController>],
+    inboxes: &'s mut [Vec<RadioFrame>],
+    outboxes: &'s mut [Vec<RadioFrame>],
+    forces: &'s mut [Vec2<f64>],
+    /// Their estimates: agent `first + k`'s at `est_start[k] - est_start[0]..est_start[k + 1]
+    /// - est_start[0]` (`est_start` has one entry more than the agents).
+    estimates: &'s mut [f64],
+    est_start: &'s [usize],
+}
+
+impl<'s> Agents<'s> {
+    /// The first `mid` agents and the rest.
+    fn split_at(self, mid: usize) -> (Self, Self) {
+        let (c0, c1) = self.controllers.split_at_mut(mid);
+        let (i0, i1) = self.inboxes.split_at_mut(mid);
+        let (o0, o1) = self.outboxes.split_at_mut(mid);
+        let (f0, f1) = self.forces.split_at_mut(mid);
+        let cut = (self.est_start[mid] - self.est_start[0]).min(self.estimates.len());
+        let (e0, e1) = self.estimates.split_at_mut(cut);
+        let lo = Agents {
+            first: self.first,
+            controllers: c0,
+            inboxes: i0,
+            outboxes: o0,
+            forces: f0,
+            estimates: e0,
+            est_start: &self.est_start[..=mid],
+        };
+        let hi = Agents {
+            first: self.first + mid,
+            controllers: c1,
+            inboxes: i1,
+            outboxes: o1,
+            forces: f1,
+            estimates: e1,
+            est_start: &self.est_start[mid..],
+        };
+        (lo, hi)
+    }
 }
 
 impl Walk<'_> {
@@ -81,6 +129,7 @@ impl Walk<'_> {
         let frames = SampledSim::inbox(a.inbox, self.sent, self.radio, i);
         let delivered = frames.len() as u64;
         let out = a.controller.tick(frames, &m, a.outbox);
+        a.controller.read_estimates(a.estimates);
         a.inbox.clear();
         *a.force = out.force;
         let mut sums = TickSums {
@@ -94,11 +143,52 @@ impl Walk<'_> {
             .record(self.t, i, out.status, out.saturated, out.degenerate, norm);
         sums
     }
+
+    /// The ticks of `agents`: halves on every thread of the current rayon pool down to
+    /// [`CHUNK`] agents, then in agent order; the sums in agent order.
+    fn agents(&self, agents: Agents<'_>) -> TickSums {
+        let n = agents.controllers.len();
+        if n > CHUNK {
+            let (lo, hi) = agents.split_at(n / 2);
+            let (a, b) = rayon::join(|| self.agents(lo), || self.agents(hi));
+            return a.then(b);
+        }
+        let Agents {
+            first,
+            controllers,
+            inboxes,
+            outboxes,
+            forces,
+            estimates,
+            est_start,
+        } = agents;
+        let mut rest = estimates;
+        let mut sums = TickSums::default();
+        let each = controllers
+            .iter_mut()
+            .zip(inboxes)
+            .zip(outboxes)
+            .zip(forces);
+        for (k, (((controller, inbox), outbox), force)) in each.enumerate() {
+            let count = (est_start[k + 1] - est_start[k]).min(rest.len());
+            let (own, later) = std::mem::take(&mut rest).split_at_mut(count);
+            rest = later;
+            let slots = AgentSlots {
+                controller,
+                inbox,
+                outbox,
+                force,
+                estimates: own,
+            };
+            sums = sums.then(self.agent(first + k, slots));
+        }
+        sums
+    }
 }
 
 impl SampledSim<'_> {
-    /// Every agent's tick on every thread ([`Walk::agent`]), its force, and the counters
-    /// and statistics of all, summed in agent order.
+    /// Every agent's tick on every thread ([`Walk::agent`]), its force and estimates, and
+    /// the counters and statistics of all, summed in agent order.
     pub(super) fn tick_parallel(&mut self, t: f64, dt: f64, tick: u64) {
         let model = self.model;
         let walk = Walk {
@@ -110,25 +200,17 @@ impl SampledSim<'_> {
             sent: &self.sent,
             footprints: &self.footprints,
         };
-        // Each agent's four parts, zipped (the slices are disjoint fields).
-        let sums = self
-            .controllers
-            .par_iter_mut()
-            .zip(&mut self.inboxes)
-            .zip(&mut self.outboxes)
-            .zip(&mut self.forces)
-            .enumerate()
-            .with_min_len(CHUNK)
-            .map(|(i, (((controller, inbox), outbox), force))| {
-                let slots = AgentSlots {
-                    controller,
-                    inbox,
-                    outbox,
-                    force,
-                };
-                walk.agent(i, slots)
-            })
-            .reduce(TickSums::default, TickSums::then);
+        // Each agent's parts (the slices are disjoint fields).
+        let sums = walk.agents(Agents {
+            first: 0,
+            controllers: &mut self.controllers,
+            inboxes: &mut self.inboxes,
+            outboxes: &mut self.outboxes,
+            forces: &mut self.forces,
+            estimates: &mut self.estimates,
+            est_start: &self.est_start,
+        });
+        self.estimates_fresh = true;
         self.count_direct(sums.delivered);
         if self.direct {
             self.radio.count_direct_sums(sums.broadcasts, sums.copies);
