@@ -7,11 +7,12 @@ use crate::model::{EstimateInfo, Model, TriangleModel};
 use controller_core::{energy, Vec2};
 use rayon::prelude::*;
 
-/// From this many triangles on, the per-angle and per-estimate terms are computed on every
-/// thread of the current rayon pool; the sums and maxima are then taken in model order, so
-/// the result is the same bits on any number of threads.
+/// From this many triangles on, the per-agent, per-angle and per-estimate terms are
+/// computed on every thread of the current rayon pool; the sums are then taken in model
+/// order (maxima do not depend on it), so the result is the same bits on any number of
+/// threads.
 pub const PARALLEL_MIN_TRIANGLES: usize = 2048;
-/// Triangles per parallel work item.
+/// Triangles (agents, estimates) per parallel work item.
 const CHUNK: usize = 512;
 
 /// Everything the diagnostics know about one instant.
@@ -66,6 +67,42 @@ pub struct Diagnostics {
     /// agents each instant walks them all).
     masses: Vec<f64>,
     edges: Vec<(usize, usize, f64)>,
+    /// Scratch: every agent's kinetic term, agent order.
+    kinetic: Vec<f64>,
+    /// Scratch: every estimate's term `½ c_e (r̂ − r)²`, layout order.
+    est_energy: Vec<f64>,
+}
+
+/// The speed extremes of some agents, and whether their state is finite.
+#[derive(Clone, Copy, Debug)]
+struct AgentExtremes {
+    /// `max |v − v*|`.
+    vel_err: f64,
+    /// `max |v|`.
+    max_speed: f64,
+    finite: bool,
+}
+
+impl Default for AgentExtremes {
+    /// Of no agent.
+    fn default() -> Self {
+        Self {
+            vel_err: 0.0,
+            max_speed: 0.0,
+            finite: true,
+        }
+    }
+}
+
+impl AgentExtremes {
+    /// Of both sets (`f64::max` ignores NaN either way, so the order does not matter).
+    fn merge(self, other: Self) -> Self {
+        Self {
+            vel_err: self.vel_err.max(other.vel_err),
+            max_speed: self.max_speed.max(other.max_speed),
+            finite: self.finite && other.finite,
+        }
+    }
 }
 
 fn unit(d: Vec2<f64>) -> Vec2<f64> {
@@ -88,6 +125,8 @@ impl Diagnostics {
         Self {
             masses: model.agents.iter().map(|a| a.mass).collect(),
             edges: estimates.iter().map(|e| (e.apex, e.far, e.gain)).collect(),
+            kinetic: vec![0.0; model.n()],
+            est_energy: vec![0.0; estimates.len()],
             estimates,
             snap,
             min_distance: MinDistance::new(model.n()),
@@ -114,17 +153,14 @@ impl Diagnostics {
         s.t = t;
         let vs = model.v_star(t);
         let v_star = Vec2::new(vs[0], vs[1]);
-        s.v_kin = 0.0;
-        s.vel_err = 0.0;
-        s.max_speed = 0.0;
-        s.finite = true;
-        for ((&mass, qi), vi) in self.masses.iter().zip(q).zip(v) {
-            s.v_kin += energy::kinetic(mass, vi, &v_star);
-            s.vel_err = s.vel_err.max((vi - v_star).norm());
-            s.max_speed = s.max_speed.max(vi.norm());
-            s.finite &=
-                qi.x.is_finite() && qi.y.is_finite() && vi.x.is_finite() && vi.y.is_finite();
-        }
+        let parallel =
+            model.triangles.len() >= PARALLEL_MIN_TRIANGLES && rayon::current_num_threads() > 1;
+        let (v_kin, extremes) =
+            agent_terms(&mut self.kinetic, &self.masses, q, v, v_star, parallel);
+        s.v_kin = v_kin;
+        s.vel_err = extremes.vel_err;
+        s.max_speed = extremes.max_speed;
+        s.finite = extremes.finite;
         // Each angle's error and energy (independent: in parallel for large formations),
         // then the sum and the maximum in model order.
         type Out<'a> = (&'a mut [f64], (&'a mut [f64], &'a [f64]));
@@ -140,7 +176,7 @@ impl Diagnostics {
         };
         let (errs, energies, cosines) =
             (&mut s.angle_err, &mut self.angle_energy, &self.cos_desired);
-        if model.triangles.len() >= PARALLEL_MIN_TRIANGLES && rayon::current_num_threads() > 1 {
+        if parallel {
             let per_angle = energies.par_chunks_mut(2).zip(cosines.par_chunks(2));
             model
                 .triangles
@@ -174,16 +210,96 @@ impl Diagnostics {
             s.v_lead = energy::leader(l.stiffness, &zt);
             s.disp_err = zt.norm();
         }
-        s.v_est = 0.0;
-        for (&(apex, far, gain), (r_hat, r_true)) in
-            self.edges.iter().zip(est.iter().zip(s.est_true.iter_mut()))
-        {
-            *r_true = (q[apex] - q[far]).norm();
-            s.v_est += energy::estimate(gain, *r_hat, *r_true);
-        }
+        s.v_est = estimate_terms(
+            &mut self.est_energy,
+            &self.edges,
+            q,
+            est,
+            &mut s.est_true,
+            parallel,
+        );
         s.v = s.v_kin + s.v_ang + s.v_lead + s.v_est;
         let (d, i, j) = self.min_distance.compute(q);
         s.min_dist = d;
         s.min_pair = (i, j);
     }
+}
+
+/// Every agent's kinetic term `½ m |v − v*|²` (S13), speed error and speed: `V_kin` summed
+/// in agent order, and the extremes. `parallel`: the terms on every thread of the current
+/// rayon pool into `scratch`, then the same sum.
+fn agent_terms(
+    scratch: &mut [f64],
+    masses: &[f64],
+    q: &[Vec2<f64>],
+    v: &[Vec2<f64>],
+    v_star: Vec2<f64>,
+    parallel: bool,
+) -> (f64, AgentExtremes) {
+    let terms = |mass: f64, qi: &Vec2<f64>, vi: &Vec2<f64>| {
+        let finite = qi.x.is_finite() && qi.y.is_finite() && vi.x.is_finite() && vi.y.is_finite();
+        let extremes = AgentExtremes {
+            vel_err: (vi - v_star).norm(),
+            max_speed: vi.norm(),
+            finite,
+        };
+        (energy::kinetic(mass, vi, &v_star), extremes)
+    };
+    if !parallel {
+        let mut sum = (0.0, AgentExtremes::default());
+        for ((&mass, qi), vi) in masses.iter().zip(q).zip(v) {
+            let (kin, e) = terms(mass, qi, vi);
+            sum = (sum.0 + kin, sum.1.merge(e));
+        }
+        return sum;
+    }
+    let extremes = scratch
+        .par_iter_mut()
+        .zip(masses)
+        .zip(q.par_iter().zip(v))
+        .with_min_len(CHUNK)
+        .map(|((slot, &mass), (qi, vi))| {
+            let (kin, e) = terms(mass, qi, vi);
+            *slot = kin;
+            e
+        })
+        .reduce(AgentExtremes::default, AgentExtremes::merge);
+    let mut v_kin = 0.0;
+    for kin in scratch.iter() {
+        v_kin += kin;
+    }
+    (v_kin, extremes)
+}
+
+/// Every estimate's true distance (into `est_true`) and term `½ c_e (r̂ − r)²` (S13):
+/// `V_est` summed in layout order. `parallel`: as [`agent_terms`].
+fn estimate_terms(
+    scratch: &mut [f64],
+    edges: &[(usize, usize, f64)],
+    q: &[Vec2<f64>],
+    est: &[f64],
+    est_true: &mut [f64],
+    parallel: bool,
+) -> f64 {
+    let term = |&(apex, far, gain): &(usize, usize, f64), r_hat: f64, r_true: &mut f64| {
+        *r_true = (q[apex] - q[far]).norm();
+        energy::estimate(gain, r_hat, *r_true)
+    };
+    let mut v_est = 0.0;
+    if !parallel {
+        for ((edge, &r_hat), r_true) in edges.iter().zip(est).zip(est_true) {
+            v_est += term(edge, r_hat, r_true);
+        }
+        return v_est;
+    }
+    edges
+        .par_iter()
+        .zip(est)
+        .zip(est_true.par_iter_mut().zip(scratch.par_iter_mut()))
+        .with_min_len(CHUNK)
+        .for_each(|((edge, &r_hat), (r_true, slot))| *slot = term(edge, r_hat, r_true));
+    for en in scratch.iter() {
+        v_est += en;
+    }
+    v_est
 }
