@@ -24,7 +24,14 @@ pub struct Monitor {
     pub min_estimate: Option<f64>,
     /// Smallest inter-agent distance seen, with time and pair.
     pub min_distance: (f64, f64, usize, usize),
-    at_min_since: Vec<Option<f64>>,
+    /// How many estimates are watched for a collapse.
+    n_estimates: usize,
+    /// The estimates held at `r_min` at the last instant, with the instant each reached
+    /// it, by index (usually none: a list rather than a slot per estimate, which every
+    /// instant of a 100,000-agent run would walk).
+    held: Vec<(usize, f64)>,
+    /// Scratch for the next `held`.
+    held_next: Vec<(usize, f64)>,
     collapsed: bool,
     /// Failures detected, in order.
     pub events: Vec<Event>,
@@ -44,7 +51,9 @@ impl Monitor {
             settle_candidate: None,
             min_estimate: None,
             min_distance: (f64::INFINITY, 0.0, 0, 0),
-            at_min_since: vec![None; n_estimates],
+            n_estimates,
+            held: Vec::new(),
+            held_next: Vec::new(),
             collapsed: false,
             events: Vec::new(),
             terminal: false,
@@ -91,21 +100,36 @@ impl Monitor {
         if s.min_dist < self.min_distance.0 {
             self.min_distance = (s.min_dist, s.t, s.min_pair.0, s.min_pair.1);
         }
-        for (k, &r) in est.iter().enumerate() {
-            self.min_estimate = Some(self.min_estimate.map_or(r, |m: f64| m.min(r)));
-            let held = r <= model.min_estimate * (1.0 + 1e-12);
-            let Some(since) = self.at_min_since.get_mut(k) else {
+        // The smallest estimate (`f64::min` ignores NaN: the order does not matter), and
+        // the estimates held at `r_min` (each keeps the instant it reached it while held).
+        if let Some(&first) = est.first() {
+            let m = est.iter().fold(first, |m, &r| m.min(r));
+            self.min_estimate = Some(self.min_estimate.map_or(m, |prev| prev.min(m)));
+        }
+        let floor = model.min_estimate * (1.0 + 1e-12);
+        let mut before = self.held.iter().peekable();
+        let mut due = None;
+        self.held_next.clear();
+        for (k, &r) in est.iter().enumerate().take(self.n_estimates) {
+            let held = r <= floor;
+            if !held {
                 continue;
-            };
-            match (held, *since) {
-                (true, None) => *since = Some(s.t),
-                (false, _) => *since = None,
-                (true, Some(t0)) => {
-                    if !self.collapsed && s.t - t0 >= cr.collapse_time {
-                        self.collapse(model, d, k, t0);
-                    }
-                }
             }
+            while before.next_if(|&&(j, _)| j < k).is_some() {}
+            match before.next_if(|&&(j, _)| j == k) {
+                Some(&(_, t0)) => {
+                    // Held since t0: collapsed once held for `collapse_time`.
+                    if due.is_none() && s.t - t0 >= cr.collapse_time {
+                        due = Some((k, t0));
+                    }
+                    self.held_next.push((k, t0));
+                }
+                None => self.held_next.push((k, s.t)),
+            }
+        }
+        std::mem::swap(&mut self.held, &mut self.held_next);
+        if let (Some((k, t0)), false) = (due, self.collapsed) {
+            self.collapse(model, d, k, t0);
         }
         // Terminal failures.
         if !s.finite {
@@ -187,12 +211,7 @@ impl Monitor {
     /// (for any time) is recorded first, as the likely cause.
     fn stop(&mut self, model: &Model, d: &Diagnostics, kind: Outcome, message: String) -> bool {
         if !self.collapsed {
-            let held = self
-                .at_min_since
-                .iter()
-                .enumerate()
-                .filter_map(|(k, s)| s.map(|t0| (k, t0)))
-                .min_by(|a, b| a.1.total_cmp(&b.1));
+            let held = self.held.iter().copied().min_by(|a, b| a.1.total_cmp(&b.1));
             if let Some((k, t0)) = held {
                 self.collapse(model, d, k, t0);
             }
