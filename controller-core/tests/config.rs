@@ -5,8 +5,8 @@ mod testkit;
 
 use controller_core::link::{link_estimates, LinkError, LinkOutput, MAX_LINK_ESTIMATES};
 use controller_core::{
-    Agent, AgentConfig, AngleConfig, ConfigError, Fault, Schedule, ScheduleStep, Status,
-    StepOutput, TriangleConfig, Vec2,
+    Agent, AgentConfig, AngleConfig, ConfigError, EstimatorMode, Fault, Schedule, ScheduleStep,
+    Status, StepOutput, TriangleConfig, Vec2,
 };
 use testkit::{rng, strip, strip_positions, Formation, HostAgent};
 
@@ -171,4 +171,40 @@ fn link_counts_are_never_truncated() {
     assert_eq!(link.frames, 300);
     assert_eq!(link.status, Status::Safe(Fault::Stale(7)));
     assert_eq!(link.fault_neighbour(), Some(7));
+}
+
+/// `copy_estimates` writes the values `owned_estimates` lists, in its order, in every
+/// estimator mode (the measured mode owns none), and stops at the end of a short buffer.
+#[test]
+fn copy_estimates_is_owned_estimates_values() {
+    use rand::Rng;
+    for mode in [
+        EstimatorMode::Shared,
+        EstimatorMode::PerAgent,
+        EstimatorMode::Measured,
+    ] {
+        let mut r = rng(7);
+        let q = testkit::fan_positions(4, 0.05, &mut r);
+        let mut f = Formation::random(q.len(), testkit::fan(4), &q, &mut r);
+        f.mode = mode;
+        for mut a in f.agents::<f64>() {
+            let owned: Vec<_> = a.owned_estimates().collect();
+            for e in &owned {
+                assert!(a.set_estimate(e.triangle, e.angle, e.edge, r.random_range(0.3..3.0)));
+            }
+            let values: Vec<f64> = a.owned_estimates().map(|e| e.value).collect();
+            let mut out = vec![f64::NAN; values.len() + 2];
+            assert_eq!(a.copy_estimates(&mut out), values.len(), "{mode:?}");
+            assert_eq!(&out[..values.len()], &values[..], "{mode:?}");
+            assert!(out[values.len()..].iter().all(|x| x.is_nan()));
+            if mode == EstimatorMode::Measured {
+                assert!(values.is_empty());
+            }
+            if let Some(short) = values.len().checked_sub(1) {
+                let mut out = vec![0.0; short];
+                assert_eq!(a.copy_estimates(&mut out), short);
+                assert_eq!(&out[..], &values[..short]);
+            }
+        }
+    }
 }

@@ -98,8 +98,9 @@ fn a_large_run_on_two_threads_is_bit_identical_to_one() {
 }
 
 /// The estimates [`Engine::view`] shows after ticks are every controller's current
-/// values (each tick copies them while the agent's state is in cache, instead of a
-/// second walk over every controller), on one thread and on two, and they moved.
+/// values (once viewed, each tick copies them while the agent's state is in cache,
+/// instead of a second walk over every controller), on one thread and on two, and they
+/// moved.
 #[test]
 fn the_estimates_a_run_shows_are_the_controllers_values() {
     let m = strip_model(PARALLEL_MIN_AGENTS + 100, 1.0);
@@ -110,6 +111,9 @@ fn the_estimates_a_run_shows_are_the_controllers_values() {
             .expect("pool");
         pool.install(|| {
             let mut sim = SampledSim::new(&m).expect("sim");
+            // Viewed once (as a run's diagnostics do at every instant): from then on the
+            // ticks copy the estimates.
+            let _ = sim.view();
             sim.advance_ticks(0.0, 5);
             let mut read = Vec::new();
             for i in 0..m.n() {

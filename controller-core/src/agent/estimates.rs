@@ -31,6 +31,27 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         })
     }
 
+    /// Writes the values of the estimates this agent owns into `out`, in
+    /// [`Self::owned_estimates`] order, as far as `out` reaches; returns how many it wrote.
+    /// (The same as taking `value` from [`Self::owned_estimates`], as a plain loop: a
+    /// simulator reads every agent's estimates at every instant.)
+    pub fn copy_estimates(&self, out: &mut [T]) -> usize {
+        let mode = self.config.estimator;
+        let mut n = 0;
+        for a in self.angles.iter().flatten() {
+            for (e, &value) in a.estimate.iter().enumerate() {
+                if owns(mode, a, e) {
+                    match out.get_mut(n) {
+                        Some(slot) => *slot = value,
+                        None => return n,
+                    }
+                    n += 1;
+                }
+            }
+        }
+        n
+    }
+
     /// Overwrites an owned estimate (for simulators integrating S9 in continuous time; call
     /// it before [`Agent::sense`], which computes the apex kernels with the estimates).
     /// Values are clamped to `r_min`; returns `false` for an estimate this agent does not

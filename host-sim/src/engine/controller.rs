@@ -215,12 +215,7 @@ impl<const M: usize, const N: usize> AgentController for LocalCore<M, N> {
     }
 
     fn read_estimates(&self, out: &mut [f64]) -> usize {
-        let mut n = 0;
-        for (slot, e) in out.iter_mut().zip(self.agent.owned_estimates()) {
-            *slot = e.value;
-            n += 1;
-        }
-        n
+        self.agent.copy_estimates(out)
     }
 
     fn frame_stats(&self) -> FrameStats {

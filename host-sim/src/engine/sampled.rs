@@ -78,6 +78,10 @@ pub struct SampledSim<'m> {
     /// `estimates` holds every controller's current values: the tick copied them (an
     /// estimate changes only at a tick), so [`Engine::view`] need not.
     estimates_fresh: bool,
+    /// [`Engine::view`] was called: from then on each agent's tick copies its estimates
+    /// while its state is in cache (a run's diagnostics view every control instant; the
+    /// benchmark's [`SampledSim::advance_ticks`] never views, and copies nothing).
+    viewed: bool,
     info: Vec<EstimateInfo>,
     last_tick: Option<f64>,
     /// Control ticks so far (the index of the sensors' streams, [`Sensors::stream`]).
@@ -176,6 +180,7 @@ impl<'m> SampledSim<'m> {
             estimates: vec![model.initial_estimate; info.len()],
             est_start,
             estimates_fresh: false,
+            viewed: false,
             info,
             last_tick: None,
             ticks: 0,
@@ -294,7 +299,7 @@ impl SampledSim<'_> {
             let inbox = Self::inbox(&self.inboxes[i], &self.sent, &model.graph.radio, i);
             delivered += inbox.len() as u64;
             self.outputs[i] = self.controllers[i].start_tick(inbox, &m, &mut self.outboxes[i])?;
-            if self.outputs[i].is_some() {
+            if self.viewed && self.outputs[i].is_some() {
                 // Done: its estimates while its state is in cache.
                 let c = &*self.controllers[i];
                 Self::read_estimates_of(c, &mut self.estimates, &self.est_start, i);
@@ -390,11 +395,12 @@ impl Engine for SampledSim<'_> {
             let out = match self.outputs[i].take() {
                 Some(out) => out,
                 None => match self.controllers[i].finish_tick(&mut self.outboxes[i]) {
-                    Ok(out) => {
+                    Ok(out) if self.viewed => {
                         let c = &*self.controllers[i];
                         Self::read_estimates_of(c, &mut self.estimates, &self.est_start, i);
                         out
                     }
+                    Ok(out) => out,
                     Err(e) => {
                         self.error = Some(e);
                         return;
@@ -418,7 +424,7 @@ impl Engine for SampledSim<'_> {
                 out.force.norm(),
             );
         }
-        self.estimates_fresh = true;
+        self.estimates_fresh = self.viewed;
         self.last_tick = Some(t);
     }
 
@@ -432,6 +438,7 @@ impl Engine for SampledSim<'_> {
     }
 
     fn view(&mut self) -> (&[Vec2<f64>], &[Vec2<f64>], &[f64]) {
+        self.viewed = true;
         if !self.estimates_fresh {
             let parallel = self.parallel();
             read_estimates(

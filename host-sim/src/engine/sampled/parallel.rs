@@ -47,6 +47,8 @@ struct Walk<'a> {
     slot_order: &'a crate::engine::slot_order::SlotOrder,
     sent: &'a [Vec<RadioFrame>],
     footprints: &'a [crate::engine::prefetch::Footprint],
+    /// Each agent copies its estimates after its tick ([`SampledSim`]'s `viewed`).
+    copy_estimates: bool,
 }
 
 /// One agent's part of a tick: its controller, mailboxes, force and estimates.
@@ -129,7 +131,9 @@ impl Walk<'_> {
         let frames = SampledSim::inbox(a.inbox, self.sent, self.radio, i);
         let delivered = frames.len() as u64;
         let out = a.controller.tick(frames, &m, a.outbox);
-        a.controller.read_estimates(a.estimates);
+        if self.copy_estimates {
+            a.controller.read_estimates(a.estimates);
+        }
         a.inbox.clear();
         *a.force = out.force;
         let mut sums = TickSums {
@@ -199,6 +203,7 @@ impl SampledSim<'_> {
             slot_order: &self.slot_order,
             sent: &self.sent,
             footprints: &self.footprints,
+            copy_estimates: self.viewed,
         };
         // Each agent's parts (the slices are disjoint fields).
         let sums = walk.agents(Agents {
@@ -210,7 +215,7 @@ impl SampledSim<'_> {
             estimates: &mut self.estimates,
             est_start: &self.est_start,
         });
-        self.estimates_fresh = true;
+        self.estimates_fresh = self.viewed;
         self.count_direct(sums.delivered);
         if self.direct {
             self.radio.count_direct_sums(sums.broadcasts, sums.copies);
