@@ -440,13 +440,11 @@ impl Engine for SampledSim<'_> {
     fn view(&mut self) -> (&[Vec2<f64>], &[Vec2<f64>], &[f64]) {
         self.viewed = true;
         if !self.estimates_fresh {
-            let parallel = self.parallel();
-            read_estimates(
-                &mut self.controllers,
-                &mut self.estimates,
-                &self.est_start,
-                parallel,
-            );
+            // The first view, or after a tick that did not copy them (about once a run:
+            // from now on every tick copies them).
+            for (i, c) in self.controllers.iter().enumerate() {
+                Self::read_estimates_of(&**c, &mut self.estimates, &self.est_start, i);
+            }
             self.estimates_fresh = true;
         }
         (&self.plant.q, &self.plant.v, &self.estimates)
@@ -498,37 +496,6 @@ impl Engine for SampledSim<'_> {
             self.error = self.controllers.iter_mut().find_map(|c| c.take_error());
         }
         self.error.take()
-    }
-}
-
-/// Reads every controller's estimates into `est` (agent `i`'s at
-/// `est[start[i] - start[0]..start[i + 1] - start[0]]`; `start` has one entry more than
-/// `controllers`). `parallel`: halves on every thread of the current rayon pool, down to
-/// [`CHUNK`] agents (each agent writes only its own slots: the same values on any number
-/// of threads, without allocating).
-fn read_estimates(
-    controllers: &mut [Box<dyn AgentController>],
-    est: &mut [f64],
-    start: &[usize],
-    parallel: bool,
-) {
-    if parallel && controllers.len() > CHUNK {
-        let mid = controllers.len() / 2;
-        let (c_lo, c_hi) = controllers.split_at_mut(mid);
-        let split = start[mid] - start[0];
-        let (e_lo, e_hi) = est.split_at_mut(split.min(est.len()));
-        rayon::join(
-            || read_estimates(c_lo, e_lo, &start[..=mid], true),
-            || read_estimates(c_hi, e_hi, &start[mid..], true),
-        );
-        return;
-    }
-    let base = start.first().copied().unwrap_or(0);
-    for (i, c) in controllers.iter().enumerate() {
-        let (a, b) = (start[i] - base, start[i + 1] - base);
-        if let Some(slot) = est.get_mut(a..b) {
-            c.read_estimates(slot);
-        }
     }
 }
 
