@@ -1,6 +1,7 @@
 //! The closest pair of agents, in expected linear time.
 
 use controller_core::Vec2;
+use rayon::prelude::*;
 
 /// Exact minimum pairwise distance on a uniform grid: agents are keyed by their cell
 /// `(⌊x/h⌋, ⌊y/h⌋)` and sorted, and each agent is compared with the agents of its own and
@@ -14,6 +15,12 @@ use controller_core::Vec2;
 /// with the same `h`, only the agents that changed cell are out of order, and sorting
 /// them by insertion takes about linear time. Equal distances go to the smallest pair
 /// `(i, j)`, whatever the order of the search.
+///
+/// From [`PARALLEL_MIN_AGENTS`] agents on, and when the current rayon pool has more than
+/// one thread, the cells, the extent and the search run on every thread (the search in
+/// runs of [`SEARCH_CHUNK`] keys): the closest pair is the least `(distance, i, j)`, which
+/// does not depend on the order it is found in, so the answer is the same on any number of
+/// threads.
 #[derive(Clone, Debug, Default)]
 pub struct MinDistance {
     /// Cell size of the next call (0: not known yet).
@@ -28,6 +35,15 @@ pub struct MinDistance {
 /// to zero.
 const MIN_CELL: f64 = 1e-6;
 
+/// Agents from which a call works on every thread of the current rayon pool.
+pub const PARALLEL_MIN_AGENTS: usize = 4096;
+
+/// Keys per task of a parallel search (and agents per task for the cells and the extent).
+const SEARCH_CHUNK: usize = 2048;
+
+/// No pair: what a search returns when it compares nothing.
+const NO_PAIR: (f64, usize, usize) = (f64::INFINITY, 0, 0);
+
 impl MinDistance {
     /// For `n` agents.
     pub fn new(n: usize) -> Self {
@@ -41,17 +57,18 @@ impl MinDistance {
     /// `(distance, i, j)` of the closest pair, `i < j` (`inf` with fewer than two agents
     /// or when no distance is a number).
     pub fn compute(&mut self, q: &[Vec2<f64>]) -> (f64, usize, usize) {
-        let none = (f64::INFINITY, 0, 0);
+        let none = NO_PAIR;
         if q.len() < 2 {
             return none;
         }
-        let side = extent(q);
+        let parallel = q.len() >= PARALLEL_MIN_AGENTS && rayon::current_num_threads() > 1;
+        let side = extent(q, parallel);
         let mut h = self.h;
         if !(h.is_finite() && h >= MIN_CELL) {
             h = (side / (q.len() as f64).sqrt()).max(MIN_CELL);
         }
         loop {
-            let best = self.search(q, h);
+            let best = self.search(q, h, parallel);
             // Within h: exact. With h beyond the extent every pair of finite agents was
             // compared (they share neighbouring cells): exact too, or none is finite.
             if best.0 <= h || h >= side || !h.is_finite() {
@@ -70,65 +87,110 @@ impl MinDistance {
     }
 
     /// The closest pair among agents in neighbouring cells of size `h`.
-    fn search(&mut self, q: &[Vec2<f64>], h: f64) -> (f64, usize, usize) {
+    fn search(&mut self, q: &[Vec2<f64>], h: f64, parallel: bool) -> (f64, usize, usize) {
         // `as` saturates (NaN → 0): such agents only give NaN distances, never the best.
         let cell = |p: &Vec2<f64>| ((p.x / h).floor() as i64, (p.y / h).floor() as i64);
         if self.keys.len() == q.len() {
             // The agents in the order of the last call, with their new cells.
-            for k in &mut self.keys {
-                (k.0, k.1) = cell(&q[k.2]);
+            let recell = |k: &mut (i64, i64, usize)| (k.0, k.1) = cell(&q[k.2]);
+            if parallel {
+                let keys = self.keys.par_iter_mut().with_min_len(SEARCH_CHUNK);
+                keys.for_each(recell);
+            } else {
+                self.keys.iter_mut().for_each(recell);
             }
         } else {
-            self.keys.clear();
-            self.keys.extend(q.iter().enumerate().map(|(i, p)| {
+            let key = |(i, p): (usize, &Vec2<f64>)| {
                 let (cx, cy) = cell(p);
                 (cx, cy, i)
-            }));
+            };
+            self.keys.clear();
+            if parallel {
+                self.keys.par_extend(q.par_iter().enumerate().map(key));
+            } else {
+                self.keys.extend(q.iter().enumerate().map(key));
+            }
         }
         // With the cells of the last call, only the agents that changed cell are out of
         // order: insertion takes about linear time (keys are distinct, so every sort gives
         // the same order).
         let budget = 4 * self.keys.len();
         if self.sorted_h != h || !insertion_sort_within(&mut self.keys, budget) {
-            self.keys.sort_unstable();
+            if parallel {
+                self.keys.par_sort_unstable();
+            } else {
+                self.keys.sort_unstable();
+            }
         }
         self.sorted_h = h;
         let keys = &self.keys;
-        let mut best = (f64::INFINITY, 0, 0);
-        let mut consider = |i: usize, j: usize| {
-            let (a, b) = (i.min(j), i.max(j));
-            let d = (q[b] - q[a]).norm();
-            if d < best.0 || (d == best.0 && (a, b) < (best.1, best.2)) {
-                best = (d, a, b);
-            }
-        };
-        // Start of the next column's cells (cx + 1, ≥ cy − 1): only moves forward.
-        let mut next = 0;
-        for (k, &(cx, cy, i)) in keys.iter().enumerate() {
-            // Own column: this cell after agent i, and the cell above.
-            for &(ox, oy, j) in &keys[k + 1..] {
-                if ox != cx || oy > cy.saturating_add(1) {
-                    break;
-                }
-                consider(i, j);
-            }
-            // Next column: cells cy − 1 ..= cy + 1.
-            let (nx, lo, hi) = (
-                cx.saturating_add(1),
-                cy.saturating_sub(1),
-                cy.saturating_add(1),
-            );
-            while next < keys.len() && (keys[next].0, keys[next].1) < (nx, lo) {
-                next += 1;
-            }
-            for &(ox, oy, j) in &keys[next..] {
-                if ox != nx || oy > hi {
-                    break;
-                }
-                consider(i, j);
-            }
+        if !parallel {
+            return search_keys(keys, q, 0..keys.len());
         }
-        best
+        let runs = keys.len().div_ceil(SEARCH_CHUNK);
+        (0..runs)
+            .into_par_iter()
+            .map(|r| {
+                let end = ((r + 1) * SEARCH_CHUNK).min(keys.len());
+                search_keys(keys, q, r * SEARCH_CHUNK..end)
+            })
+            .reduce(|| NO_PAIR, least)
+    }
+}
+
+/// The closest pair of the keys in `run` (sorted `keys`) with the agents of their own and
+/// the next cells, as `(distance, i, j)`, `i < j`; [`NO_PAIR`] when no distance is a
+/// number.
+fn search_keys(
+    keys: &[(i64, i64, usize)],
+    q: &[Vec2<f64>],
+    run: core::ops::Range<usize>,
+) -> (f64, usize, usize) {
+    let mut best = NO_PAIR;
+    let mut consider = |i: usize, j: usize| {
+        let (a, b) = (i.min(j), i.max(j));
+        best = least(best, ((q[b] - q[a]).norm(), a, b));
+    };
+    let next_column = |(cx, cy): (i64, i64)| (cx.saturating_add(1), cy.saturating_sub(1));
+    // Start of the next column's cells (cx + 1, ≥ cy − 1) for the run's first key; it only
+    // moves forward, since the keys are sorted.
+    let mut next = keys.get(run.start).map_or(keys.len(), |&(cx, cy, _)| {
+        let from = next_column((cx, cy));
+        keys.partition_point(|&(x, y, _)| (x, y) < from)
+    });
+    for k in run {
+        let (cx, cy, i) = keys[k];
+        // Own column: this cell after agent i, and the cell above.
+        for &(ox, oy, j) in &keys[k + 1..] {
+            if ox != cx || oy > cy.saturating_add(1) {
+                break;
+            }
+            consider(i, j);
+        }
+        // Next column: cells cy − 1 ..= cy + 1.
+        let (nx, lo) = next_column((cx, cy));
+        let hi = cy.saturating_add(1);
+        while next < keys.len() && (keys[next].0, keys[next].1) < (nx, lo) {
+            next += 1;
+        }
+        for &(ox, oy, j) in &keys[next..] {
+            if ox != nx || oy > hi {
+                break;
+            }
+            consider(i, j);
+        }
+    }
+    best
+}
+
+/// The lesser of two pairs `(distance, i, j)`: the shorter distance, an equal one to the
+/// smaller `(i, j)`. A NaN distance is never the lesser of a pair with a number, so the
+/// least of many pairs does not depend on the order they are compared in.
+fn least(a: (f64, usize, usize), b: (f64, usize, usize)) -> (f64, usize, usize) {
+    if b.0 < a.0 || (b.0 == a.0 && (b.1, b.2) < (a.1, a.2)) {
+        b
+    } else {
+        a
     }
 }
 
@@ -153,13 +215,25 @@ fn insertion_sort_within<T: Ord + Copy>(v: &mut [T], budget: usize) -> bool {
 }
 
 /// The larger side of the bounding box of the finite agents (0 for none, so that the
-/// search stops at once).
-fn extent(q: &[Vec2<f64>]) -> f64 {
-    let (mut lo, mut hi) = (Vec2::repeat(f64::INFINITY), Vec2::repeat(f64::NEG_INFINITY));
-    for p in q.iter().filter(|p| p.x.is_finite() && p.y.is_finite()) {
-        lo = lo.inf(p);
-        hi = hi.sup(p);
-    }
+/// search stops at once). `parallel`: on every thread (minima and maxima are exact).
+fn extent(q: &[Vec2<f64>], parallel: bool) -> f64 {
+    type Bounds = (Vec2<f64>, Vec2<f64>);
+    let empty = || -> Bounds { (Vec2::repeat(f64::INFINITY), Vec2::repeat(f64::NEG_INFINITY)) };
+    let add = |(lo, hi): Bounds, p: &Vec2<f64>| -> Bounds {
+        if p.x.is_finite() && p.y.is_finite() {
+            (lo.inf(p), hi.sup(p))
+        } else {
+            (lo, hi)
+        }
+    };
+    let (lo, hi) = if parallel {
+        q.par_iter()
+            .with_min_len(SEARCH_CHUNK)
+            .fold(empty, add)
+            .reduce(empty, |a, b| (a.0.inf(&b.0), a.1.sup(&b.1)))
+    } else {
+        q.iter().fold(empty(), add)
+    };
     let side = (hi - lo).max();
     if side.is_finite() {
         side
@@ -254,6 +328,78 @@ mod tests {
             }
         }
         best
+    }
+
+    /// A formation large enough to be searched on every thread (runs of keys, each with
+    /// its own start in the next column, merged): on one, two and three threads the brute
+    /// force's answer, through small moves, a closest pair on either side of a cell column
+    /// (found from the next column, in a run in the middle), two closest pairs at exactly
+    /// the same distance (the smaller indices win, although the search meets the other
+    /// first), a lattice of ties, a coincident pair and a non-finite agent.
+    #[test]
+    fn a_parallel_search_gives_the_sequential_answer() {
+        let n = PARALLEL_MIN_AGENTS + 1500;
+        let scatter = |k: usize| {
+            let k = k as f64;
+            Vec2::new(
+                (k * 0.618_034).fract() * 90.0 - 45.0,
+                (k * 0.414_214).fract() * 60.0,
+            )
+        };
+        let mut q: Vec<Vec2<f64>> = (0..n).map(scatter).collect();
+        let pools: Vec<rayon::ThreadPool> = [1, 2, 3]
+            .iter()
+            .map(|&t| {
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(t)
+                    .build()
+                    .expect("a pool")
+            })
+            .collect();
+        let mut finders = vec![MinDistance::new(n); pools.len()];
+        let tiny = 2f64.powi(-10);
+        for round in 0..8 {
+            match round {
+                // Cells have an edge at x = 0 whatever their size.
+                2 => {
+                    q[1234] = Vec2::new(-1e-4, 7.3);
+                    q[4321] = Vec2::new(1e-4, 7.3);
+                }
+                3 => {
+                    q[1234] = scatter(1234);
+                    q[4321] = scatter(4321);
+                    // Exactly `tiny` apart, both; (10, 11) lies at the larger x.
+                    q[10] = Vec2::new(30.0, 1.0);
+                    q[11] = Vec2::new(30.0 + tiny, 1.0);
+                    q[5000] = Vec2::new(-30.0, 1.0);
+                    q[5001] = Vec2::new(-30.0 + tiny, 1.0);
+                }
+                // A lattice: every neighbour at exactly 0.5 m.
+                4 => q
+                    .iter_mut()
+                    .enumerate()
+                    .for_each(|(k, p)| *p = Vec2::new((k % 80) as f64, (k / 80) as f64) * 0.5),
+                5 => q[n - 1] = q[3],
+                6 => q[SEARCH_CHUNK + 7] = Vec2::new(f64::NAN, 0.0),
+                _ => q.iter_mut().enumerate().for_each(|(k, p)| {
+                    *p += Vec2::new(0.01 * (k as f64).sin(), 0.01 * (k as f64 * 1.3).cos());
+                }),
+            }
+            let expected = brute(&q);
+            match round {
+                2 => assert_eq!(expected, (2e-4, 1234, 4321)),
+                3 => assert_eq!(expected, (tiny, 10, 11)),
+                _ => {}
+            }
+            for (pool, md) in pools.iter().zip(&mut finders) {
+                let threads = pool.current_num_threads();
+                assert_eq!(
+                    pool.install(|| md.compute(&q)),
+                    expected,
+                    "round {round}, {threads} threads"
+                );
+            }
+        }
     }
 
     /// A lattice (columns share one x: the case a sweep along x is slow on), pushed around
