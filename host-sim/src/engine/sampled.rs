@@ -492,7 +492,8 @@ impl Engine for SampledSim<'_> {
     }
 
     fn take_error(&mut self) -> Option<HilError> {
-        if self.error.is_none() {
+        // A `LocalCore` never keeps a failure: no walk over 100,000 controllers per tick.
+        if self.error.is_none() && !self.local {
             self.error = self.controllers.iter_mut().find_map(|c| c.take_error());
         }
         self.error.take()
