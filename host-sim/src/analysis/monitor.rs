@@ -7,6 +7,7 @@ use super::shape_check::{folded_names, shape_check};
 use super::snapshot::{Diagnostics, Snapshot};
 use crate::model::Model;
 use controller_core::Vec2;
+use rayon::prelude::*;
 
 /// Watches the snapshots of a run for failures and keeps the run's extremes.
 #[derive(Clone, Debug)]
@@ -102,32 +103,18 @@ impl Monitor {
         }
         // The smallest estimate (`f64::min` ignores NaN: the order does not matter), and
         // the estimates held at `r_min` (each keeps the instant it reached it while held).
-        if let Some(&first) = est.first() {
-            let m = est.iter().fold(first, |m, &r| m.min(r));
+        let floor = model.min_estimate * (1.0 + 1e-12);
+        let watched = &est[..self.n_estimates.min(est.len())];
+        let (least, any_held) = scan_estimates(est, watched.len(), floor);
+        if let Some(m) = least {
             self.min_estimate = Some(self.min_estimate.map_or(m, |prev| prev.min(m)));
         }
-        let floor = model.min_estimate * (1.0 + 1e-12);
-        let mut before = self.held.iter().peekable();
-        let mut due = None;
-        self.held_next.clear();
-        for (k, &r) in est.iter().enumerate().take(self.n_estimates) {
-            let held = r <= floor;
-            if !held {
-                continue;
-            }
-            while before.next_if(|&&(j, _)| j < k).is_some() {}
-            match before.next_if(|&&(j, _)| j == k) {
-                Some(&(_, t0)) => {
-                    // Held since t0: collapsed once held for `collapse_time`.
-                    if due.is_none() && s.t - t0 >= cr.collapse_time {
-                        due = Some((k, t0));
-                    }
-                    self.held_next.push((k, t0));
-                }
-                None => self.held_next.push((k, s.t)),
-            }
-        }
-        std::mem::swap(&mut self.held, &mut self.held_next);
+        // Nothing held now nor before: the list stays empty without a walk.
+        let due = if any_held || !self.held.is_empty() {
+            self.update_held(watched, floor, s.t, cr.collapse_time)
+        } else {
+            None
+        };
         if let (Some((k, t0)), false) = (due, self.collapsed) {
             self.collapse(model, d, k, t0);
         }
@@ -178,6 +165,40 @@ impl Monitor {
             );
         }
         false
+    }
+
+    /// The estimates of `watched` held at `r_min` (at most `floor`) at instant `t`, each
+    /// with the instant it reached it (kept from the last instant while still held), and
+    /// the first one held for `collapse_time` or longer, as `(index, since)`.
+    fn update_held(
+        &mut self,
+        watched: &[f64],
+        floor: f64,
+        t: f64,
+        collapse_time: f64,
+    ) -> Option<(usize, f64)> {
+        let mut before = self.held.iter().peekable();
+        let mut due = None;
+        self.held_next.clear();
+        for (k, &r) in watched.iter().enumerate() {
+            let held = r <= floor;
+            if !held {
+                continue;
+            }
+            while before.next_if(|&&(j, _)| j < k).is_some() {}
+            match before.next_if(|&&(j, _)| j == k) {
+                Some(&(_, t0)) => {
+                    // Held since t0: collapsed once held for `collapse_time`.
+                    if due.is_none() && t - t0 >= collapse_time {
+                        due = Some((k, t0));
+                    }
+                    self.held_next.push((k, t0));
+                }
+                None => self.held_next.push((k, t)),
+            }
+        }
+        std::mem::swap(&mut self.held, &mut self.held_next);
+        due
     }
 
     /// Records the collapse of estimate `k`, held at `r_min` since `t0`.
@@ -330,4 +351,26 @@ impl Monitor {
             None => (Outcome::NotConverged, end),
         }
     }
+}
+
+/// Estimates from which [`scan_estimates`] runs on every thread of the current rayon pool.
+const PARALLEL_MIN_ESTIMATES: usize = 8192;
+
+/// The smallest of `est` (`None` when empty; `f64::min` ignores NaN, and estimates are
+/// positive, so the order of the comparisons does not matter) and whether any of the first
+/// `watched` is at most `floor`: one pass, on every thread for large formations.
+fn scan_estimates(est: &[f64], watched: usize, floor: f64) -> (Option<f64>, bool) {
+    let each = |(k, &r): (usize, &f64)| (r, k < watched && r <= floor);
+    let merge = |a: (f64, bool), b: (f64, bool)| (a.0.min(b.0), a.1 || b.1);
+    let parallel = est.len() >= PARALLEL_MIN_ESTIMATES && rayon::current_num_threads() > 1;
+    let scan = if parallel {
+        est.par_iter()
+            .enumerate()
+            .with_min_len(PARALLEL_MIN_ESTIMATES / 4)
+            .map(each)
+            .reduce_with(merge)
+    } else {
+        est.iter().enumerate().map(each).reduce(merge)
+    };
+    scan.map_or((None, false), |(m, held)| (Some(m), held))
 }
