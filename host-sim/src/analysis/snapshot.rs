@@ -155,14 +155,127 @@ impl Diagnostics {
         let v_star = Vec2::new(vs[0], vs[1]);
         let parallel =
             model.triangles.len() >= PARALLEL_MIN_TRIANGLES && rayon::current_num_threads() > 1;
-        let (v_kin, extremes) =
-            agent_terms(&mut self.kinetic, &self.masses, q, v, v_star, parallel);
-        s.v_kin = v_kin;
+        // Each set of independent terms goes into its scratch (on every thread for large
+        // formations); each sum is then taken in model order on one thread while the
+        // others compute the next set.
+        let extremes = agent_terms(&mut self.kinetic, &self.masses, q, v, v_star, parallel);
         s.vel_err = extremes.vel_err;
         s.max_speed = extremes.max_speed;
         s.finite = extremes.finite;
-        // Each angle's error and energy (independent: in parallel for large formations),
-        // then the sum and the maximum in model order.
+        let angles = AngleTerms {
+            triangles: &model.triangles,
+            cos_desired: &self.cos_desired,
+        };
+        let (v_kin, ()) = both(
+            parallel,
+            || in_order(&self.kinetic),
+            || angles.evaluate(q, &mut s.angle_err, &mut self.angle_energy, parallel),
+        );
+        s.v_kin = v_kin;
+        let ((v_ang, max_angle_err), ()) = both(
+            parallel,
+            || angle_sums(&s.angle_err, &self.angle_energy),
+            || {
+                estimate_terms(
+                    &mut self.est_energy,
+                    &self.edges,
+                    q,
+                    est,
+                    &mut s.est_true,
+                    parallel,
+                )
+            },
+        );
+        (s.v_ang, s.max_angle_err) = (v_ang, max_angle_err);
+        let (v_est, (d, i, j)) = both(
+            parallel,
+            || in_order(&self.est_energy),
+            || self.min_distance.compute(q),
+        );
+        s.v_est = v_est;
+        (s.min_dist, s.min_pair) = (d, (i, j));
+        s.v_lead = 0.0;
+        s.disp_err = 0.0;
+        if let (Some(l), Some(zs)) = (&model.leader, model.z_star(t)) {
+            let zt = q[l.a] - q[l.b] - Vec2::new(zs[0], zs[1]);
+            s.v_lead = energy::leader(l.stiffness, &zt);
+            s.disp_err = zt.norm();
+        }
+        s.v = s.v_kin + s.v_ang + s.v_lead + s.v_est;
+    }
+}
+
+/// `a` and `b`: at the same time on the current rayon pool when `parallel`, else one
+/// after the other.
+fn both<A: Send, B: Send>(
+    parallel: bool,
+    a: impl FnOnce() -> A + Send,
+    b: impl FnOnce() -> B + Send,
+) -> (A, B) {
+    if parallel {
+        rayon::join(a, b)
+    } else {
+        (a(), b())
+    }
+}
+
+/// The sum of `terms` in their order, from `+0`.
+fn in_order(terms: &[f64]) -> f64 {
+    let mut sum = 0.0;
+    for x in terms {
+        sum += x;
+    }
+    sum
+}
+
+/// Every agent's kinetic term `½ m |v − v*|²` (S13) into `scratch` (agent order), and the
+/// extremes of the speed error and speed. `parallel`: on every thread of the current rayon
+/// pool.
+fn agent_terms(
+    scratch: &mut [f64],
+    masses: &[f64],
+    q: &[Vec2<f64>],
+    v: &[Vec2<f64>],
+    v_star: Vec2<f64>,
+    parallel: bool,
+) -> AgentExtremes {
+    let terms = |slot: &mut f64, mass: f64, qi: &Vec2<f64>, vi: &Vec2<f64>| {
+        let finite = qi.x.is_finite() && qi.y.is_finite() && vi.x.is_finite() && vi.y.is_finite();
+        *slot = energy::kinetic(mass, vi, &v_star);
+        AgentExtremes {
+            vel_err: (vi - v_star).norm(),
+            max_speed: vi.norm(),
+            finite,
+        }
+    };
+    if !parallel {
+        let mut extremes = AgentExtremes::default();
+        for (((slot, &mass), qi), vi) in scratch.iter_mut().zip(masses).zip(q).zip(v) {
+            extremes = extremes.merge(terms(slot, mass, qi, vi));
+        }
+        return extremes;
+    }
+    scratch
+        .par_iter_mut()
+        .zip(masses)
+        .zip(q.par_iter().zip(v))
+        .with_min_len(CHUNK)
+        .map(|((slot, &mass), (qi, vi))| terms(slot, mass, qi, vi))
+        .reduce(AgentExtremes::default, AgentExtremes::merge)
+}
+
+/// What an instant's angle terms read of the model.
+struct AngleTerms<'a> {
+    triangles: &'a [TriangleModel],
+    /// `cos α*` of every angle, model order.
+    cos_desired: &'a [f64],
+}
+
+impl AngleTerms<'_> {
+    /// Each angle's error `α − α*` into `errs` and energy `½ c ỹ²` (S13) into `energies`,
+    /// model order. `parallel`: on every thread of the current rayon pool (the angles are
+    /// independent).
+    fn evaluate(&self, q: &[Vec2<f64>], errs: &mut [f64], energies: &mut [f64], parallel: bool) {
         type Out<'a> = (&'a mut [f64], (&'a mut [f64], &'a [f64]));
         let angles = |(tri, (err, (en, cos_desired))): (&TriangleModel, Out<'_>)| {
             let each = tri.angles.iter().zip(err).zip(en).zip(cos_desired);
@@ -174,105 +287,42 @@ impl Diagnostics {
                 *err = y.clamp(-1.0, 1.0).acos() - a.desired;
             }
         };
-        let (errs, energies, cosines) =
-            (&mut s.angle_err, &mut self.angle_energy, &self.cos_desired);
         if parallel {
-            let per_angle = energies.par_chunks_mut(2).zip(cosines.par_chunks(2));
-            model
-                .triangles
+            let per_angle = energies
+                .par_chunks_mut(2)
+                .zip(self.cos_desired.par_chunks(2));
+            self.triangles
                 .par_iter()
                 .zip(errs.par_chunks_mut(2).zip(per_angle))
                 .with_min_len(CHUNK)
                 .for_each(angles);
         } else {
-            let per_angle = energies.chunks_mut(2).zip(cosines.chunks(2));
-            model
-                .triangles
+            let per_angle = energies.chunks_mut(2).zip(self.cos_desired.chunks(2));
+            self.triangles
                 .iter()
                 .zip(errs.chunks_mut(2).zip(per_angle))
                 .for_each(angles);
         }
-        s.v_ang = 0.0;
-        s.max_angle_err = 0.0;
-        for (err, en) in s.angle_err.iter().zip(&self.angle_energy) {
-            s.v_ang += en;
-            // NaN propagates as "not settled".
-            s.max_angle_err = if err.is_nan() {
-                f64::NAN
-            } else {
-                s.max_angle_err.max(err.abs())
-            };
-        }
-        s.v_lead = 0.0;
-        s.disp_err = 0.0;
-        if let (Some(l), Some(zs)) = (&model.leader, model.z_star(t)) {
-            let zt = q[l.a] - q[l.b] - Vec2::new(zs[0], zs[1]);
-            s.v_lead = energy::leader(l.stiffness, &zt);
-            s.disp_err = zt.norm();
-        }
-        s.v_est = estimate_terms(
-            &mut self.est_energy,
-            &self.edges,
-            q,
-            est,
-            &mut s.est_true,
-            parallel,
-        );
-        s.v = s.v_kin + s.v_ang + s.v_lead + s.v_est;
-        let (d, i, j) = self.min_distance.compute(q);
-        s.min_dist = d;
-        s.min_pair = (i, j);
     }
 }
 
-/// Every agent's kinetic term `½ m |v − v*|²` (S13), speed error and speed: `V_kin` summed
-/// in agent order, and the extremes. `parallel`: the terms on every thread of the current
-/// rayon pool into `scratch`, then the same sum.
-fn agent_terms(
-    scratch: &mut [f64],
-    masses: &[f64],
-    q: &[Vec2<f64>],
-    v: &[Vec2<f64>],
-    v_star: Vec2<f64>,
-    parallel: bool,
-) -> (f64, AgentExtremes) {
-    let terms = |mass: f64, qi: &Vec2<f64>, vi: &Vec2<f64>| {
-        let finite = qi.x.is_finite() && qi.y.is_finite() && vi.x.is_finite() && vi.y.is_finite();
-        let extremes = AgentExtremes {
-            vel_err: (vi - v_star).norm(),
-            max_speed: vi.norm(),
-            finite,
+/// `V_ang`, the angle energies summed in model order, and `max |α − α*|` (NaN when an
+/// error is NaN: "not settled").
+fn angle_sums(errs: &[f64], energies: &[f64]) -> (f64, f64) {
+    let (mut v_ang, mut max_err) = (0.0, 0.0_f64);
+    for (err, en) in errs.iter().zip(energies) {
+        v_ang += en;
+        max_err = if err.is_nan() {
+            f64::NAN
+        } else {
+            max_err.max(err.abs())
         };
-        (energy::kinetic(mass, vi, &v_star), extremes)
-    };
-    if !parallel {
-        let mut sum = (0.0, AgentExtremes::default());
-        for ((&mass, qi), vi) in masses.iter().zip(q).zip(v) {
-            let (kin, e) = terms(mass, qi, vi);
-            sum = (sum.0 + kin, sum.1.merge(e));
-        }
-        return sum;
     }
-    let extremes = scratch
-        .par_iter_mut()
-        .zip(masses)
-        .zip(q.par_iter().zip(v))
-        .with_min_len(CHUNK)
-        .map(|((slot, &mass), (qi, vi))| {
-            let (kin, e) = terms(mass, qi, vi);
-            *slot = kin;
-            e
-        })
-        .reduce(AgentExtremes::default, AgentExtremes::merge);
-    let mut v_kin = 0.0;
-    for kin in scratch.iter() {
-        v_kin += kin;
-    }
-    (v_kin, extremes)
+    (v_ang, max_err)
 }
 
-/// Every estimate's true distance (into `est_true`) and term `½ c_e (r̂ − r)²` (S13):
-/// `V_est` summed in layout order. `parallel`: as [`agent_terms`].
+/// Every estimate's true distance (into `est_true`) and term `½ c_e (r̂ − r)²` (S13, into
+/// `scratch`), layout order. `parallel`: as [`agent_terms`].
 fn estimate_terms(
     scratch: &mut [f64],
     edges: &[(usize, usize, f64)],
@@ -280,17 +330,17 @@ fn estimate_terms(
     est: &[f64],
     est_true: &mut [f64],
     parallel: bool,
-) -> f64 {
+) {
     let term = |&(apex, far, gain): &(usize, usize, f64), r_hat: f64, r_true: &mut f64| {
         *r_true = (q[apex] - q[far]).norm();
         energy::estimate(gain, r_hat, *r_true)
     };
-    let mut v_est = 0.0;
     if !parallel {
-        for ((edge, &r_hat), r_true) in edges.iter().zip(est).zip(est_true) {
-            v_est += term(edge, r_hat, r_true);
+        let each = edges.iter().zip(est).zip(est_true.iter_mut().zip(scratch));
+        for ((edge, &r_hat), (r_true, slot)) in each {
+            *slot = term(edge, r_hat, r_true);
         }
-        return v_est;
+        return;
     }
     edges
         .par_iter()
@@ -298,8 +348,4 @@ fn estimate_terms(
         .zip(est_true.par_iter_mut().zip(scratch.par_iter_mut()))
         .with_min_len(CHUNK)
         .for_each(|((edge, &r_hat), (r_true, slot))| *slot = term(edge, r_hat, r_true));
-    for en in scratch.iter() {
-        v_est += en;
-    }
-    v_est
 }
