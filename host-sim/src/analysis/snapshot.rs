@@ -158,7 +158,8 @@ impl Diagnostics {
         // Each set of independent terms goes into its scratch (on every thread for large
         // formations); each sum is then taken in model order on one thread while the
         // others compute the next set.
-        let extremes = agent_terms(&mut self.kinetic, &self.masses, q, v, v_star, parallel);
+        let (extremes, agents) =
+            agent_terms(&mut self.kinetic, &self.masses, q, v, v_star, parallel);
         s.vel_err = extremes.vel_err;
         s.max_speed = extremes.max_speed;
         s.finite = extremes.finite;
@@ -168,11 +169,11 @@ impl Diagnostics {
         };
         let (v_kin, ()) = both(
             parallel,
-            || in_order(&self.kinetic),
+            || in_order(&self.kinetic[..agents]),
             || angles.evaluate(q, &mut s.angle_err, &mut self.angle_energy, parallel),
         );
         s.v_kin = v_kin;
-        let ((v_ang, max_angle_err), ()) = both(
+        let ((v_ang, max_angle_err), estimates) = both(
             parallel,
             || angle_sums(&s.angle_err, &self.angle_energy),
             || {
@@ -189,7 +190,7 @@ impl Diagnostics {
         (s.v_ang, s.max_angle_err) = (v_ang, max_angle_err);
         let (v_est, (d, i, j)) = both(
             parallel,
-            || in_order(&self.est_energy),
+            || in_order(&self.est_energy[..estimates]),
             || self.min_distance.compute(q),
         );
         s.v_est = v_est;
@@ -228,9 +229,10 @@ fn in_order(terms: &[f64]) -> f64 {
     sum
 }
 
-/// Every agent's kinetic term `½ m |v − v*|²` (S13) into `scratch` (agent order), and the
-/// extremes of the speed error and speed. `parallel`: on every thread of the current rayon
-/// pool.
+/// Every agent's kinetic term `½ m |v − v*|²` (S13) into `scratch` (agent order), the
+/// extremes of the speed error and speed, and how many terms were written (the agents that
+/// have a mass, a position and a velocity: only those are summed). `parallel`: on every
+/// thread of the current rayon pool.
 fn agent_terms(
     scratch: &mut [f64],
     masses: &[f64],
@@ -238,7 +240,7 @@ fn agent_terms(
     v: &[Vec2<f64>],
     v_star: Vec2<f64>,
     parallel: bool,
-) -> AgentExtremes {
+) -> (AgentExtremes, usize) {
     let terms = |slot: &mut f64, mass: f64, qi: &Vec2<f64>, vi: &Vec2<f64>| {
         let finite = qi.x.is_finite() && qi.y.is_finite() && vi.x.is_finite() && vi.y.is_finite();
         *slot = energy::kinetic(mass, vi, &v_star);
@@ -248,20 +250,22 @@ fn agent_terms(
             finite,
         }
     };
+    let written = scratch.len().min(masses.len()).min(q.len()).min(v.len());
     if !parallel {
         let mut extremes = AgentExtremes::default();
         for (((slot, &mass), qi), vi) in scratch.iter_mut().zip(masses).zip(q).zip(v) {
             extremes = extremes.merge(terms(slot, mass, qi, vi));
         }
-        return extremes;
+        return (extremes, written);
     }
-    scratch
+    let extremes = scratch
         .par_iter_mut()
         .zip(masses)
         .zip(q.par_iter().zip(v))
         .with_min_len(CHUNK)
         .map(|((slot, &mass), (qi, vi))| terms(slot, mass, qi, vi))
-        .reduce(AgentExtremes::default, AgentExtremes::merge)
+        .reduce(AgentExtremes::default, AgentExtremes::merge);
+    (extremes, written)
 }
 
 /// What an instant's angle terms read of the model.
@@ -322,7 +326,8 @@ fn angle_sums(errs: &[f64], energies: &[f64]) -> (f64, f64) {
 }
 
 /// Every estimate's true distance (into `est_true`) and term `½ c_e (r̂ − r)²` (S13, into
-/// `scratch`), layout order. `parallel`: as [`agent_terms`].
+/// `scratch`), layout order, and how many terms were written (the estimates that have a
+/// value: only those are summed). `parallel`: as [`agent_terms`].
 fn estimate_terms(
     scratch: &mut [f64],
     edges: &[(usize, usize, f64)],
@@ -330,17 +335,22 @@ fn estimate_terms(
     est: &[f64],
     est_true: &mut [f64],
     parallel: bool,
-) {
+) -> usize {
     let term = |&(apex, far, gain): &(usize, usize, f64), r_hat: f64, r_true: &mut f64| {
         *r_true = (q[apex] - q[far]).norm();
         energy::estimate(gain, r_hat, *r_true)
     };
+    let written = edges
+        .len()
+        .min(est.len())
+        .min(est_true.len())
+        .min(scratch.len());
     if !parallel {
         let each = edges.iter().zip(est).zip(est_true.iter_mut().zip(scratch));
         for ((edge, &r_hat), (r_true, slot)) in each {
             *slot = term(edge, r_hat, r_true);
         }
-        return;
+        return written;
     }
     edges
         .par_iter()
@@ -348,4 +358,5 @@ fn estimate_terms(
         .zip(est_true.par_iter_mut().zip(scratch.par_iter_mut()))
         .with_min_len(CHUNK)
         .for_each(|((edge, &r_hat), (r_true, slot))| *slot = term(edge, r_hat, r_true));
+    written
 }
