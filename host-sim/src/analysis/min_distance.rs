@@ -167,8 +167,12 @@ fn search_keys(
             }
             consider(i, j);
         }
-        // Next column: cells cy − 1 ..= cy + 1.
+        // Next column: cells cy − 1 ..= cy + 1 (none when the column saturated at
+        // `i64::MAX`: `nx` would be this very column, agent i included).
         let (nx, lo) = next_column((cx, cy));
+        if nx == cx {
+            continue;
+        }
         let hi = cy.saturating_add(1);
         while next < keys.len() && (keys[next].0, keys[next].1) < (nx, lo) {
             next += 1;
@@ -400,6 +404,23 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// An agent so far away that its cell column saturates at `i64::MAX` has no next
+    /// column: it is never compared with itself (a distance 0 that would read as a
+    /// collision).
+    #[test]
+    fn a_saturated_cell_is_not_its_own_neighbour() {
+        let mut md = MinDistance::new(0);
+        let mut q: Vec<Vec2<f64>> = (0..100)
+            .map(|k| Vec2::new(f64::from(k % 10), f64::from(k / 10)))
+            .collect();
+        assert_eq!(md.compute(&q), brute(&q));
+        q.iter_mut().for_each(|p| *p += Vec2::repeat(0.1));
+        q[50] = Vec2::new(1e20, 3.0);
+        let (d, i, j) = md.compute(&q);
+        assert!(i < j, "({d}, {i}, {j})");
+        assert_eq!((d, i, j), brute(&q));
     }
 
     /// A lattice (columns share one x: the case a sweep along x is slow on), pushed around
