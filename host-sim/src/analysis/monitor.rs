@@ -356,9 +356,11 @@ impl Monitor {
 /// Estimates from which [`scan_estimates`] runs on every thread of the current rayon pool.
 const PARALLEL_MIN_ESTIMATES: usize = 8192;
 
-/// The smallest of `est` (`None` when empty; `f64::min` ignores NaN, and estimates are
-/// positive, so the order of the comparisons does not matter) and whether any of the first
-/// `watched` is at most `floor`: one pass, on every thread for large formations.
+/// The smallest of `est` (`None` when empty) and whether any of the first `watched` is at
+/// most `floor`: one pass, on every thread for large formations. `f64::min` ignores NaN
+/// and keeps its first operand on a tie (`+0` against `−0`), and rayon's reduction keeps
+/// the order of the elements, so the answer is the sequential fold's on any number of
+/// threads.
 fn scan_estimates(est: &[f64], watched: usize, floor: f64) -> (Option<f64>, bool) {
     let each = |(k, &r): (usize, &f64)| (r, k < watched && r <= floor);
     let merge = |a: (f64, bool), b: (f64, bool)| (a.0.min(b.0), a.1 || b.1);
