@@ -16,11 +16,11 @@ use rayon::prelude::*;
 /// them by insertion takes about linear time. Equal distances go to the smallest pair
 /// `(i, j)`, whatever the order of the search.
 ///
-/// From [`PARALLEL_MIN_AGENTS`] agents on, and when the current rayon pool has more than
-/// one thread, the cells, the extent and the search run on every thread (the search in
-/// runs of [`SEARCH_CHUNK`] keys): the closest pair is the least `(distance, i, j)`, which
-/// does not depend on the order it is found in, so the answer is the same on any number of
-/// threads.
+/// From `PARALLEL_MIN_AGENTS` (4,096) agents on, and when the current rayon pool has more
+/// than one thread, the cells, the extent and the search run on every thread (the search in
+/// runs of `SEARCH_CHUNK` (2,048) keys): the closest pair is the least `(distance, i, j)`,
+/// which does not depend on the order it is found in, so the answer is the same on any
+/// number of threads.
 #[derive(Clone, Debug, Default)]
 pub struct MinDistance {
     /// Cell size of the next call (0: not known yet).
