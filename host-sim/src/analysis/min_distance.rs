@@ -16,11 +16,11 @@ use rayon::prelude::*;
 /// them by insertion takes about linear time. Equal distances go to the smallest pair
 /// `(i, j)`, whatever the order of the search.
 ///
-/// From `PARALLEL_MIN_AGENTS` (4,096) agents on, and when the current rayon pool has more
-/// than one thread, the cells, the extent and the search run on every thread (the search in
-/// runs of `SEARCH_CHUNK` (2,048) keys): the closest pair is the least `(distance, i, j)`,
-/// which does not depend on the order it is found in, so the answer is the same on any
-/// number of threads.
+/// When the caller asks (the diagnostics of a large formation), the cells, the extent and
+/// the search run on every thread of the current rayon pool (the search in runs of
+/// `SEARCH_CHUNK` (2,048) keys): the closest pair is the least `(distance, i, j)`, which
+/// does not depend on the order it is found in, so the answer is the same on any number of
+/// threads.
 #[derive(Clone, Debug, Default)]
 pub struct MinDistance {
     /// Cell size of the next call (0: not known yet).
@@ -34,9 +34,6 @@ pub struct MinDistance {
 /// The smallest cell size the grid uses (m): coincident agents would otherwise shrink it
 /// to zero.
 const MIN_CELL: f64 = 1e-6;
-
-/// Agents from which a call works on every thread of the current rayon pool.
-pub const PARALLEL_MIN_AGENTS: usize = 4096;
 
 /// Keys per task of a parallel search (and agents per task for the cells and the extent).
 const SEARCH_CHUNK: usize = 2048;
@@ -55,13 +52,13 @@ impl MinDistance {
     }
 
     /// `(distance, i, j)` of the closest pair, `i < j` (`inf` with fewer than two agents
-    /// or when no distance is a number).
-    pub fn compute(&mut self, q: &[Vec2<f64>]) -> (f64, usize, usize) {
+    /// or when no distance is a number). `parallel`: on every thread of the current rayon
+    /// pool (the same answer).
+    pub fn compute(&mut self, q: &[Vec2<f64>], parallel: bool) -> (f64, usize, usize) {
         let none = NO_PAIR;
         if q.len() < 2 {
             return none;
         }
-        let parallel = q.len() >= PARALLEL_MIN_AGENTS && rayon::current_num_threads() > 1;
         let side = extent(q, parallel);
         let mut h = self.h;
         if !(h.is_finite() && h >= MIN_CELL) {
@@ -266,8 +263,8 @@ mod tests {
                     best = best.min((q[i] - q[j]).norm());
                 }
             }
-            assert_eq!(md.compute(&q).0, best, "round {round}");
-            assert_eq!(brute(&q), md.compute(&q), "round {round}");
+            assert_eq!(md.compute(&q, false).0, best, "round {round}");
+            assert_eq!(brute(&q), md.compute(&q, false), "round {round}");
             for p in &mut q {
                 p.x += 0.3 * p.y.sin();
             }
@@ -296,7 +293,7 @@ mod tests {
             if round >= 30 {
                 q.iter_mut().for_each(|p| *p *= 0.8);
             }
-            assert_eq!(md.compute(&q), brute(&q), "round {round}");
+            assert_eq!(md.compute(&q, false), brute(&q), "round {round}");
         }
     }
 
@@ -342,7 +339,7 @@ mod tests {
     /// first), a lattice of ties, a coincident pair and a non-finite agent.
     #[test]
     fn a_parallel_search_gives_the_sequential_answer() {
-        let n = PARALLEL_MIN_AGENTS + 1500;
+        let n = 2 * SEARCH_CHUNK + 1500;
         let scatter = |k: usize| {
             let k = k as f64;
             Vec2::new(
@@ -398,7 +395,7 @@ mod tests {
             for (pool, md) in pools.iter().zip(&mut finders) {
                 let threads = pool.current_num_threads();
                 assert_eq!(
-                    pool.install(|| md.compute(&q)),
+                    pool.install(|| md.compute(&q, true)),
                     expected,
                     "round {round}, {threads} threads"
                 );
@@ -415,10 +412,10 @@ mod tests {
         let mut q: Vec<Vec2<f64>> = (0..100)
             .map(|k| Vec2::new(f64::from(k % 10), f64::from(k / 10)))
             .collect();
-        assert_eq!(md.compute(&q), brute(&q));
+        assert_eq!(md.compute(&q, false), brute(&q));
         q.iter_mut().for_each(|p| *p += Vec2::repeat(0.1));
         q[50] = Vec2::new(1e20, 3.0);
-        let (d, i, j) = md.compute(&q);
+        let (d, i, j) = md.compute(&q, false);
         assert!(i < j, "({d}, {i}, {j})");
         assert_eq!((d, i, j), brute(&q));
     }
@@ -432,29 +429,29 @@ mod tests {
         let mut q: Vec<Vec2<f64>> = (0..400)
             .map(|k| Vec2::new(f64::from(k % 20), f64::from(k / 20)))
             .collect();
-        assert_eq!(md.compute(&q), brute(&q));
-        assert_eq!(md.compute(&q), (1.0, 0, 1));
+        assert_eq!(md.compute(&q, false), brute(&q));
+        assert_eq!(md.compute(&q, false), (1.0, 0, 1));
         for p in &mut q {
             *p *= 7.0;
         }
-        assert_eq!(md.compute(&q), brute(&q));
+        assert_eq!(md.compute(&q, false), brute(&q));
         q[399] = q[398] + Vec2::new(0.01, 0.0);
         assert_eq!(
-            md.compute(&q),
+            md.compute(&q, false),
             (0.01_f64.max((q[399] - q[398]).norm()), 398, 399)
         );
         q[5] = q[6];
-        assert_eq!(md.compute(&q), (0.0, 5, 6));
+        assert_eq!(md.compute(&q, false), (0.0, 5, 6));
         for (k, p) in q.iter_mut().enumerate() {
             *p *= 3.0 + (k as f64 * 0.37).sin();
         }
-        assert_eq!(md.compute(&q), brute(&q));
+        assert_eq!(md.compute(&q, false), brute(&q));
         // Fewer agents than the last call, then all of them again.
-        assert_eq!(md.compute(&q[..57]), brute(&q[..57]));
-        assert_eq!(md.compute(&q), brute(&q));
+        assert_eq!(md.compute(&q[..57], false), brute(&q[..57]));
+        assert_eq!(md.compute(&q, false), brute(&q));
         q[7] = Vec2::new(f64::NAN, 1.0);
-        let (d, i, j) = md.compute(&q);
+        let (d, i, j) = md.compute(&q, false);
         assert!(d.is_finite() && i != 7 && j != 7);
-        assert_eq!(md.compute(&[Vec2::zeros()]).0, f64::INFINITY);
+        assert_eq!(md.compute(&[Vec2::zeros()], false).0, f64::INFINITY);
     }
 }

@@ -105,7 +105,7 @@ impl Monitor {
         // the estimates held at `r_min` (each keeps the instant it reached it while held).
         let floor = model.min_estimate * (1.0 + 1e-12);
         let watched = &est[..self.n_estimates.min(est.len())];
-        let (least, any_held) = scan_estimates(est, watched.len(), floor);
+        let (least, any_held) = scan_estimates(est, watched.len(), floor, d.parallel());
         if let Some(m) = least {
             self.min_estimate = Some(self.min_estimate.map_or(m, |prev| prev.min(m)));
         }
@@ -353,22 +353,22 @@ impl Monitor {
     }
 }
 
-/// Estimates from which [`scan_estimates`] runs on every thread of the current rayon pool.
-const PARALLEL_MIN_ESTIMATES: usize = 8192;
+/// Estimates per parallel work item of [`scan_estimates`].
+const CHUNK: usize = 2048;
 
 /// The smallest of `est` (`None` when empty) and whether any of the first `watched` is at
-/// most `floor`: one pass, on every thread for large formations. `f64::min` ignores NaN
+/// most `floor`: one pass, on every thread of the current rayon pool when `parallel` (as
+/// the diagnostics of the instant were). `f64::min` ignores NaN
 /// and keeps its first operand on a tie (`+0` against `−0`), and rayon's reduction keeps
 /// the order of the elements, so the answer is the sequential fold's on any number of
 /// threads.
-fn scan_estimates(est: &[f64], watched: usize, floor: f64) -> (Option<f64>, bool) {
+fn scan_estimates(est: &[f64], watched: usize, floor: f64, parallel: bool) -> (Option<f64>, bool) {
     let each = |(k, &r): (usize, &f64)| (r, k < watched && r <= floor);
     let merge = |a: (f64, bool), b: (f64, bool)| (a.0.min(b.0), a.1 || b.1);
-    let parallel = est.len() >= PARALLEL_MIN_ESTIMATES && rayon::current_num_threads() > 1;
     let scan = if parallel {
         est.par_iter()
             .enumerate()
-            .with_min_len(PARALLEL_MIN_ESTIMATES / 4)
+            .with_min_len(CHUNK)
             .map(each)
             .reduce_with(merge)
     } else {

@@ -71,6 +71,8 @@ pub struct Diagnostics {
     kinetic: Vec<f64>,
     /// Scratch: every estimate's term `½ c_e (r̂ − r)²`, layout order.
     est_energy: Vec<f64>,
+    /// See [`Diagnostics::parallel`].
+    parallel: bool,
 }
 
 /// The speed extremes of some agents, and whether their state is finite.
@@ -127,6 +129,7 @@ impl Diagnostics {
             edges: estimates.iter().map(|e| (e.apex, e.far, e.gain)).collect(),
             kinetic: vec![0.0; model.n()],
             est_energy: vec![0.0; estimates.len()],
+            parallel: false,
             estimates,
             snap,
             min_distance: MinDistance::new(model.n()),
@@ -191,7 +194,7 @@ impl Diagnostics {
         let (v_est, (d, i, j)) = both(
             parallel,
             || in_order(&self.est_energy[..estimates]),
-            || self.min_distance.compute(q),
+            || self.min_distance.compute(q, parallel),
         );
         s.v_est = v_est;
         (s.min_dist, s.min_pair) = (d, (i, j));
@@ -203,6 +206,13 @@ impl Diagnostics {
             s.disp_err = zt.norm();
         }
         s.v = s.v_kin + s.v_ang + s.v_lead + s.v_est;
+        self.parallel = parallel;
+    }
+
+    /// The last [`Self::evaluate`] ran on every thread of the current rayon pool (a large
+    /// formation, more than one thread): whoever reads the same instant may too.
+    pub fn parallel(&self) -> bool {
+        self.parallel
     }
 }
 

@@ -324,8 +324,8 @@ impl SampledSim<'_> {
         }
     }
 
-    /// Copies agent `i`'s current estimates into `estimates` (field by field, like
-    /// [`Scene::of`]).
+    /// Copies agent `i`'s current estimates into its slots of `estimates`
+    /// (`est_start[i]..est_start[i + 1]`).
     fn read_estimates_of(
         controller: &dyn AgentController,
         estimates: &mut [f64],
