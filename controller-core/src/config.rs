@@ -28,6 +28,69 @@ pub enum EstimatorMode {
     Measured,
 }
 
+/// How the agent turns successive bearings into the bearing and the bearing rate the law
+/// uses (SPEC §2, §11). A bearing measured with its rate (an optical-flow sensor) is used
+/// as it is in either mode.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum BearingFilter<T> {
+    /// The finite difference of two successive bearings (SPEC §2): exact in the limit of
+    /// noise-free bearings, but it turns 1° of noise at 100 Hz into about 140°/s of rate.
+    FiniteDifference,
+    /// The bearing tracker of SPEC §11 (S15–S17), one per sensed neighbour.
+    Tracker(TrackerConfig<T>),
+}
+
+impl<T: Real> Default for BearingFilter<T> {
+    /// The tracker with [`TrackerConfig::default`]: what works on real sensors.
+    fn default() -> Self {
+        Self::Tracker(TrackerConfig::default())
+    }
+}
+
+/// The settings of the bearing tracker (SPEC §11, S15–S17).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct TrackerConfig<T> {
+    /// `σ_b > 0`: standard deviation of the bearing noise (rad); `R = σ_b²` in S16.
+    pub bearing_noise: T,
+    /// `σ_ω ≥ 0`: the bearing rate the kinematic model cannot explain (stale neighbour
+    /// velocity, own velocity noise), as white noise of density `σ_ω²` (rad²/s) in S15.
+    pub rate_noise: T,
+    /// `σ_ρ ≥ 0`: random walk of the inverse distance, density `σ_ρ²` (1/(m² s)) in S15.
+    pub inverse_range_noise: T,
+    /// `g > 0`: a bearing whose innovation exceeds `g` standard deviations is an outlier
+    /// and is not used (S16); three in a row restart the track.
+    pub gate: T,
+}
+
+impl<T: Real> Default for TrackerConfig<T> {
+    /// A camera-grade bearing sensor: `σ_b = 2°`, `σ_ω = 5·10⁻⁴ rad/√s`,
+    /// `σ_ρ = 0.05 /(m √s)`, gate 5σ (docs/sensors.md).
+    fn default() -> Self {
+        Self {
+            bearing_noise: T::lit(0.034_906_585_039_886_59), // 2°
+            rate_noise: T::lit(5.0e-4),
+            inverse_range_noise: T::lit(0.05),
+            gate: T::lit(5.0),
+        }
+    }
+}
+
+impl<T: Real> TrackerConfig<T> {
+    /// Every setting finite and in range: `0 < σ_b ≤ 0.5 rad`, `0 ≤ σ_ω ≤ 100`,
+    /// `0 ≤ σ_ρ ≤ 100`, `1 ≤ g ≤ 1000`.
+    pub fn is_valid(&self) -> bool {
+        let within = |x: T, lo: T, hi: T| x.finite() && x >= lo && x <= hi;
+        self.bearing_noise.finite()
+            && self.bearing_noise > T::zero()
+            && self.bearing_noise <= T::lit(0.5)
+            && within(self.rate_noise, T::zero(), T::lit(100.0))
+            && within(self.inverse_range_noise, T::zero(), T::lit(100.0))
+            && within(self.gate, T::one(), T::lit(1000.0))
+    }
+}
+
 /// One controlled angle `α = (apex; v, w)` of a triangle.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -196,6 +259,8 @@ pub struct AgentConfig<T, const MT: usize> {
     pub leader: Option<LeaderConfig<T>>,
     /// Safety limits.
     pub limits: Limits<T>,
+    /// How bearings become the bearing and rate the law uses (SPEC §11).
+    pub bearing_filter: BearingFilter<T>,
     /// How frames are protected ([`Integrity`]); the same for every agent of a swarm.
     pub integrity: Integrity,
     /// Broadcast every `comm_every`-th control step (`≥ 1`; 1 = every step). The agent
@@ -222,6 +287,7 @@ impl<T: Real, const MT: usize> AgentConfig<T, MT> {
             velocity_reference: Schedule::default(),
             leader: None,
             limits: Limits::default(),
+            bearing_filter: BearingFilter::default(),
             integrity: Integrity::Crc16,
             comm_every: 1,
             comm_phase: 0,
@@ -274,6 +340,9 @@ pub enum ConfigError {
     BadCommRate,
     /// The leader partner is this agent itself.
     BadLeader,
+    /// A bearing tracker setting is not finite or out of range
+    /// ([`TrackerConfig::is_valid`]).
+    BadBearingFilter,
 }
 
 impl core::fmt::Display for ConfigError {
@@ -290,6 +359,7 @@ impl core::fmt::Display for ConfigError {
             Self::BadSchedule => write!(f, "a schedule has a non-finite entry or times that do not strictly increase"),
             Self::BadCommRate => write!(f, "comm_every is 0 or comm_phase is not below comm_every"),
             Self::BadLeader => write!(f, "the leader partner is the agent itself"),
+            Self::BadBearingFilter => write!(f, "a bearing tracker setting is not finite or out of range"),
         }
     }
 }

@@ -42,6 +42,7 @@ pub mod law;
 pub mod link;
 pub mod scalar;
 pub mod stats;
+pub mod tracker;
 pub mod wire;
 
 pub use agent::{
@@ -49,8 +50,9 @@ pub use agent::{
     Status, StepOutput,
 };
 pub use config::{
-    AgentConfig, AgentId, AngleConfig, ConfigError, EstimatorMode, Integrity, LeaderConfig,
-    LeaderRole, Limits, Schedule, ScheduleStep, TriangleConfig, MAX_SCHEDULE_STEPS,
+    AgentConfig, AgentId, AngleConfig, BearingFilter, ConfigError, EstimatorMode, Integrity, LeaderConfig,
+    LeaderRole, Limits, Schedule, ScheduleStep, TrackerConfig, TriangleConfig,
+    MAX_SCHEDULE_STEPS,
 };
 pub use scalar::Real;
 pub use stats::FrameStats;

@@ -5,7 +5,7 @@
 //! to a core configuration type is a compile error here until it is mapped.
 
 use controller_core::{
-    AgentConfig, AngleConfig, EstimatorMode, Integrity, LeaderConfig, LeaderRole, Limits, Schedule,
+    AgentConfig, AngleConfig, BearingFilter, EstimatorMode, TrackerConfig, Integrity, LeaderConfig, LeaderRole, Limits, Schedule,
     ScheduleStep, SwarmKey, TriangleConfig,
 };
 
@@ -37,6 +37,33 @@ pub enum ph_integrity {
     /// protection (see `docs/core.md`, "auth"); call `ph_agent_set_boot_epoch` after
     /// `ph_agent_init*`.
     PH_INTEGRITY_AUTH = 2,
+}
+
+/// How the agent filters its bearings (values of `ph_bearing_filter.kind`; SPEC §11).
+#[repr(u8)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ph_filter_kind {
+    /// The bearing tracker (S15–S17) with the settings of `ph_bearing_filter`. Default.
+    PH_FILTER_TRACKER = 0,
+    /// The finite difference of successive bearings (SPEC §2); the settings are unused
+    /// and must be zero.
+    PH_FILTER_FINITE_DIFFERENCE = 1,
+}
+
+/// The bearing filter (SPEC §11): `kind` is a `ph_filter_kind`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ph_bearing_filter {
+    /// A `ph_filter_kind`.
+    pub kind: u8,
+    /// `σ_b > 0`: the bearing noise (rad), at most 0.5.
+    pub bearing_noise: f32,
+    /// `σ_ω ≥ 0`: unmodelled bearing rate (rad/√s).
+    pub rate_noise: f32,
+    /// `σ_ρ ≥ 0`: random walk of the inverse distance (1/(m √s)).
+    pub inverse_range_noise: f32,
+    /// Innovation gate in standard deviations, in `[1, 1000]`.
+    pub gate: f32,
 }
 
 /// Which end of the leader edge an agent is (values of `ph_leader.role`; S11 with
@@ -159,6 +186,8 @@ pub struct ph_config {
     pub leader: ph_leader,
     /// Safety limits.
     pub limits: ph_limits,
+    /// The bearing filter (SPEC §11).
+    pub bearing_filter: ph_bearing_filter,
     /// A `ph_integrity`.
     pub integrity: u8,
     /// Broadcast every `comm_every`-th step (≥ 1).
@@ -319,6 +348,53 @@ fn limits_from_core(l: &Limits<f32>) -> ph_limits {
     }
 }
 
+fn filter_to_core(f: &ph_bearing_filter) -> Result<BearingFilter<f32>, ph_status> {
+    let ph_bearing_filter {
+        kind,
+        bearing_noise,
+        rate_noise,
+        inverse_range_noise,
+        gate,
+    } = *f;
+    match kind {
+        x if x == ph_filter_kind::PH_FILTER_TRACKER as u8 => {
+            Ok(BearingFilter::Tracker(TrackerConfig {
+                bearing_noise,
+                rate_noise,
+                inverse_range_noise,
+                gate,
+            }))
+        }
+        x if x == ph_filter_kind::PH_FILTER_FINITE_DIFFERENCE as u8
+            && [bearing_noise, rate_noise, inverse_range_noise, gate] == [0.0; 4] =>
+        {
+            Ok(BearingFilter::FiniteDifference)
+        }
+        _ => Err(ph_status::PH_ERR_CONFIG_BAD_ENUM),
+    }
+}
+
+fn filter_from_core(f: &BearingFilter<f32>) -> ph_bearing_filter {
+    match *f {
+        BearingFilter::FiniteDifference => ph_bearing_filter {
+            kind: ph_filter_kind::PH_FILTER_FINITE_DIFFERENCE as u8,
+            ..ph_bearing_filter::default()
+        },
+        BearingFilter::Tracker(TrackerConfig {
+            bearing_noise,
+            rate_noise,
+            inverse_range_noise,
+            gate,
+        }) => ph_bearing_filter {
+            kind: ph_filter_kind::PH_FILTER_TRACKER as u8,
+            bearing_noise,
+            rate_noise,
+            inverse_range_noise,
+            gate,
+        },
+    }
+}
+
 /// The core's configuration of a C configuration. Checks only what the C form can get
 /// wrong (counts, enum values); the core's [`controller_core::Agent::new`] checks the
 /// rest.
@@ -336,6 +412,7 @@ pub fn to_core(c: &ph_config) -> Result<FfiConfig, ph_status> {
         velocity_reference,
         leader,
         limits,
+        bearing_filter,
         integrity,
         comm_every,
         comm_phase,
@@ -383,6 +460,7 @@ pub fn to_core(c: &ph_config) -> Result<FfiConfig, ph_status> {
         velocity_reference: schedule_to_core(velocity_reference)?,
         leader,
         limits: limits_to_core(limits),
+        bearing_filter: filter_to_core(bearing_filter)?,
         integrity: integrity_to_core(*integrity, auth_key)?,
         comm_every: *comm_every,
         comm_phase: *comm_phase,
@@ -402,6 +480,7 @@ pub fn from_core(c: &FfiConfig) -> ph_config {
         velocity_reference,
         leader,
         limits,
+        bearing_filter,
         integrity,
         comm_every,
         comm_phase,
@@ -422,6 +501,7 @@ pub fn from_core(c: &FfiConfig) -> ph_config {
         velocity_damping: *velocity_damping,
         velocity_reference: schedule_from_core(velocity_reference),
         limits: limits_from_core(limits),
+        bearing_filter: filter_from_core(bearing_filter),
         ..ph_config::default()
     };
     for (dst, t) in out.triangles.iter_mut().zip(triangles) {

@@ -62,6 +62,8 @@ pub enum ph_status {
     PH_ERR_CONFIG_BAD_SCHEDULE = 31,
     /// Configuration: `comm_every` is 0 or `comm_phase ≥ comm_every`.
     PH_ERR_CONFIG_BAD_COMM_RATE = 32,
+    /// Configuration: a bearing tracker setting is not finite or out of range (SPEC §11).
+    PH_ERR_CONFIG_BAD_BEARING_FILTER = 33,
     /// Blob: does not start with the magic `"PHCF"`.
     PH_ERR_BLOB_MAGIC = 40,
     /// Blob: a format version (or reserved header byte) this library does not read.
@@ -119,6 +121,7 @@ impl From<ConfigError> for ph_status {
             ConfigError::BadSchedule => Self::PH_ERR_CONFIG_BAD_SCHEDULE,
             ConfigError::BadCommRate => Self::PH_ERR_CONFIG_BAD_COMM_RATE,
             ConfigError::BadLeader => Self::PH_ERR_CONFIG_BAD_LEADER,
+            ConfigError::BadBearingFilter => Self::PH_ERR_CONFIG_BAD_BEARING_FILTER,
         }
     }
 }
@@ -160,7 +163,7 @@ impl From<BlobError> for ph_status {
 
 /// Every status, for the code → status lookup of `ph_status_str`. `tests/header.rs`
 /// checks that it lists as many codes as the header's `ph_status` has.
-pub const ALL: [ph_status; 39] = {
+pub const ALL: [ph_status; 40] = {
     use ph_status::*;
     [
         PH_OK,
@@ -183,6 +186,7 @@ pub const ALL: [ph_status; 39] = {
         PH_ERR_CONFIG_BAD_ENUM,
         PH_ERR_CONFIG_BAD_SCHEDULE,
         PH_ERR_CONFIG_BAD_COMM_RATE,
+        PH_ERR_CONFIG_BAD_BEARING_FILTER,
         PH_ERR_BLOB_MAGIC,
         PH_ERR_BLOB_VERSION,
         PH_ERR_BLOB_LENGTH,
@@ -225,6 +229,7 @@ impl ph_status {
             Self::PH_ERR_CONFIG_TOO_MANY_NEIGHBOURS => c"PH_ERR_CONFIG_TOO_MANY_NEIGHBOURS",
             Self::PH_ERR_CONFIG_BAD_PARAMETER => c"PH_ERR_CONFIG_BAD_PARAMETER",
             Self::PH_ERR_CONFIG_BAD_LEADER => c"PH_ERR_CONFIG_BAD_LEADER",
+            Self::PH_ERR_CONFIG_BAD_BEARING_FILTER => c"PH_ERR_CONFIG_BAD_BEARING_FILTER",
             Self::PH_ERR_CONFIG_TOO_MANY_TRIANGLES => c"PH_ERR_CONFIG_TOO_MANY_TRIANGLES",
             Self::PH_ERR_CONFIG_SCHEDULE_TOO_LONG => c"PH_ERR_CONFIG_SCHEDULE_TOO_LONG",
             Self::PH_ERR_CONFIG_BAD_ENUM => c"PH_ERR_CONFIG_BAD_ENUM",

@@ -33,7 +33,7 @@ pub const PH_AGENT_SIZE: usize = 3404;
 pub const PH_AGENT_ALIGN: usize = 4;
 /// Bytes of agent memory (`sizeof` the agent, for 64-bit hosts).
 #[cfg(target_pointer_width = "64")]
-pub const PH_AGENT_SIZE: usize = 3792;
+pub const PH_AGENT_SIZE: usize = 4096;
 /// Alignment of the agent memory, in bytes.
 #[cfg(target_pointer_width = "64")]
 pub const PH_AGENT_ALIGN: usize = 8;

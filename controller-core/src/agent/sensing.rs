@@ -4,7 +4,8 @@
 
 use super::state::{AngleState, ApexPart, Neighbour, Side};
 use super::{Agent, BearingMeasurement, Fault, MeasurementError, Measurements};
-use crate::config::{AgentId, EstimatorMode};
+use crate::config::{AgentId, BearingFilter, EstimatorMode};
+use crate::tracker::TrackLimits;
 use crate::{law, Real, Vec2};
 
 /// Neither NaN nor infinite, in two float operations: `x − x` is 0 exactly for finite `x`
@@ -65,6 +66,14 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         self.time = m.time;
         self.velocity = m.velocity;
         self.partner_offset = m.partner_offset;
+        let how = Filtering {
+            filter: &self.config.bearing_filter,
+            v: &m.velocity,
+            limits: TrackLimits {
+                rho_initial: T::one() / self.config.initial_estimate,
+                rho_max: T::one() / self.config.min_estimate,
+            },
+        };
         // The oldest neighbour (ages are never NaN: ∞ + a finite dt ≥ 0, or 0 when heard).
         let mut oldest = T::zero();
         if in_order {
@@ -76,7 +85,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     oldest = n.age;
                 }
                 match bearings.next() {
-                    Some(b) => take_bearing(n, b, dt),
+                    Some(b) => take_bearing(n, b, dt, &how),
                     None => no_bearing(n, dt),
                 }
             }
@@ -87,7 +96,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     oldest = n.age;
                 }
                 match bearing_to(m.bearings, n.id) {
-                    Some(b) => take_bearing(n, b, dt),
+                    Some(b) => take_bearing(n, b, dt, &how),
                     None => no_bearing(n, dt),
                 }
             }
@@ -267,23 +276,41 @@ fn bearing_to<T: Real>(
     bearings.iter().find(|b| b.neighbour == id)
 }
 
+/// What [`take_bearing`] needs of the agent: its bearing filter, its own velocity of this
+/// tick, and the tracker's limits.
+struct Filtering<'a, T: Real> {
+    filter: &'a BearingFilter<T>,
+    v: &'a Vec2<T>,
+    limits: TrackLimits<T>,
+}
+
 /// Stores a checked bearing of this tick and its rate (`dt`: time since the last tick).
 #[inline(always)]
 fn take_bearing<T: Real, const MT: usize>(
     n: &mut Neighbour<T, MT>,
     b: &BearingMeasurement<T>,
     dt: T,
+    how: &Filtering<'_, T>,
 ) {
     let interval = n.bearing_age + dt;
-    n.rate = match b.rate {
-        Some(rate) => rate,
+    let (s, rate) = match (b.rate, how.filter) {
+        (Some(rate), _) => (b.bearing, rate),
         // Finite difference of successive bearings (SPEC §2), over the time since the
         // previous bearing (a missed tick widens the interval). Without a previous
         // bearing the interval is −∞: zero rate.
-        None if interval > T::zero() => (b.bearing - n.s) / interval,
-        None => Vec2::zeros(),
+        (None, BearingFilter::FiniteDifference) if interval > T::zero() => {
+            (b.bearing, (b.bearing - n.s) / interval)
+        }
+        (None, BearingFilter::FiniteDifference) => (b.bearing, Vec2::zeros()),
+        // SPEC §11: the tracker, driven by the relative velocity Δv = v_w − v_u (the
+        // neighbour's from its last frame).
+        (None, BearingFilter::Tracker(c)) => {
+            let dv = n.velocity - how.v;
+            n.track.update(&b.bearing, &dv, interval, c, &how.limits)
+        }
     };
-    n.s = b.bearing;
+    n.rate = rate;
+    n.s = s;
     n.bearing_age = T::zero();
     n.range = b.range;
     n.fresh = true;

@@ -3,7 +3,9 @@
 
 use super::state::{AngleState, ApexOf, ApexPart, Neighbour, Remote, Side, SELF_SLOT};
 use super::{Agent, Fault};
-use crate::config::{AgentConfig, AgentId, ConfigError, EstimatorMode, Limits, TriangleConfig};
+use crate::config::{
+    AgentConfig, AgentId, BearingFilter, ConfigError, EstimatorMode, Limits, TriangleConfig,
+};
 use crate::wire::{mode_byte, quant, FrameWriter};
 use crate::{FrameStats, Real, Vec2};
 
@@ -140,6 +142,11 @@ fn check_parameters<T: Real, const MT: usize>(c: &AgentConfig<T, MT>) -> Result<
     }
     if !c.velocity_reference.is_valid() {
         return Err(ConfigError::BadSchedule);
+    }
+    if let BearingFilter::Tracker(t) = &c.bearing_filter {
+        if !t.is_valid() {
+            return Err(ConfigError::BadBearingFilter);
+        }
     }
     if c.comm_every == 0 || c.comm_phase >= c.comm_every {
         return Err(ConfigError::BadCommRate);

@@ -116,6 +116,8 @@ pub(super) struct Neighbour<T: Real, const MT: usize> {
     pub range: Option<T>,
     /// `s` was measured this tick.
     pub fresh: bool,
+    /// The bearing tracker of this neighbour (SPEC §11; unused with the finite difference).
+    pub track: crate::tracker::Track<T>,
 }
 
 impl<T: Real, const MT: usize> Neighbour<T, MT> {
@@ -133,6 +135,7 @@ impl<T: Real, const MT: usize> Neighbour<T, MT> {
             bearing_age: T::lit(f64::NEG_INFINITY),
             range: None,
             fresh: false,
+            track: crate::tracker::Track::default(),
         }
     }
 

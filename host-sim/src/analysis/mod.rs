@@ -7,6 +7,7 @@
 
 mod min_distance;
 mod monitor;
+pub mod noise;
 mod outcome;
 pub mod shape_check;
 mod snapshot;

@@ -2,6 +2,7 @@
 //! and divergence (the run stops at a terminal failure), keeps the run's extremes, and
 //! gives the verdict at the end (`docs/outputs.md`, "Outcome").
 
+use super::noise::{MeanSquare, NoiseBands, NoiseReport};
 use super::outcome::{Event, Outcome};
 use super::shape_check::{folded_names, shape_check};
 use super::snapshot::{Diagnostics, Snapshot};
@@ -21,6 +22,12 @@ pub struct Monitor {
     /// When the largest rise peaked.
     pub max_rise_t: f64,
     settle_candidate: Option<f64>,
+    /// The bands of a noisy run (`None`: noise-free, or not yet observed).
+    bands: Option<NoiseBands>,
+    /// Noisy runs: the angle errors since the settle candidate.
+    settled_ms: MeanSquare,
+    /// Noisy runs: the angle errors over the last quarter of the run.
+    tail_ms: MeanSquare,
     /// Smallest estimate seen (`None` without estimates).
     pub min_estimate: Option<f64>,
     /// Smallest inter-agent distance seen, with time and pair.
@@ -50,6 +57,9 @@ impl Monitor {
             max_rise: 0.0,
             max_rise_t: 0.0,
             settle_candidate: None,
+            bands: None,
+            settled_ms: MeanSquare::default(),
+            tail_ms: MeanSquare::default(),
             min_estimate: None,
             min_distance: (f64::INFINITY, 0.0, 0, 0),
             n_estimates,
@@ -67,6 +77,22 @@ impl Monitor {
         self.settle_candidate
     }
 
+    /// The noise bands and the steady-state RMS angle error of a noisy run (`None` for
+    /// noise-free sensors).
+    pub fn noise_report(&self) -> Option<NoiseReport> {
+        let bands = self.bands?;
+        let window = if self.settle_candidate.is_some() {
+            &self.settled_ms
+        } else {
+            &self.tail_ms
+        };
+        Some(NoiseReport {
+            bands,
+            steady_rms_angle_error: window.rms(),
+            window_start: window.from,
+        })
+    }
+
     /// Observes one snapshot and the estimates; returns `true` when the run must stop.
     pub fn observe(&mut self, model: &Model, d: &Diagnostics, est: &[f64]) -> bool {
         let s = &d.snap;
@@ -76,6 +102,7 @@ impl Monitor {
         let epoch = model.schedule_epoch(s.t);
         if self.v0.is_none() {
             self.v0 = Some(s.v);
+            self.bands = NoiseBands::of(model);
         }
         if epoch != self.epoch {
             self.epoch = epoch;
@@ -89,13 +116,23 @@ impl Monitor {
                 self.max_rise_t = s.t;
             }
         }
-        // Settling.
-        if s.max_angle_err < cr.angle_tolerance {
+        // Settling (inside the noise band when the sensors are noisy).
+        let tolerance = self.bands.map_or(cr.angle_tolerance, |b| b.angle);
+        if s.max_angle_err < tolerance {
             if self.settle_candidate.is_none() {
                 self.settle_candidate = Some(s.t);
+                self.settled_ms = MeanSquare::default();
             }
         } else {
             self.settle_candidate = None;
+        }
+        if self.bands.is_some() {
+            if self.settle_candidate.is_some() {
+                self.settled_ms.add(s.t, &s.angle_err);
+            }
+            if s.t >= 0.75 * model.duration {
+                self.tail_ms.add(s.t, &s.angle_err);
+            }
         }
         // Extremes.
         if s.min_dist < self.min_distance.0 {
@@ -281,12 +318,25 @@ impl Monitor {
             return (kind, chain());
         }
         let settled = self.settle_candidate.is_some();
-        let disp_ok = last.disp_err <= cr.displacement_tolerance;
-        let vel_ok = last.vel_err <= cr.velocity_tolerance;
+        let (angle_tol, disp_tol, vel_tol) = match self.bands {
+            Some(b) => (b.angle, b.displacement, b.velocity),
+            None => (
+                cr.angle_tolerance,
+                cr.displacement_tolerance,
+                cr.velocity_tolerance,
+            ),
+        };
+        let band = if self.bands.is_some() {
+            " (noise band)"
+        } else {
+            ""
+        };
+        let disp_ok = last.disp_err <= disp_tol;
+        let vel_ok = last.vel_err <= vel_tol;
         if settled && disp_ok && vel_ok {
             let mut why = format!(
-                "every angle error below {} rad from t = {:.3} s; final |z − z*| = {:.2e} m, max |v − v*| = {:.2e} m/s",
-                cr.angle_tolerance,
+                "every angle error below {}{band} rad from t = {:.3} s; final |z − z*| = {:.2e} m, max |v − v*| = {:.2e} m/s",
+                angle_tol,
                 self.settle_candidate.unwrap_or(0.0),
                 last.disp_err,
                 last.vel_err
@@ -308,8 +358,8 @@ impl Monitor {
                         )
                     };
                     let why = format!(
-                        "every angle error below {} rad from t = {:.3} s, but the formation is not the target shape: {folded}an agent is {:.3e} of the target's size from its target point (tolerance {})",
-                        cr.angle_tolerance,
+                        "every angle error below {}{band} rad from t = {:.3} s, but the formation is not the target shape: {folded}an agent is {:.3e} of the target's size from its target point (tolerance {})",
+                        angle_tol,
                         self.settle_candidate.unwrap_or(0.0),
                         c.fit.max_rel,
                         cr.shape_tolerance
@@ -325,20 +375,20 @@ impl Monitor {
         let mut missing = Vec::new();
         if !settled {
             missing.push(format!(
-                "max angle error {:.3e} rad ≥ {} rad",
-                last.max_angle_err, cr.angle_tolerance
+                "max angle error {:.3e} rad ≥ {}{band} rad",
+                last.max_angle_err, angle_tol
             ));
         }
         if !disp_ok {
             missing.push(format!(
-                "|z − z*| = {:.3e} m > {} m",
-                last.disp_err, cr.displacement_tolerance
+                "|z − z*| = {:.3e} m > {}{band} m",
+                last.disp_err, disp_tol
             ));
         }
         if !vel_ok {
             missing.push(format!(
-                "max |v − v*| = {:.3e} m/s > {} m/s",
-                last.vel_err, cr.velocity_tolerance
+                "max |v − v*| = {:.3e} m/s > {}{band} m/s",
+                last.vel_err, vel_tol
             ));
         }
         let end = format!(

@@ -191,6 +191,7 @@ pub fn drive(
         events: monitor.events.clone(),
         final_time: s.t,
         settle_time: monitor.settle_time(),
+        noise: monitor.noise_report(),
         final_max_angle_error: s.max_angle_err,
         final_displacement_error: s.disp_err,
         final_velocity_error: s.vel_err,

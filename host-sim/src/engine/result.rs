@@ -19,6 +19,9 @@ pub struct RunResult {
     pub final_time: f64,
     /// See [`crate::analysis::Monitor::settle_time`].
     pub settle_time: Option<f64>,
+    /// The noise bands and steady-state RMS angle error of a noisy run (`None` for
+    /// noise-free sensors).
+    pub noise: Option<crate::analysis::noise::NoiseReport>,
     /// Final `max |α − α*|` (rad).
     pub final_max_angle_error: f64,
     /// Final `|z − z*|` (m).

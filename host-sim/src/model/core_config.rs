@@ -3,8 +3,8 @@
 
 use super::{AngleModel, Estimator, Model};
 use controller_core::{
-    AgentConfig, AngleConfig, EstimatorMode, LeaderConfig, LeaderRole, Limits, Schedule,
-    ScheduleStep, TriangleConfig,
+    AgentConfig, AngleConfig, BearingFilter, EstimatorMode, LeaderConfig, LeaderRole, Limits, Schedule,
+    ScheduleStep, TrackerConfig, TriangleConfig,
 };
 
 /// Triangle capacity of one host agent (`MT` of `controller_core::Agent`): the core's
@@ -66,6 +66,7 @@ impl Model {
         c.velocity_damping = a.velocity_damping;
         c.velocity_reference = self.velocity_reference.clone();
         c.limits = self.limits;
+        c.bearing_filter = self.sensors.bearing_filter;
         c.integrity = self.integrity.core(&self.auth_key);
         c.comm_every = u16::try_from(self.comm_every)
             .map_err(|_| format!("comm_every = {} exceeds 65535", self.comm_every))?;
@@ -140,6 +141,15 @@ impl Model {
             safe_damping: f(c.limits.safe_damping),
             bearing_tolerance: f(c.limits.bearing_tolerance),
             margin_cos: f(c.limits.margin_cos),
+        };
+        t.bearing_filter = match c.bearing_filter {
+            BearingFilter::FiniteDifference => BearingFilter::FiniteDifference,
+            BearingFilter::Tracker(k) => BearingFilter::Tracker(TrackerConfig {
+                bearing_noise: f(k.bearing_noise),
+                rate_noise: f(k.rate_noise),
+                inverse_range_noise: f(k.inverse_range_noise),
+                gate: f(k.gate),
+            }),
         };
         t.integrity = c.integrity;
         t.comm_every = c.comm_every;

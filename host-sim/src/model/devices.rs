@@ -1,6 +1,7 @@
 //! What the agents' sensors and radios get wrong, in SI units.
 
 use super::{BearingRate, ChannelModel};
+use controller_core::BearingFilter;
 
 /// Sensor imperfections, in SI units.
 #[derive(Clone, Debug, PartialEq)]
@@ -11,6 +12,8 @@ pub struct SensorModel {
     pub bearing_bias: f64,
     /// Source of bearing rates.
     pub bearing_rate: BearingRate,
+    /// The controllers' bearing filter (SPEC §11), resolved from `sensors.bearing_filter`.
+    pub bearing_filter: BearingFilter<f64>,
     /// Velocity noise standard deviation per component (m/s).
     pub velocity_noise: f64,
     /// Velocity bias (m/s).
@@ -28,6 +31,7 @@ impl SensorModel {
             bearing_noise: 0.0,
             bearing_bias: 0.0,
             bearing_rate,
+            bearing_filter: BearingFilter::FiniteDifference,
             velocity_noise: 0.0,
             velocity_bias: [0.0; 2],
             offset_noise: 0.0,

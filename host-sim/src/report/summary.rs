@@ -56,6 +56,15 @@ pub fn summary_json(model: &Model, r: &RunResult, estimates: &[EstimateInfo]) ->
         .control
         .last_fault
         .map(|(t, i, f)| json!({ "t": t, "agent": id(i), "fault": format!("{f:?}") }));
+    let noise = r.noise.map(|n| {
+        json!({
+            "angle_band_rad": fin(n.bands.angle),
+            "displacement_band_m": fin(n.bands.displacement),
+            "velocity_band_m_s": fin(n.bands.velocity),
+            "steady_rms_angle_error_rad": opt(n.steady_rms_angle_error),
+            "steady_window_start_s": opt(n.window_start),
+        })
+    });
     let mut v = json!({
         "scenario": model.name,
         "source": model.source,
@@ -133,6 +142,22 @@ pub fn summary_json(model: &Model, r: &RunResult, estimates: &[EstimateInfo]) ->
         "steps": r.steps,
     });
     if let Some(obj) = v.as_object_mut() {
+        // Only when they apply, so that a noise-free run's summary is what it always was.
+        if let Some(n) = noise {
+            obj.insert("noise".to_owned(), n);
+        }
+        if let controller_core::BearingFilter::Tracker(t) = &model.sensors.bearing_filter {
+            obj.insert(
+                "bearing_filter".to_owned(),
+                json!({
+                    "kind": "tracker",
+                    "bearing_noise_rad": fin(t.bearing_noise),
+                    "rate_noise": fin(t.rate_noise),
+                    "inverse_range_noise": fin(t.inverse_range_noise),
+                    "gate": fin(t.gate),
+                }),
+            );
+        }
         super::channel::add_json(obj, model, r);
         super::attack::add_json(obj, model, r);
     }

@@ -80,6 +80,10 @@ pub struct SensorSpec {
     pub bearing_bias_deg: f64,
     /// Bearing rates: `finite_difference` or `exact`.
     pub bearing_rate: BearingRate,
+    /// How each controller filters its bearings (SPEC §11): `auto`, `tracker` or `none`.
+    pub bearing_filter: FilterChoice,
+    /// `[sensors.tracker]`: the tracker's settings.
+    pub tracker: TrackerSpec,
     /// Standard deviation of each velocity component's noise (m/s).
     pub velocity_noise: f64,
     /// Constant velocity bias `[x, y]` (m/s).
@@ -96,10 +100,53 @@ impl Default for SensorSpec {
             bearing_noise_deg: 0.0,
             bearing_bias_deg: 0.0,
             bearing_rate: BearingRate::FiniteDifference,
+            bearing_filter: FilterChoice::Auto,
+            tracker: TrackerSpec::default(),
             velocity_noise: 0.0,
             velocity_bias: [0.0, 0.0],
             offset_noise: 0.0,
             range_noise: 0.0,
+        }
+    }
+}
+
+/// `sensors.bearing_filter`: how the controllers turn bearings into bearings and rates.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FilterChoice {
+    /// The tracker when the bearings are noisy (`bearing_noise_deg > 0`), the finite
+    /// difference for an ideal bearing sensor.
+    #[default]
+    Auto,
+    /// The bearing tracker of SPEC §11.
+    Tracker,
+    /// Today's finite difference of successive bearings (SPEC §2).
+    None,
+}
+
+/// `[sensors.tracker]`: the bearing tracker's settings (SPEC §11, S15–S17).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct TrackerSpec {
+    /// `σ_b` the tracker assumes (degrees); default: `sensors.bearing_noise_deg`, at least
+    /// 0.1°.
+    pub bearing_noise_deg: Option<f64>,
+    /// `σ_ω`: bearing rate the kinematic model cannot explain (rad/√s).
+    pub rate_noise: f64,
+    /// `σ_ρ`: random walk of the inverse distance (1/(m √s)).
+    pub inverse_range_noise: f64,
+    /// Innovation gate in standard deviations.
+    pub gate: f64,
+}
+
+impl Default for TrackerSpec {
+    fn default() -> Self {
+        let c = controller_core::TrackerConfig::<f64>::default();
+        Self {
+            bearing_noise_deg: None,
+            rate_noise: c.rate_noise,
+            inverse_range_noise: c.inverse_range_noise,
+            gate: c.gate,
         }
     }
 }

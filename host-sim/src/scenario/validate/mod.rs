@@ -17,7 +17,7 @@ use crate::model::{Graph, Model, RadioModel, SensorModel};
 use crate::scenario::error::{ErrorKind::InvalidValue, ScenarioError, ScenarioErrors};
 use crate::scenario::ScenarioFile;
 use checker::Checker;
-use controller_core::Limits;
+use controller_core::{BearingFilter, Limits, TrackerConfig};
 
 /// Validates a parsed scenario file. `file` labels errors; `default_name` is used when the
 /// file has no `name`.
@@ -91,6 +91,7 @@ pub fn validate(s: &ScenarioFile, file: &str, default_name: &str) -> Result<Mode
             bearing_noise: se.bearing_noise_deg.to_radians(),
             bearing_bias: se.bearing_bias_deg.to_radians(),
             bearing_rate: se.bearing_rate,
+            bearing_filter: bearing_filter(se),
             velocity_noise: se.velocity_noise,
             velocity_bias: se.velocity_bias,
             offset_noise: se.offset_noise,
@@ -131,3 +132,29 @@ pub fn validate(s: &ScenarioFile, file: &str, default_name: &str) -> Result<Mode
         Err(ScenarioErrors(core_errors))
     }
 }
+
+/// The filter each controller runs, from `sensors.bearing_filter` (SPEC §11): `auto` is
+/// the tracker for noisy bearings and the finite difference for an ideal sensor.
+fn bearing_filter(se: &crate::scenario::settings::SensorSpec) -> BearingFilter<f64> {
+    use crate::scenario::settings::FilterChoice;
+    let tracker = matches!(se.bearing_filter, FilterChoice::Tracker)
+        || (se.bearing_filter == FilterChoice::Auto && se.bearing_noise_deg > 0.0);
+    if !tracker {
+        return BearingFilter::FiniteDifference;
+    }
+    let t = &se.tracker;
+    let sigma_deg = t
+        .bearing_noise_deg
+        .unwrap_or(se.bearing_noise_deg)
+        .max(MIN_TRACKER_NOISE_DEG);
+    BearingFilter::Tracker(TrackerConfig {
+        bearing_noise: sigma_deg.to_radians(),
+        rate_noise: t.rate_noise,
+        inverse_range_noise: t.inverse_range_noise,
+        gate: t.gate,
+    })
+}
+
+/// The smallest bearing noise the tracker assumes (degrees): an ideal sensor's `σ = 0`
+/// would make the tracker trust every bearing completely.
+const MIN_TRACKER_NOISE_DEG: f64 = 0.1;

@@ -19,6 +19,31 @@ pub(super) struct Timing {
     pub reorder_delay: f64,
 }
 
+/// The largest bearing noise a scenario may declare (degrees): 0.5 rad, the tracker's
+/// limit ([`controller_core::TrackerConfig::is_valid`]).
+pub(super) const MAX_BEARING_NOISE_DEG: f64 = 28.0;
+
+/// `[sensors.tracker]`: each setting in the range the core accepts.
+fn check_tracker(c: &mut Checker<'_>, t: &crate::scenario::settings::TrackerSpec) {
+    let mut within = |field: &str, x: f64, lo: f64, hi: f64, open_lo: bool| {
+        let low_ok = if open_lo { x > lo } else { x >= lo };
+        if !(x.is_finite() && low_ok && x <= hi) {
+            let lo_s = if open_lo { "above" } else { "at least" };
+            c.err(
+                InvalidValue,
+                &format!("sensors.tracker.{field}"),
+                format!("{x} is out of range: must be finite, {lo_s} {lo} and at most {hi}"),
+            );
+        }
+    };
+    if let Some(b) = t.bearing_noise_deg {
+        within("bearing_noise_deg", b, 0.0, MAX_BEARING_NOISE_DEG, true);
+    }
+    within("rate_noise", t.rate_noise, 0.0, 100.0, false);
+    within("inverse_range_noise", t.inverse_range_noise, 0.0, 100.0, false);
+    within("gate", t.gate, 1.0, 1000.0, false);
+}
+
 /// Checks the run-wide sections.
 pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile) -> Timing {
     c.positive(InvalidValue, "duration", s.duration);
@@ -120,6 +145,14 @@ pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile) -> Timing {
     if !se.bearing_bias_deg.is_finite() {
         c.err(InvalidValue, "sensors.bearing_bias_deg", "must be finite");
     }
+    if se.bearing_noise_deg > MAX_BEARING_NOISE_DEG {
+        c.err(
+            InvalidValue,
+            "sensors.bearing_noise_deg",
+            format!("{} is not a bearing sensor: at most {MAX_BEARING_NOISE_DEG}°", se.bearing_noise_deg),
+        );
+    }
+    check_tracker(c, &se.tracker);
     c.non_negative(InvalidValue, "sensors.velocity_noise", se.velocity_noise);
     c.non_negative(InvalidValue, "sensors.offset_noise", se.offset_noise);
     c.non_negative(InvalidValue, "sensors.range_noise", se.range_noise);

@@ -1,0 +1,147 @@
+//! The bearing tracker of SPEC §11 (S15–S17): one per sensed neighbour, it turns noisy
+//! bearings into a smoothed bearing `ŝ` and a bearing rate `ṡ̂` without differentiating
+//! the noise.
+//!
+//! The state is the bearing `ŝ` (a unit vector) and the inverse distance `ρ̂ = 1/r̂` to the
+//! neighbour; its error covariance is kept in the tangent coordinates `(δθ, δρ)` as the
+//! symmetric 2×2 matrix `[p00, p01; p01, p11]`. The prediction is the exact bearing
+//! kinematics (S2, S3) driven by the relative velocity `Δv = v_w − v_u`, which the agent
+//! knows (its own velocity, and the neighbour's from its frames); the measurement is the
+//! bearing itself. The rate the law uses is S2 with `1/r` replaced by `ρ̂` (S17): it is
+//! zero whenever the relative velocity is, whatever the bearing noise.
+//!
+//! Everything is `no_std`, allocation-free and panic-free; no trigonometry (one square
+//! root per update).
+
+use crate::config::TrackerConfig;
+use crate::geometry::perp;
+use crate::{Real, Vec2};
+
+/// One neighbour's track (S15–S17).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Track<T: Real> {
+    /// `ŝ`, the smoothed unit bearing.
+    pub s: Vec2<T>,
+    /// `ρ̂ ≥ 0`, the inverse distance (1/m).
+    pub rho: T,
+    /// Covariance of `(δθ, δρ)`: `[p00, p01, p11]`.
+    pub p: [T; 3],
+    /// Measurements in a row that failed the gate (S16).
+    pub rejected: u8,
+    /// The track has been started by a first bearing.
+    pub live: bool,
+}
+
+/// What the tracker needs besides its configuration: the agent-wide constants.
+#[derive(Clone, Copy, Debug)]
+pub struct TrackLimits<T: Real> {
+    /// `ρ̂(0) = 1/r̂(0)` (the configured initial estimate, SPEC §6).
+    pub rho_initial: T,
+    /// `ρ_max = 1/r_min` (S10's floor).
+    pub rho_max: T,
+}
+
+/// Consecutive gated-out bearings after which the track restarts at the measurement.
+const MAX_REJECTED: u8 = 3;
+
+impl<T: Real> Track<T> {
+    /// Takes bearing `z` (unit) measured `dt` seconds after the previous one, with the
+    /// relative velocity `dv = v_w − v_u`; returns `(ŝ, ṡ̂)` (S15–S17). A first bearing,
+    /// a non-positive or non-finite `dt`, a bearing more than 90° from the prediction, or
+    /// [`MAX_REJECTED`] gated-out bearings in a row (re)start the track at `z` with zero
+    /// covariance cross term.
+    pub fn update(
+        &mut self,
+        z: &Vec2<T>,
+        dv: &Vec2<T>,
+        dt: T,
+        c: &TrackerConfig<T>,
+        lim: &TrackLimits<T>,
+    ) -> (Vec2<T>, Vec2<T>) {
+        let r = c.bearing_noise * c.bearing_noise;
+        if !(self.live && dt > T::zero() && dt.finite()) {
+            self.start(z, r, lim);
+            return (self.s, rate(&self.s, self.rho, dv));
+        }
+        // S15: prediction along the bearing kinematics (S2, S3) with ρ̂ for 1/r.
+        let t = perp(&self.s);
+        let (a, b) = (t.dot(dv), self.s.dot(dv));
+        let delta = dt * self.rho * a;
+        let s_pred = unit(&(self.s + t * delta));
+        let rho_pred = clamp(self.rho - dt * self.rho * self.rho * b, lim.rho_max);
+        let f01 = dt * a;
+        let f11 = T::one() - T::lit(2.0) * dt * self.rho * b;
+        let [p00, p01, p11] = self.p;
+        let p11f = p11 * f01;
+        let p00 = p00 + f01 * (p01 + p01 + p11f) + c.rate_noise * c.rate_noise * dt;
+        let p01 = f11 * (p01 + p11f);
+        let p11 = f11 * f11 * p11 + c.inverse_range_noise * c.inverse_range_noise * dt;
+        // S16: the bearing as a measurement of the tangent angle, e = (Jŝ)ᵀz ≈ δθ.
+        let tp = perp(&s_pred);
+        let (e, along) = (tp.dot(z), s_pred.dot(z));
+        if along <= T::zero() {
+            self.start(z, r, lim);
+            return (self.s, rate(&self.s, self.rho, dv));
+        }
+        let sv = p00 + r;
+        let gate = c.gate * c.gate * sv;
+        if !(e * e <= gate) {
+            // An outlier (or a NaN): predict only.
+            self.rejected = self.rejected.saturating_add(1);
+            if self.rejected >= MAX_REJECTED {
+                self.start(z, r, lim);
+            } else {
+                self.s = s_pred;
+                self.rho = rho_pred;
+                self.p = [p00, p01, p11];
+            }
+            return (self.s, rate(&self.s, self.rho, dv));
+        }
+        self.rejected = 0;
+        let (k0, k1) = (p00 / sv, p01 / sv);
+        self.s = unit(&(s_pred + tp * (k0 * e)));
+        self.rho = clamp(rho_pred + k1 * e, lim.rho_max);
+        let one_k0 = T::one() - k0;
+        self.p = [one_k0 * p00, one_k0 * p01, p11 - k1 * p01];
+        (self.s, rate(&self.s, self.rho, dv))
+    }
+
+    /// (Re)starts the track at bearing `z` with `ρ̂(0)`: variance `R` on the angle, `ρ̂(0)²`
+    /// (100 %) on the inverse distance.
+    fn start(&mut self, z: &Vec2<T>, r: T, lim: &TrackLimits<T>) {
+        let rho = clamp(lim.rho_initial, lim.rho_max);
+        *self = Self {
+            s: *z,
+            rho,
+            p: [r, T::zero(), rho * rho],
+            rejected: 0,
+            live: true,
+        };
+    }
+}
+
+/// S17: `ṡ̂ = ρ̂ P(ŝ) Δv = ρ̂ ((Jŝ)ᵀΔv) Jŝ` (S2 with `ρ̂` for `1/r`).
+#[inline]
+pub fn rate<T: Real>(s: &Vec2<T>, rho: T, dv: &Vec2<T>) -> Vec2<T> {
+    let t = perp(s);
+    t * (rho * t.dot(dv))
+}
+
+/// `x / |x|` (the tracker's vectors are never near zero: a unit vector plus a
+/// perpendicular part).
+#[inline]
+fn unit<T: Real>(x: &Vec2<T>) -> Vec2<T> {
+    x / x.dot(x).sqrt_fast()
+}
+
+/// `ρ` clamped to `[0, ρ_max]` (NaN becomes 0).
+#[inline]
+fn clamp<T: Real>(rho: T, rho_max: T) -> T {
+    if rho > rho_max {
+        rho_max
+    } else if rho >= T::zero() {
+        rho
+    } else {
+        T::zero()
+    }
+}
