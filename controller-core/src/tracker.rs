@@ -45,14 +45,16 @@ pub struct TrackLimits<T: Real> {
 const MAX_REJECTED: u8 = 3;
 
 impl<T: Real> Track<T> {
-    /// Takes bearing `z` (unit) measured `dt` seconds after the previous one, with the
-    /// relative velocity `dv = v_w − v_u`; returns `(ŝ, ṡ̂)` (S15–S17). A first bearing,
+    /// Takes bearing `z` (unit) measured `dt` seconds after the previous one; `moved` is
+    /// the relative velocity `v_w − v_u` over that interval (as known at its start) and
+    /// `dv` the one now. Returns `(ŝ, ṡ̂)` (S15–S17). A first bearing,
     /// a non-positive or non-finite `dt`, a bearing more than 90° from the prediction, or
     /// [`MAX_REJECTED`] gated-out bearings in a row (re)start the track at `z` with zero
     /// covariance cross term.
     pub fn update(
         &mut self,
         z: &Vec2<T>,
+        moved: &Vec2<T>,
         dv: &Vec2<T>,
         dt: T,
         c: &TrackerConfig<T>,
@@ -65,7 +67,7 @@ impl<T: Real> Track<T> {
         }
         // S15: prediction along the bearing kinematics (S2, S3) with ρ̂ for 1/r.
         let t = perp(&self.s);
-        let (a, b) = (t.dot(dv), self.s.dot(dv));
+        let (a, b) = (t.dot(moved), self.s.dot(moved));
         let delta = dt * self.rho * a;
         let s_pred = unit(&(self.s + t * delta));
         let rho_pred = clamp(self.rho - dt * self.rho * self.rho * b, lim.rho_max);

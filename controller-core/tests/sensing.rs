@@ -10,7 +10,9 @@ fn finite_difference_rate_tracks_a_rotating_bearing_across_missed_ticks() {
     let mut r = rng(0);
     let mut f = Formation::random(4, strip(4), &strip_positions(4, 0.1, &mut r), &mut r);
     f.leader = None;
-    let mut a = testkit::HostAgent::<f64>::new(f.config(0)).expect("valid");
+    let mut c = f.config(0);
+    c.bearing_filter = controller_core::BearingFilter::FiniteDifference;
+    let mut a = testkit::HostAgent::<f64>::new(c).expect("valid");
     let (omega, dt) = (0.8, 0.01);
     let bearing = |k: usize, to: u8| {
         let th = omega * dt * k as f64 + f64::from(to);

@@ -64,11 +64,12 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             }
         };
         self.time = m.time;
-        self.velocity = m.velocity;
+        let v_before = core::mem::replace(&mut self.velocity, m.velocity);
         self.partner_offset = m.partner_offset;
         let how = Filtering {
             filter: &self.config.bearing_filter,
             v: &m.velocity,
+            v_before: &v_before,
             limits: TrackLimits {
                 rho_initial: T::one() / self.config.initial_estimate,
                 rho_max: T::one() / self.config.min_estimate,
@@ -277,10 +278,11 @@ fn bearing_to<T: Real>(
 }
 
 /// What [`take_bearing`] needs of the agent: its bearing filter, its own velocity of this
-/// tick, and the tracker's limits.
+/// tick and of the last, and the tracker's limits.
 struct Filtering<'a, T: Real> {
     filter: &'a BearingFilter<T>,
     v: &'a Vec2<T>,
+    v_before: &'a Vec2<T>,
     limits: TrackLimits<T>,
 }
 
@@ -303,10 +305,12 @@ fn take_bearing<T: Real, const MT: usize>(
         }
         (None, BearingFilter::FiniteDifference) => (b.bearing, Vec2::zeros()),
         // SPEC §11: the tracker, driven by the relative velocity Δv = v_w − v_u (the
-        // neighbour's from its last frame).
+        // neighbour's from its last frame, sent at about the last tick): the motion since
+        // the last tick with the own velocity then, the rate with the own velocity now.
         (None, BearingFilter::Tracker(c)) => {
+            let moved = n.velocity - how.v_before;
             let dv = n.velocity - how.v;
-            n.track.update(&b.bearing, &dv, interval, c, &how.limits)
+            n.track.update(&b.bearing, &moved, &dv, interval, c, &how.limits)
         }
     };
     n.rate = rate;
