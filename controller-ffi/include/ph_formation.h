@@ -77,14 +77,14 @@
 /**
  * Bytes of agent memory (`sizeof` the agent, for 32-bit targets such as Cortex-M).
  */
-#define PH_AGENT_SIZE 3404
+#define PH_AGENT_SIZE 3760
 #endif
 
 #if defined(PH_PTR64)
 /**
  * Bytes of agent memory (`sizeof` the agent, for 64-bit hosts).
  */
-#define PH_AGENT_SIZE 3792
+#define PH_AGENT_SIZE 4096
 #endif
 
 #if defined(PH_PTR32)
@@ -210,6 +210,10 @@ enum ph_status
    * Configuration: `comm_every` is 0 or `comm_phase ≥ comm_every`.
    */
   PH_ERR_CONFIG_BAD_COMM_RATE = 32,
+  /**
+   * Configuration: a bearing tracker setting is not finite or out of range (SPEC §11).
+   */
+  PH_ERR_CONFIG_BAD_BEARING_FILTER = 33,
   /**
    * Blob: does not start with the magic `"PHCF"`.
    */
@@ -577,6 +581,32 @@ typedef struct {
 } ph_limits;
 
 /**
+ * The bearing filter (SPEC §11): `kind` is a `ph_filter_kind`.
+ */
+typedef struct {
+  /**
+   * A `ph_filter_kind`.
+   */
+  uint8_t kind;
+  /**
+   * `σ_b > 0`: the bearing noise (rad), at most 0.5.
+   */
+  float bearing_noise;
+  /**
+   * `σ_ω ≥ 0`: unmodelled bearing rate (rad/√s).
+   */
+  float rate_noise;
+  /**
+   * `σ_ρ ≥ 0`: random walk of the inverse distance (1/(m √s)).
+   */
+  float inverse_range_noise;
+  /**
+   * Innovation gate in standard deviations, in `[1, 1000]`.
+   */
+  float gate;
+} ph_bearing_filter;
+
+/**
  * One agent's configuration. Start from `ph_config_default` (the SPEC defaults), then
  * set the triangles, gains and maneuvers.
  */
@@ -629,6 +659,10 @@ typedef struct {
    * Safety limits.
    */
   ph_limits limits;
+  /**
+   * The bearing filter (SPEC §11).
+   */
+  ph_bearing_filter bearing_filter;
   /**
    * A `ph_integrity`.
    */

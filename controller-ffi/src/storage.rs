@@ -27,7 +27,7 @@ pub struct ph_agent {
 
 /// Bytes of agent memory (`sizeof` the agent, for 32-bit targets such as Cortex-M).
 #[cfg(target_pointer_width = "32")]
-pub const PH_AGENT_SIZE: usize = 3404;
+pub const PH_AGENT_SIZE: usize = 3760;
 /// Alignment of the agent memory, in bytes.
 #[cfg(target_pointer_width = "32")]
 pub const PH_AGENT_ALIGN: usize = 4;

@@ -1,0 +1,140 @@
+//! Real bearing sensors (docs/sensors.md): with camera-grade noise the default sensing (the
+//! bearing tracker of SPEC §11) holds the formations, and the noise-aware verdict calls a
+//! run that is only noisy `converged` while a collapse is still a collapse. Bad sensor
+//! and tracker settings are refused with their field.
+
+use host_sim::engine::{self as sim, NullRecorder, RunResult};
+use host_sim::model::Model;
+use host_sim::{load, Outcome, Simulation};
+
+fn model(name: &str, overrides: &[&str]) -> Model {
+    let o: Vec<String> = overrides.iter().map(|s| (*s).to_owned()).collect();
+    load(name, &o).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+fn run(m: &Model) -> RunResult {
+    sim::run(m, &mut NullRecorder, &mut |_| {}).expect("run")
+}
+
+#[test]
+fn two_degrees_and_ten_percent_loss_converge_with_default_criteria() {
+    for (name, duration) in [("paper", "100"), ("formation-only", "30")] {
+        let m = model(
+            name,
+            &[
+                "sensors.bearing_noise_deg=2",
+                "radio.loss=0.1",
+                &format!("duration={duration}"),
+            ],
+        );
+        let r = run(&m);
+        assert_eq!(r.outcome, Outcome::Converged, "{name}: {}", r.reason);
+        assert!(
+            r.final_max_angle_error <= 0.035,
+            "{name}: final angle error {}",
+            r.final_max_angle_error
+        );
+        let n = r.noise.expect("a noisy run reports its bands");
+        // √2 σ_b with σ_b = 2°.
+        let band = std::f64::consts::SQRT_2 * 2f64.to_radians();
+        assert!((n.bands.angle - band).abs() < 1e-12, "{name}: {n:?}");
+        let rms = n.steady_rms_angle_error.expect("steady-state RMS");
+        assert!(rms > 0.0 && rms < band / 4.0, "{name}: RMS {rms}");
+        assert!(r.reason.contains("noise band"), "{name}: {}", r.reason);
+    }
+}
+
+#[test]
+fn a_collapse_under_noise_is_still_a_collapse() {
+    // The finite difference at 2°: the rates are noise, the estimates collapse.
+    let m = model(
+        concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/strip20.toml"),
+        &[
+            "sensors.bearing_noise_deg=2",
+            "sensors.bearing_filter=none",
+            "radio.loss=0.1",
+            "duration=5",
+        ],
+    );
+    let r = run(&m);
+    assert_eq!(r.outcome, Outcome::EstimateCollapse, "{}", r.reason);
+    // And a formation that the noise keeps from its shape is not converged, whatever
+    // the band.
+    let m = model(
+        "formation-only",
+        &[
+            "sensors.bearing_noise_deg=2",
+            "sensors.bearing_filter=none",
+            "duration=30",
+        ],
+    );
+    let r = run(&m);
+    assert_ne!(r.outcome, Outcome::Converged, "{}", r.reason);
+}
+
+#[test]
+fn the_tracker_without_noise_keeps_the_paper_figures_within_one_percent() {
+    let fd = run(&model("paper", &[]));
+    let tr = run(&model("paper", &["sensors.bearing_filter=tracker"]));
+    assert_eq!(tr.outcome, Outcome::Converged, "{}", tr.reason);
+    let (a, b) = (
+        fd.settle_time.expect("settles"),
+        tr.settle_time.expect("settles"),
+    );
+    assert!((a - 40.85).abs() < 0.01, "finite difference settles at {a}");
+    assert!((b - a).abs() <= 0.01 * a, "tracker {b} against {a}");
+    assert!(tr.final_max_angle_error < 1e-3);
+    assert!(tr.final_displacement_error < 1e-2 && tr.final_velocity_error < 1e-2);
+}
+
+#[test]
+fn a_noise_free_summary_is_unchanged_and_a_noisy_one_reports_the_noise() {
+    let clean = model("formation-only", &["duration=5"]);
+    let run_clean = Simulation::new(&clean).run().expect("run");
+    let j = run_clean.summary_json(&clean);
+    assert!(j.get("noise").is_none() && j.get("bearing_filter").is_none());
+    let noisy = model(
+        "formation-only",
+        &["duration=5", "sensors.bearing_noise_deg=1"],
+    );
+    let run_noisy = Simulation::new(&noisy).run().expect("run");
+    let j = run_noisy.summary_json(&noisy);
+    let n = j.get("noise").expect("noise");
+    for k in [
+        "angle_band_rad",
+        "displacement_band_m",
+        "velocity_band_m_s",
+        "steady_rms_angle_error_rad",
+        "steady_window_start_s",
+    ] {
+        assert!(n.get(k).is_some_and(|v| v.is_number()), "{k}: {n}");
+    }
+    assert_eq!(j["bearing_filter"]["kind"], "tracker");
+    let sigma = j["bearing_filter"]["bearing_noise_rad"].as_f64().expect("σ");
+    assert!((sigma - 1f64.to_radians()).abs() < 1e-12);
+}
+
+#[test]
+fn bad_sensor_and_tracker_settings_name_their_field() {
+    let cases: [(&str, &str); 8] = [
+        ("sensors.bearing_noise_deg=-1", "sensors.bearing_noise_deg"),
+        ("sensors.bearing_noise_deg=nan", "sensors.bearing_noise_deg"),
+        ("sensors.bearing_noise_deg=90", "sensors.bearing_noise_deg"),
+        ("sensors.tracker.rate_noise=-0.1", "sensors.tracker.rate_noise"),
+        (
+            "sensors.tracker.inverse_range_noise=inf",
+            "sensors.tracker.inverse_range_noise",
+        ),
+        ("sensors.tracker.gate=0.5", "sensors.tracker.gate"),
+        (
+            "sensors.tracker.bearing_noise_deg=0",
+            "sensors.tracker.bearing_noise_deg",
+        ),
+        ("sensors.bearing_filter=kalman", "sensors.bearing_filter"),
+    ];
+    for (set, field) in cases {
+        let e = load("paper", &[set.to_owned()]).expect_err(set);
+        let text = e.to_string();
+        assert!(text.contains(field), "{set}: {text}");
+    }
+}
