@@ -20,9 +20,11 @@ use std::fs::{File, OpenOptions};
 use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
-/// Most stretches merged at once (a journal has at most `order::ROUNDS` + 1 per session
-/// that did not finish, and [`sort_runs`] leaves one).
+/// Most stretches a file may have (a journal has at most `order::ROUNDS` per session, plus
+/// the sorted rows of the sessions before: [`sort_runs`] leaves one).
 pub const MAX_STRETCHES: usize = 4096;
+/// Most files open at once in a merge; more stretches (shards) are merged in passes.
+pub const FAN_IN: usize = 128;
 
 /// `runs.csv` open for appending rows.
 pub struct Journal {
@@ -101,7 +103,7 @@ pub struct Stretch {
 }
 
 /// The stretches of `path` in job order, and its number of rows.
-pub fn stretches(path: &Path, m: &Manifest) -> Result<(Vec<Stretch>, u64), SweepError> {
+pub fn stretches_of(path: &Path, m: &Manifest) -> Result<(Vec<Stretch>, u64), SweepError> {
     let mut r = runs_csv::open(path, m)?;
     let mut out: Vec<Stretch> = Vec::new();
     let mut last: Option<(usize, u64)> = None;
@@ -166,8 +168,47 @@ impl Cursor {
 }
 
 /// Merges `stretches` (of one or more files written for `m`) into `out` in job order,
-/// aggregating the points; returns the number of rows and the statistics.
+/// aggregating the points; returns the number of rows and the statistics. More than
+/// [`FAN_IN`] stretches are first merged by groups into files beside `out`
+/// (`<out>.pass<k>-<i>`, removed after).
 pub fn merge_stretches(
+    stretches: &[Stretch],
+    m: &Manifest,
+    out: &Path,
+) -> Result<(u64, Vec<PointStats>), SweepError> {
+    let mut level = stretches.to_vec();
+    let mut temps: Vec<PathBuf> = Vec::new();
+    let mut pass = 0;
+    let result = loop {
+        if level.len() <= FAN_IN {
+            break merge_few(&level, m, out);
+        }
+        pass += 1;
+        let mut next = Vec::new();
+        for (i, group) in level.chunks(FAN_IN).enumerate() {
+            let mut name = out.as_os_str().to_owned();
+            name.push(format!(".pass{pass}-{i}"));
+            let tmp = PathBuf::from(name);
+            temps.push(tmp.clone());
+            if let Err(e) = merge_few(group, m, &tmp) {
+                remove(&temps);
+                return Err(e);
+            }
+            next.extend(stretches_of(&tmp, m)?.0);
+        }
+        level = next;
+    };
+    remove(&temps);
+    result
+}
+
+fn remove(files: &[PathBuf]) {
+    for f in files {
+        let _ = std::fs::remove_file(f);
+    }
+}
+
+fn merge_few(
     stretches: &[Stretch],
     m: &Manifest,
     out: &Path,
@@ -247,7 +288,7 @@ impl Ord for HeapRow {
 pub fn sort_runs(dir: &Path, m: &Manifest) -> Result<(u64, Vec<PointStats>), SweepError> {
     let path = dir.join("runs.csv");
     drop_torn_line(&path)?;
-    let (parts, _) = stretches(&path, m)?;
+    let (parts, _) = stretches_of(&path, m)?;
     let tmp = dir.join("runs.csv.sorting");
     let got = merge_stretches(&parts, m, &tmp)?;
     std::fs::rename(&tmp, &path)

@@ -3,7 +3,7 @@
 
 use super::aggregate::PointStats;
 use super::error::SweepError;
-use super::journal::{merge_stretches, stretches};
+use super::journal::{merge_stretches, stretches_of};
 use super::output::{write_summary, Manifest};
 use super::run::RunRow;
 use super::runs_csv;
@@ -129,7 +129,7 @@ pub fn merge_into(
     let c = check(dirs)?;
     let mut all = Vec::new();
     for (d, m) in &c.shards {
-        let (parts, rows) = stretches(&d.join("runs.csv"), m)?;
+        let (parts, rows) = stretches_of(&d.join("runs.csv"), m)?;
         if rows != m.finished {
             return Err(count_mismatch(d, rows, m.finished));
         }

@@ -5,14 +5,14 @@
 //!
 //! The runs of each point are cut into at most [`ROUNDS`] blocks of `B = ⌈runs / ROUNDS⌉`
 //! consecutive runs; round `b` runs block `b` of every point, point after point. A
-//! partial sweep therefore differs by at most `B` runs between points (1 up to 64 runs
+//! partial sweep therefore differs by at most `B` runs between points (1 up to 256 runs
 //! per point), and the rows of one round are in job order: a run's `runs.csv` is at most
 //! [`ROUNDS`] + 1 sorted stretches, merged in bounded memory.
 
 use super::shard::Shard;
 
 /// Most rounds a sweep's runs are cut into (bounds the sorted stretches of a journal).
-pub const ROUNDS: u64 = 64;
+pub const ROUNDS: u64 = 256;
 
 /// Runs per point and round: `⌈runs / ROUNDS⌉`.
 pub fn block(runs: u64) -> u64 {
@@ -56,7 +56,8 @@ mod tests {
                 assert_eq!(shard.count(points * runs), want.len() as u64);
             }
         }
-        // 100 runs at 7 points: after 40 jobs the points have 4 to 6 runs (block 2).
+        // 100 runs at 7 points (block 1): after 40 jobs the points have 5 or 6 runs; 1000
+        // runs (block 4): after 100 jobs, 12 to 16.
         let mut per_point = [0; 7];
         for j in jobs(7, 100, Shard::ALL).take(40) {
             per_point[(j / 100) as usize] += 1;
