@@ -63,10 +63,13 @@ mod tests {
             per_point[(j / 100) as usize] += 1;
         }
         let (lo, hi) = (per_point.iter().min(), per_point.iter().max());
-        assert_eq!(
-            (lo, hi),
-            (Some(&4), Some(&6)),
-            "within one block (2 runs): {per_point:?}"
-        );
+        assert_eq!((lo, hi), (Some(&5), Some(&6)), "{per_point:?}");
+        assert_eq!(block(1000), 4);
+        let mut per_point = [0; 7];
+        for j in jobs(7, 1000, Shard::ALL).take(100) {
+            per_point[(j / 1000) as usize] += 1;
+        }
+        let (lo, hi) = (per_point.iter().min(), per_point.iter().max());
+        assert_eq!((lo, hi), (Some(&12), Some(&16)), "{per_point:?}");
     }
 }
