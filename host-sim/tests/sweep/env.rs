@@ -74,3 +74,47 @@ fn shard_auto_refuses_missing_or_inconsistent_variables() {
         Err(ShardError::Syntax(s)) if s == "3/2"
     ));
 }
+
+#[test]
+fn the_command_takes_the_shard_from_the_environment() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("tiny.toml");
+    std::fs::write(&file, TINY).unwrap();
+    let vars = [
+        "SLURM_ARRAY_TASK_ID",
+        "SLURM_ARRAY_TASK_MIN",
+        "SLURM_ARRAY_TASK_MAX",
+        "SLURM_ARRAY_TASK_COUNT",
+        "JOB_COMPLETION_INDEX",
+    ];
+    let cmd = || {
+        let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_host-sim"));
+        c.args(["-q", "sweep"])
+            .arg(&file)
+            .args(["--shard", "auto", "--no-plots", "--jobs", "1"]);
+        for v in vars {
+            c.env_remove(v);
+        }
+        c
+    };
+    let none = cmd().output().unwrap();
+    assert_eq!(none.status.code(), Some(2));
+    let msg = String::from_utf8_lossy(&none.stderr);
+    assert!(msg.contains("neither SLURM_ARRAY_TASK_ID"), "{msg}");
+    let out = tmp.path().join("s");
+    let task = cmd()
+        .args(["--max-runs", "2", "--out"])
+        .arg(&out)
+        .envs([
+            ("SLURM_ARRAY_TASK_ID", "0"),
+            ("SLURM_ARRAY_TASK_MIN", "0"),
+            ("SLURM_ARRAY_TASK_MAX", "2"),
+            ("SLURM_ARRAY_TASK_COUNT", "3"),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(task.status.code(), Some(130), "2 of 4 runs");
+    let json: serde_json::Value = serde_json::from_str(&read(&out, "sweep.json")).unwrap();
+    assert_eq!(json["shard"], "1/3");
+    assert_eq!(read(&out, "runs.csv").lines().count(), 3, "jobs 0 and 3");
+}
