@@ -146,18 +146,25 @@ pub(super) fn command(args: &SweepArgs, quiet: bool) -> u8 {
     }
 }
 
-/// The plan and shard of `host-sim sweep [SWEEP] [--resume DIR]`.
-fn plan_of(args: &SweepArgs) -> Result<(Plan, Shard), SweepError> {
+/// The plan and shard of `host-sim sweep [SWEEP] [--resume DIR]`, and whether DIR holds
+/// a sweep already.
+fn plan_of(args: &SweepArgs) -> Result<(Plan, Shard, bool), SweepError> {
     let usage = |reason: String| SweepError::new(exit_code::USAGE, "sweep", "", reason);
     let old = match &args.resume {
         Some(dir) if dir.join("sweep.json").is_file() => Some(Manifest::read(dir)?),
         _ => None,
     };
+    // Resuming, what the command line leaves out is as first given (sweep.json).
+    let runs = args.runs.or(old.as_ref().map(|m| m.runs));
+    let set = match &old {
+        Some(m) if args.set.is_empty() => &m.set,
+        _ => &args.set,
+    };
     let plan = match (&args.sweep, &old) {
-        (Some(name), _) => Plan::load_with(name, args.runs, &args.set)?,
+        (Some(name), _) => Plan::load_with(name, runs, set)?,
         (None, Some(m)) => {
             let name = m.sweep.strip_prefix("builtin:").unwrap_or(&m.sweep);
-            Plan::load_with(name, Some(args.runs.unwrap_or(m.runs)), &m.set)?
+            Plan::load_with(name, runs, set)?
         }
         (None, None) => {
             return Err(usage(match &args.resume {
@@ -183,13 +190,14 @@ fn plan_of(args: &SweepArgs) -> Result<(Plan, Shard), SweepError> {
     if args.shards.is_some() && args.shard != Some(ShardArg::Auto) {
         return Err(usage("--shards goes with --shard auto".into()));
     }
-    Ok((plan, shard))
+    Ok((plan, shard, old.is_some()))
 }
 
 fn run(args: &SweepArgs, quiet: bool) -> Result<u8, SweepError> {
-    let (plan, shard) = plan_of(args)?;
+    let (plan, shard, resuming) = plan_of(args)?;
     let threads = args.jobs.unwrap_or_else(rayon::current_num_threads);
-    if !args.allow_large {
+    // A sweep being resumed was accepted (or allowed) when it started.
+    if !args.allow_large && !resuming {
         sweep::estimate(&plan, shard, threads).check(&plan.label)?;
     }
     let out = match (&args.resume, &args.out) {

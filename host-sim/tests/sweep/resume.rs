@@ -123,6 +123,32 @@ fn a_run_limit_then_resume_gives_the_uninterrupted_bytes() {
     // Resuming a finished sweep runs nothing and changes nothing.
     assert_eq!(code(&resume(&part, &[])), Some(0));
     same_files(&whole, &part);
+    // --runs and --set are kept in sweep.json: the sweep named again without them resumes.
+    let small = tmp.path().join("small");
+    let args = [
+        file,
+        "--runs",
+        "2",
+        "--set",
+        "duration=1",
+        "--max-runs",
+        "3",
+    ];
+    assert_eq!(code(&sweep(&args, Some(&small))), Some(130));
+    let json: serde_json::Value = serde_json::from_str(&read(&small, "sweep.json")).unwrap();
+    assert_eq!(json["set"], serde_json::json!(["duration=1"]));
+    let rest = Command::new(BIN)
+        .args(["-q", "sweep", file, "--no-plots", "--resume"])
+        .arg(&small)
+        .output()
+        .unwrap();
+    assert_eq!(
+        code(&rest),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&rest.stderr)
+    );
+    assert_eq!(rows(&small).len(), 8);
     // Another sweep's folder is refused.
     let other = tmp.path().join("other.toml");
     std::fs::write(&other, TINY.replace("seed = 7", "seed = 8")).unwrap();
