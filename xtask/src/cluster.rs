@@ -96,7 +96,7 @@ pub fn run() -> Result<(), String> {
         &longer,
         &SWEEP
             .replace("runs = 3", "runs = 30")
-            .replace("duration=2", "duration=20"),
+            .replace("duration=2", "duration=30"),
     )?;
 
     // 1. The array, merged, against one unsharded run.
