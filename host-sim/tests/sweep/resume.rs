@@ -254,6 +254,49 @@ fn a_killed_sweep_is_resumed_from_its_unsorted_torn_runs_csv() {
 }
 
 #[test]
+fn merge_names_a_partial_or_killed_shard_and_accepts_it_resumed() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("tiny.toml");
+    std::fs::write(&file, TINY).unwrap();
+    let file = file.to_str().unwrap();
+    let whole = tmp.path().join("whole");
+    assert_eq!(code(&sweep(&[file], Some(&whole))), Some(0));
+    let (s1, s2, merged) = (
+        tmp.path().join("s1"),
+        tmp.path().join("s2"),
+        tmp.path().join("merged"),
+    );
+    assert_eq!(code(&sweep(&[file, "--shard", "1/2"], Some(&s1))), Some(0));
+    let cut = sweep(&[file, "--shard", "2/2", "--max-runs", "2"], Some(&s2));
+    assert_eq!(code(&cut), Some(130));
+    let merge = || {
+        Command::new(BIN)
+            .args(["-q", "sweep", "merge", "--no-plots", "--out"])
+            .arg(&merged)
+            .args([&s1, &s2])
+            .output()
+            .unwrap()
+    };
+    let m = merge();
+    let said = String::from_utf8_lossy(&m.stderr);
+    assert_eq!(code(&m), Some(130), "{said}");
+    assert!(
+        said.contains("partial: shard 2/2") && said.contains("2 of 6 runs"),
+        "{said}"
+    );
+    // Killed before its end: sweep.json as written at the start (0 finished).
+    let json = read(&s2, "sweep.json").replace("\"finished\": 2", "\"finished\": 0");
+    std::fs::write(s2.join("sweep.json"), json).unwrap();
+    let m = merge();
+    let said = String::from_utf8_lossy(&m.stderr);
+    assert_eq!(code(&m), Some(1), "{said}");
+    assert!(said.contains("has 2 runs, sweep.json says 0") && said.contains("--resume"));
+    assert_eq!(code(&resume(&s2, &[])), Some(0));
+    assert_eq!(code(&merge()), Some(0));
+    same_files(&whole, &merged);
+}
+
+#[test]
 fn more_stretches_than_open_files_are_merged_in_passes() {
     // One point, 300 runs: a runs.csv in descending run order has 300 stretches, more
     // than journal::FAN_IN, so sorting it takes two passes.
