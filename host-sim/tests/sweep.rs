@@ -4,7 +4,7 @@
 
 use host_sim::sweep::{
     aggregate, merge, quantile, run_all, run_seed, wilson, write_all, Manifest, Plan, RunRow,
-    Shard, SweepError, SweepSource,
+    Shard, ShardArg, SweepError, SweepSource,
 };
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -64,8 +64,12 @@ fn read(dir: &Path, f: &str) -> String {
 
 #[path = "sweep/cli.rs"]
 mod cli;
+#[path = "sweep/env.rs"]
+mod env;
 #[path = "sweep/errors.rs"]
 mod errors;
+#[path = "sweep/resume.rs"]
+mod resume;
 #[path = "sweep/runs.rs"]
 mod runs;
 #[path = "sweep/stats.rs"]

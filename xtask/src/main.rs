@@ -9,12 +9,15 @@
 //!   host-in-the-loop tests; then the duration of each phase.
 //! * `cargo xtask firmware-profile [REGION] [TOP]`: where the instructions of one
 //!   measured step go (by file and function).
+//! * `cargo xtask cluster-test`: a sweep as a Slurm job array on a one-node cluster
+//!   started here (installs slurm-wlm and munge if missing).
 //! * `cargo xtask stack-frames <elf> [N]`: the largest stack frames of an ELF.
 //! * `cargo xtask qemu-run <elf> [qemu args…]`: the cargo runner of the firmware (QEMU +
 //!   live defmt log).
 
 mod budgets;
 mod check;
+mod cluster;
 mod firmware_check;
 mod fwlog;
 mod profile;
@@ -44,6 +47,10 @@ enum Task {
     FirmwareCheck(CheckArgs),
     /// Run every check of the project (what scripts/test.sh runs after installing).
     Test(CheckArgs),
+    /// Run a sweep as a Slurm job array on a one-node cluster started for the test
+    /// (installs slurm-wlm and munge if missing; as root), merge it, cancel and resubmit a
+    /// task; compare with an unsharded run byte for byte.
+    ClusterTest,
     /// Where the instructions of one measured region of `measure` go: by source file, by
     /// innermost function and by outermost function of the inlining chain (needs binutils'
     /// addr2line). Report also in target/firmware-check/profile-REGION.txt.
@@ -141,6 +148,7 @@ fn main() -> ExitCode {
                 }
             })
         }),
+        Task::ClusterTest => cluster::run().map(|()| ExitCode::SUCCESS),
         Task::Test(a) => a
             .options()
             .and_then(|o| test_cmd::run(&o))

@@ -136,6 +136,10 @@ fn phases(
             )
         },
     )?;
+    phase(
+        "Slurm job array (cargo xtask cluster-test)",
+        &mut crate::cluster::run,
+    )?;
     phase("host-in-the-loop (host-sim QEMU tests)", &mut || {
         // No `-p host-sim`: the default members' feature set, as `cargo test` built it.
         tools::run(cargo().args(["test", "--test", "hil", "--", "--include-ignored"]))

@@ -41,51 +41,123 @@ pub struct PointStats {
     pub settle: Vec<Option<f64>>,
 }
 
-/// Aggregates `rows` (any order) into one [`PointStats`] per point `0..points`.
-pub fn aggregate(rows: &[RunRow], points: usize) -> Vec<PointStats> {
-    let mut by_point: Vec<Vec<&RunRow>> = vec![Vec::new(); points];
-    for r in rows {
-        if let Some(v) = by_point.get_mut(r.point) {
-            v.push(r);
+/// The runs of one point, accumulated one at a time (counts and settle times only).
+#[derive(Clone, Debug)]
+pub struct PointAcc {
+    point: usize,
+    rows: u64,
+    errors: u64,
+    counts: Vec<u64>,
+    settle: Vec<f64>,
+}
+
+impl PointAcc {
+    /// No run yet at `point`.
+    pub fn new(point: usize) -> Self {
+        Self {
+            point,
+            rows: 0,
+            errors: 0,
+            counts: vec![0; Outcome::ALL.len()],
+            settle: Vec::new(),
         }
     }
-    by_point
-        .iter()
-        .enumerate()
-        .map(|(point, rs)| {
-            let errors = rs.iter().filter(|r| r.outcome == ERROR).count() as u64;
-            let n = rs.len() as u64 - errors;
-            let fractions = Outcome::ALL
+
+    /// Counts one run (of this point).
+    pub fn add(&mut self, r: &RunRow) {
+        self.rows += 1;
+        if r.outcome == ERROR {
+            self.errors += 1;
+        }
+        if let Some(i) = Outcome::ALL.iter().position(|o| o.as_str() == r.outcome) {
+            self.counts[i] += 1;
+        }
+        if let Some(t) = r.settle_time.filter(|t| t.is_finite()) {
+            self.settle.push(t);
+        }
+    }
+
+    /// The point's statistics.
+    pub fn finish(mut self) -> PointStats {
+        let n = self.rows - self.errors;
+        let fractions = Outcome::ALL
+            .iter()
+            .zip(&self.counts)
+            .map(|(o, &count)| {
+                let (fraction, lo, hi) = wilson(count, n);
+                Fraction {
+                    outcome: o.as_str(),
+                    count,
+                    fraction,
+                    lo,
+                    hi,
+                }
+            })
+            .collect();
+        self.settle.sort_by(f64::total_cmp);
+        PointStats {
+            point: self.point,
+            n,
+            errors: self.errors,
+            fractions,
+            settled: self.settle.len() as u64,
+            settle: SETTLE_QUANTILES
                 .iter()
-                .map(|o| {
-                    let count = rs.iter().filter(|r| r.outcome == o.as_str()).count() as u64;
-                    let (fraction, lo, hi) = wilson(count, n);
-                    Fraction {
-                        outcome: o.as_str(),
-                        count,
-                        fraction,
-                        lo,
-                        hi,
-                    }
-                })
-                .collect();
-            let mut settle: Vec<f64> = rs
-                .iter()
-                .filter_map(|r| r.settle_time)
-                .filter(|t| t.is_finite())
-                .collect();
-            settle.sort_by(f64::total_cmp);
-            PointStats {
-                point,
-                n,
-                errors,
-                fractions,
-                settled: settle.len() as u64,
-                settle: SETTLE_QUANTILES
-                    .iter()
-                    .map(|(q, _)| quantile(&settle, *q))
-                    .collect(),
-            }
-        })
-        .collect()
+                .map(|(q, _)| quantile(&self.settle, *q))
+                .collect(),
+        }
+    }
+}
+
+/// Aggregates rows that come in point order (as `runs.csv` holds them), holding one
+/// point's settle times at a time.
+#[derive(Clone, Debug)]
+pub struct Sorted {
+    points: usize,
+    current: PointAcc,
+    out: Vec<PointStats>,
+}
+
+impl Sorted {
+    /// For points `0..points`.
+    pub fn new(points: usize) -> Self {
+        Self {
+            points,
+            current: PointAcc::new(0),
+            out: Vec::new(),
+        }
+    }
+
+    /// Counts the next row (its point not below the previous row's).
+    pub fn add(&mut self, r: &RunRow) {
+        while r.point > self.current.point && self.current.point < self.points {
+            let next = PointAcc::new(self.current.point + 1);
+            self.out
+                .push(std::mem::replace(&mut self.current, next).finish());
+        }
+        if r.point == self.current.point {
+            self.current.add(r);
+        }
+    }
+
+    /// One [`PointStats`] per point.
+    pub fn finish(mut self) -> Vec<PointStats> {
+        while self.out.len() < self.points {
+            let next = PointAcc::new(self.current.point + 1);
+            self.out
+                .push(std::mem::replace(&mut self.current, next).finish());
+        }
+        self.out
+    }
+}
+
+/// Aggregates `rows` (any order) into one [`PointStats`] per point `0..points`.
+pub fn aggregate(rows: &[RunRow], points: usize) -> Vec<PointStats> {
+    let mut acc: Vec<PointAcc> = (0..points).map(PointAcc::new).collect();
+    for r in rows {
+        if let Some(a) = acc.get_mut(r.point) {
+            a.add(r);
+        }
+    }
+    acc.into_iter().map(PointAcc::finish).collect()
 }

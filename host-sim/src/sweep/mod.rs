@@ -5,8 +5,12 @@
 //! * [`plan`]: checked against the base scenario (the axes and points in `axes.rs`: grid
 //!   or random), each run's seed derived from (sweep seed, point, run);
 //! * [`perturb`]: random initial shapes (as `host-sim design` makes them);
-//! * [`run`]: the runs, in parallel on rayon's pool, rows in job order;
-//! * [`shard`] and [`mod@merge`]: a deterministic share of the runs, and shares combined;
+//! * [`run`]: one run, and all of a small sweep's in memory (rows in job order);
+//! * [`mod@execute`]: the command's runs: interleaved over the points ([`order`]), streamed
+//!   to `runs.csv` and sorted at the end ([`journal`]), stopped by a signal or a run limit,
+//!   resumed ([`done`]); [`mod@estimate`]: disk and time, refused above a limit;
+//! * [`shard`] and [`mod@merge`]: a deterministic share of the runs (`K/N` or from Slurm's
+//!   or Kubernetes' variables), and shares combined;
 //! * [`mod@aggregate`] and [`stats`]: outcome fractions with 95 % Wilson intervals and
 //!   settle-time quantiles per point;
 //! * [`output`], [`runs_csv`] and [`figures`]: `sweep.json`, `runs.csv`, `points.csv`,
@@ -18,9 +22,14 @@
 pub mod aggregate;
 mod axes;
 pub mod builtin;
+pub mod done;
 pub mod error;
+pub mod estimate;
+pub mod execute;
 pub mod figures;
+pub mod journal;
 pub mod merge;
+pub mod order;
 pub mod output;
 pub mod perturb;
 pub mod plan;
@@ -34,10 +43,12 @@ pub mod table;
 pub use aggregate::{aggregate, PointStats};
 pub use builtin::{builtin_sweep, BuiltinSweep, BUILTIN_SWEEPS};
 pub use error::SweepError;
-pub use merge::merge;
+pub use estimate::{estimate, Estimate};
+pub use execute::{execute, Control, Report};
+pub use merge::{merge, merge_into};
 pub use output::{redraw, write_all, Manifest};
 pub use plan::{run_seed, Plan};
 pub use run::{run_all, run_job, Finished, RunRow};
-pub use shard::Shard;
+pub use shard::{Shard, ShardArg, ShardError};
 pub use spec::SweepSource;
 pub use stats::{quantile, wilson};

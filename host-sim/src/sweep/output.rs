@@ -24,6 +24,9 @@ pub struct Manifest {
     pub sweep: String,
     /// The base scenario (file or `builtin:<name>`).
     pub base: String,
+    /// The command line's `--set` (absent when none: `--resume` gives them again).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub set: Vec<String>,
     /// Identifies the sweep text, base text, seed and runs (shards must agree).
     pub fingerprint: String,
     /// Sweep seed.
@@ -54,11 +57,23 @@ pub struct Manifest {
 impl Manifest {
     /// The manifest of `plan`'s runs in `shard`, as far as `done` got.
     pub fn new(plan: &Plan, shard: Shard, done: &Finished) -> Self {
+        Self::of(
+            plan,
+            shard,
+            done.jobs,
+            done.rows.len() as u64,
+            done.interrupted,
+        )
+    }
+
+    /// The manifest of `plan`'s runs in `shard`: `jobs`, of which `finished` ran.
+    pub fn of(plan: &Plan, shard: Shard, jobs: u64, finished: u64, interrupted: bool) -> Self {
         Self {
             name: plan.name.clone(),
             description: plan.description.clone(),
             sweep: plan.label.clone(),
             base: plan.base.label.clone(),
+            set: plan.set.clone(),
             fingerprint: plan.fingerprint.clone(),
             seed: plan.seed,
             runs: plan.runs,
@@ -72,9 +87,9 @@ impl Manifest {
                 .collect(),
             outcomes: Outcome::ALL.iter().map(|o| o.as_str().to_owned()).collect(),
             shard: (!shard.is_all()).then(|| shard.to_string()),
-            jobs: done.jobs,
-            finished: done.rows.len() as u64,
-            interrupted: done.interrupted,
+            jobs,
+            finished,
+            interrupted,
         }
     }
 
@@ -186,36 +201,71 @@ pub fn write_all(
 ) -> Result<(Vec<PathBuf>, Vec<PointStats>), SweepError> {
     std::fs::create_dir_all(dir)
         .map_err(|e| SweepError::output(dir, format!("cannot create: {e}")))?;
-    let write_text = |name: &str, text: String| -> Result<PathBuf, SweepError> {
-        let p = dir.join(name);
-        std::fs::write(&p, text)
-            .map_err(|e| SweepError::output(&p, format!("cannot write: {e}")))?;
-        Ok(p)
-    };
-    let json_text =
-        |v: &serde_json::Value| serde_json::to_string_pretty(v).unwrap_or_default() + "\n";
-    let mut files = vec![write_text("sweep.json", json_text(&json!(m)))?];
-    let runs = dir.join("runs.csv");
-    runs_csv::write(&runs, m, rows)?;
-    files.push(runs);
+    runs_csv::write(&dir.join("runs.csv"), m, rows)?;
     let stats = aggregate(rows, m.points.len());
-    let points = dir.join("points.csv");
-    write_points_csv(&points, m, &stats)?;
-    files.push(points);
-    files.push(write_text(
-        "points.json",
-        json_text(&points_json(m, &stats)),
-    )?);
-    if plots && m.shard.is_none() {
-        files.extend(super::figures::draw(dir, m, &stats)?);
-    }
+    let files = write_summary(dir, m, &stats, plots)?;
     Ok((files, stats))
+}
+
+/// Writes `sweep.json` alone (as a sweep starts: a killed sweep leaves it for `--resume`).
+pub fn write_manifest(dir: &Path, m: &Manifest) -> Result<PathBuf, SweepError> {
+    let p = dir.join("sweep.json");
+    std::fs::write(&p, json_text(&json!(m)))
+        .map_err(|e| SweepError::output(&p, format!("cannot write: {e}")))?;
+    Ok(p)
+}
+
+fn json_text(v: &serde_json::Value) -> String {
+    serde_json::to_string_pretty(v).unwrap_or_default() + "\n"
+}
+
+/// Writes every output but `runs.csv` (already in `dir`) from the points' statistics:
+/// `sweep.json`, `points.csv`, `points.json` and, if `plots` (and not a shard), the
+/// figures. Returns the files, `runs.csv` included.
+pub fn write_summary(
+    dir: &Path,
+    m: &Manifest,
+    stats: &[PointStats],
+    plots: bool,
+) -> Result<Vec<PathBuf>, SweepError> {
+    let mut files = vec![write_manifest(dir, m)?, dir.join("runs.csv")];
+    let points = dir.join("points.csv");
+    write_points_csv(&points, m, stats)?;
+    files.push(points);
+    let p = dir.join("points.json");
+    std::fs::write(&p, json_text(&points_json(m, stats)))
+        .map_err(|e| SweepError::output(&p, format!("cannot write: {e}")))?;
+    files.push(p);
+    if plots && m.shard.is_none() {
+        files.extend(super::figures::draw(dir, m, stats)?);
+    }
+    Ok(files)
 }
 
 /// Redraws the figures of the sweep output folder `dir` from its `sweep.json` and
 /// `runs.csv` (for a shard: `sweep merge` first); returns the files.
 pub fn redraw(dir: &Path) -> Result<Vec<PathBuf>, SweepError> {
     let m = Manifest::read(dir)?;
-    let rows = runs_csv::read(&dir.join("runs.csv"), &m)?;
-    super::figures::draw(dir, &m, &aggregate(&rows, m.points.len()))
+    let path = dir.join("runs.csv");
+    let mut r = runs_csv::open(&path, &m)?;
+    let mut agg = super::aggregate::Sorted::new(m.points.len());
+    let mut last = None;
+    let mut rec = csv::StringRecord::new();
+    let mut line = 1;
+    while r
+        .read_record(&mut rec)
+        .map_err(|e| SweepError::output(&path, format!("cannot read: {e}")))?
+    {
+        line += 1;
+        let row = runs_csv::parse(&path, &m, &rec, line)?;
+        if last >= Some((row.point, row.run)) {
+            return Err(SweepError::output(
+                &path,
+                format!("line {line}: not in job order (an unfinished sweep: --resume it)"),
+            ));
+        }
+        last = Some((row.point, row.run));
+        agg.add(&row);
+    }
+    super::figures::draw(dir, &m, &agg.finish())
 }

@@ -64,6 +64,8 @@ pub struct Plan {
     pub axes: Vec<String>,
     /// Each point's value on each axis.
     pub points: Vec<Vec<toml::Value>>,
+    /// The command line's `--set` (also in `base.set`), kept for `--resume`.
+    pub set: Vec<String>,
     /// Hash of the sweep text, the base text, seed and runs (shards must agree).
     pub fingerprint: String,
 }
@@ -113,7 +115,9 @@ impl Plan {
         let source = SweepSource::resolve(arg)?;
         let mut file = source.parse()?;
         file.base.set.extend(set.iter().cloned());
-        check(&source, file, runs)
+        let mut plan = check(&source, file, runs)?;
+        plan.set = set.to_vec();
+        Ok(plan)
     }
 
     /// Parses and checks a sweep's text.
@@ -210,6 +214,7 @@ fn check(src: &SweepSource, f: SweepFile, runs: Option<u64>) -> Result<Plan, Swe
         runs,
         common_seeds: f.common_seeds,
         sampling: f.sampling,
+        set: Vec::new(),
         fingerprint: fingerprint(&[
             &src.text,
             &base.text,

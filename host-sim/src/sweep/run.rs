@@ -134,7 +134,8 @@ pub struct Finished {
     pub interrupted: bool,
 }
 
-/// Runs the jobs of `shard` on the current rayon pool (`ThreadPool::install` picks
+/// Runs the jobs of `shard` on the current rayon pool, every row in memory (for small
+/// sweeps and tests; the command streams them: [`super::execute()`]) (`ThreadPool::install` picks
 /// another). Once `stop` is set no new job starts (the running ones finish and are kept).
 /// `done` is called after each run, from the worker thread.
 pub fn run_all(

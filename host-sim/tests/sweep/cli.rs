@@ -14,7 +14,7 @@ fn command_line_runs_a_sweep_and_refuses_a_bad_one() {
     };
     assert_eq!(
         (args.sweep.as_deref(), args.shard),
-        (Some("basin"), Some(Shard { k: 2, n: 3 }))
+        (Some("basin"), Some(ShardArg::Fixed(Shard { k: 2, n: 3 })))
     );
     for bad in ["4/3", "0/3", "2", "a/b"] {
         assert!(
