@@ -70,7 +70,7 @@ impl Vehicle {
             let config = model.agent_config(i)?;
             let force = config.limits.max_force;
             let acceleration = force / agent.mass;
-            if !(acceleration <= l.max_acceleration) {
+            if acceleration.is_nan() || acceleration > l.max_acceleration {
                 return Err(format!(
                     "--vehicle: {}: agent {}: controller.max_force = {force} N on its {} kg \
                      virtual mass asks up to {acceleration:.3} m/s², more than {} reaches \
@@ -89,7 +89,7 @@ impl Vehicle {
             for step in &config.velocity_reference.steps {
                 let [x, y] = step.value;
                 let speed = x.hypot(y);
-                if !(speed <= l.max_speed) {
+                if speed.is_nan() || speed > l.max_speed {
                     return Err(format!(
                         "--vehicle: {}: velocity_reference = ({x}, {y}) from t = {} s is \
                          {speed:.3} m/s, faster than {} flies ({} m/s, {})",
