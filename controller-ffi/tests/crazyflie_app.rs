@@ -11,6 +11,8 @@
 //!   and leader offsets from the shared positions (P2P port 1): they must end on the
 //!   square of `crazyflie-app/formation.toml` within 1 cm, and the run from the C
 //!   struct (`-DFORMATION_USE_STRUCT`) must print the same lines.
+//! * `position_accuracy_table_is_measured`: `cfapp-host --position-noise` re-measures
+//!   the shape error under position noise of docs/crazyflie.md's table.
 //! * `app_stack_fits_its_task_on_the_crazyflie_mcu` (QEMU): the same program on the
 //!   STM32F405 (`c/build.sh cfapp-firmware`) measures the app's stack at init and per
 //!   tick (painted stack); `CONFIG_APP_STACKSIZE × 4` in `crazyflie-app/app-config`
@@ -164,6 +166,50 @@ fn app_code_converges_four_simulated_crazyflies() {
         from_blobs, from_struct,
         "the exported blobs and formation.c's C struct must be the same configuration"
     );
+}
+
+/// `rms=` and `max=` of `cfapp-host --position-noise SIGMA --seconds 60`.
+fn shape_error(program: &Path, sigma: &str) -> (f64, f64) {
+    let out = Command::new(program)
+        .args(["--position-noise", sigma, "--seconds", "60"])
+        .output()
+        .expect("run cfapp-host");
+    let log = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(out.status.success(), "{log}");
+    let line = log
+        .lines()
+        .find(|l| l.starts_with("CFAPP shape"))
+        .unwrap_or_else(|| panic!("no shape line:\n{log}"));
+    let field = |name: &str| -> f64 {
+        line.split_whitespace()
+            .find_map(|f| f.strip_prefix(name))
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_else(|| panic!("no {name} in {line:?}"))
+    };
+    (field("rms="), field("max="))
+}
+
+#[test]
+fn position_accuracy_table_is_measured() {
+    let program = build_with("cfapp-host", &scratch("cfapp-noise"), &[]);
+    let doc = std::fs::read_to_string(root().join("docs/crazyflie.md")).expect("docs/crazyflie.md");
+    for sigma in ["0.001", "0.01"] {
+        let (rms, max) = shape_error(&program, sigma);
+        println!("position noise {sigma} m: shape error rms {rms} m, max {max} m");
+        let row = doc
+            .lines()
+            .find(|l| l.starts_with(&format!("| {sigma} | ")))
+            .unwrap_or_else(|| panic!("docs/crazyflie.md: no row for sigma = {sigma}"));
+        let cells: Vec<f64> = row
+            .split('|')
+            .filter_map(|c| c.trim().parse().ok())
+            .collect();
+        let close = |a: f64, b: f64| (a - b).abs() <= 0.02 * b.abs();
+        assert!(
+            cells.len() == 3 && close(cells[1], rms) && close(cells[2], max),
+            "docs/crazyflie.md states {row:?}; measured rms {rms}, max {max}: update it"
+        );
+    }
 }
 
 /// `CFAPP stack init_bytes=<n> tick_bytes=<n>` of a QEMU run.

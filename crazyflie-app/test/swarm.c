@@ -31,6 +31,22 @@ static float v[SWARM_N][2];
 /* Inboxes: filled during a tick, delivered at the next one. */
 static inbox air[2][SWARM_N];
 static int current;   /* the robot whose app runs (its state estimator) */
+static float noise;   /* position noise (m), swarm_run_with() */
+static uint32_t rng = 0x9e3779b9u;
+
+/* Approximately standard normal: the sum of 12 uniforms minus 6 (xorshift32; no
+ * libm on the MCU). */
+static float gauss(void)
+{
+    float sum = 0.0f;
+    for (int k = 0; k < 12; k++) {
+        rng ^= rng << 13;
+        rng ^= rng >> 17;
+        rng ^= rng << 5;
+        sum += (float)(rng >> 8) * (1.0f / 16777216.0f);
+    }
+    return sum - 6.0f;
+}
 static int sending;   /* the inbox generation being filled */
 static uint32_t lost; /* packets that did not fit an inbox */
 
@@ -52,7 +68,9 @@ logVarId_t logGetVarId(const char *group, const char *name)
 
 float logGetFloat(logVarId_t id)
 {
-    return id < 2 ? q[current][id] : id < 4 ? v[current][id - 2] : 0.0f;
+    if (id < 2)
+        return q[current][id] + (noise > 0.0f ? noise * gauss() : 0.0f);
+    return id < 4 ? v[current][id - 2] : 0.0f;
 }
 
 /* agent_loop_send_fn: broadcast to the three others, delivered next tick. */
@@ -105,10 +123,42 @@ static int converged(float *max_speed)
     return ok;
 }
 
+static float shape_error(void)
+{
+    float worst = 0.0f;
+    for (int i = 0; i < SWARM_N; i++) {
+        float e = norm(q[i][0] - q[0][0] - square[i][0], q[i][1] - q[0][1] - square[i][1]);
+        if (e > worst)
+            worst = e;
+    }
+    return worst;
+}
+
+static void run(uint32_t max_ticks, int stop_when_converged, swarm_result *r,
+                swarm_shape_error *error);
+
 int swarm_run(swarm_result *r)
 {
+    run(SWARM_MAX_TIME_S * 100u, 1, r, NULL);
+    return r->converged;
+}
+
+void swarm_run_with(const swarm_options *options, swarm_result *r, swarm_shape_error *error)
+{
+    noise = options->position_noise;
+    if (options->seconds == 0) {
+        run(SWARM_MAX_TIME_S * 100u, 1, r, error);
+        return;
+    }
+    run(options->seconds * 100u, 0, r, error);
+}
+
+static void run(uint32_t max_ticks, int stop_when_converged, swarm_result *r,
+                swarm_shape_error *error)
+{
     __builtin_memset(r, 0, sizeof *r);
-    uint32_t max_ticks = SWARM_MAX_TIME_S * 100u;
+    float sum_sq = 0.0f, worst = 0.0f;
+    uint32_t samples = 0;
     uint32_t tick = 0;
     for (; tick < max_ticks; tick++) {
         float now = (float)tick * TICK_S;
@@ -136,8 +186,14 @@ int swarm_run(swarm_result *r)
                     v[i][k] += h / SWARM_TAU * (loops[i].setpoint[k] - v[i][k]);
                     q[i][k] += h * v[i][k];
                 }
+        if (tick + 1000u >= max_ticks) { /* the last 10 s */
+            float e = shape_error();
+            sum_sq += e * e;
+            worst = e > worst ? e : worst;
+            samples++;
+        }
         float unused;
-        if (tick > 100u && converged(&unused)) {
+        if (stop_when_converged && tick > 100u && converged(&unused)) {
             tick++;
             break;
         }
@@ -151,7 +207,10 @@ int swarm_run(swarm_result *r)
     }
     float unused;
     r->converged = converged(&unused) && r->error == PH_OK && lost == 0;
-    return r->converged;
+    if (error != NULL) {
+        error->rms = samples > 0 ? __builtin_sqrtf(sum_sq / (float)samples) : shape_error();
+        error->max = samples > 0 ? worst : shape_error();
+    }
 }
 
 void swarm_print(const swarm_result *r)

@@ -40,11 +40,30 @@ typedef struct {
     ph_status error;           /* first init or step error (PH_OK if none) */
 } swarm_result;
 
+/* Position accuracy study (host only): Gaussian noise of this standard deviation
+ * (m) on every position the state estimator gives (own position, and through the
+ * position packets the neighbours'), and a run of fixed length. */
+typedef struct {
+    float position_noise; /* m, 0: exact */
+    uint32_t seconds;     /* 0: until converged or SWARM_MAX_TIME_S */
+} swarm_options;
+
+/* RMS and largest distance of q_i - q_1 from the square over the last
+ * 10 s of a fixed-length run (m). */
+typedef struct {
+    float rms;
+    float max;
+} swarm_shape_error;
+
 /* Builds the four agents (agent_loop_init, as appMain does). */
 ph_status swarm_init(void);
 
 /* Runs them until converged or SWARM_MAX_TIME_S. Returns result->converged. */
 int swarm_run(swarm_result *result);
+
+/* A fixed-length run with options (host): the shape error of its last 10 s. */
+void swarm_run_with(const swarm_options *options, swarm_result *result,
+                    swarm_shape_error *error);
 
 /* Prints "DEMO final t=... rel=..." (the format of paper_demo.h) and
  * "CFAPP result converged=... t=... ticks=... safe_ticks=... max_setpoint_speed=... error=...". */
