@@ -40,7 +40,7 @@ typedef struct {
 /* Builds agent `id` in memory[0..size] (PH_AGENT_SIZE bytes, PH_AGENT_ALIGN-aligned):
  * from its blob (formation_blob()), or with -DFORMATION_USE_STRUCT from
  * formation_config() (the ph_config in `scratch`, which the caller keeps static:
- * it is 620 bytes). */
+ * it is 620 bytes; unused, and may be NULL, with blobs). */
 ph_status agent_loop_init(agent_loop *loop, uint8_t *memory, size_t size, uint8_t id,
                           ph_config *scratch);
 

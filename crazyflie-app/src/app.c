@@ -51,7 +51,12 @@ typedef struct {
 /* The agent lives here (PH_AGENT_SIZE bytes of .bss, 3,404 on the Crazyflie). */
 static uint8_t agent_memory[PH_AGENT_SIZE] __attribute__((aligned(PH_AGENT_ALIGN)));
 static agent_loop loop;
-static ph_config scratch; /* only with -DFORMATION_USE_STRUCT, only at init */
+#ifdef FORMATION_USE_STRUCT
+static ph_config scratch_config; /* 620 bytes, only read at init */
+#define SCRATCH (&scratch_config)
+#else
+#define SCRATCH NULL /* the configuration is this agent's blob */
+#endif
 static P2PPacket tx_packet;
 static QueueHandle_t rx_queue;
 static volatile uint32_t rx_dropped; /* queue full */
@@ -125,7 +130,7 @@ void appMain(void)
         return;
     }
     /* The app's stack peak (CONFIG_APP_STACKSIZE in app-config; docs/c-api.md). */
-    ph_status s = agent_loop_init(&loop, agent_memory, sizeof agent_memory, id, &scratch);
+    ph_status s = agent_loop_init(&loop, agent_memory, sizeof agent_memory, id, SCRATCH);
     if (s != PH_OK) {
         DEBUG_PRINT("no formation agent %u: %s\n", (unsigned)id, ph_status_str(s));
         return;
