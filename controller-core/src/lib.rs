@@ -33,6 +33,7 @@
 )]
 #![deny(missing_docs)]
 
+pub mod actuate;
 pub mod agent;
 pub mod config;
 pub mod crc16;

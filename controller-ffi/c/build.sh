@@ -4,6 +4,12 @@
 #   controller-ffi/c/build.sh host OUT_DIR       OUT_DIR/c-host-demo (system cc)
 #   controller-ffi/c/build.sh firmware OUT_DIR   OUT_DIR/c-firmware.elf (arm-none-eabi-gcc,
 #                                                STM32F405 / QEMU netduinoplus2)
+#   controller-ffi/c/build.sh cfapp-host OUT_DIR       OUT_DIR/cfapp-host: the Crazyflie
+#                                                app's code (crazyflie-app/src, its blobs)
+#                                                driving four simulated vehicles
+#   controller-ffi/c/build.sh cfapp-firmware OUT_DIR   OUT_DIR/cfapp-firmware.elf: the
+#                                                same on the STM32F405 (stack figures)
+#   (CFAPP_CFLAGS: extra flags for the app, e.g. -DFORMATION_USE_STRUCT)
 #
 # The staticlib: for the firmware `cargo rustc -p controller-ffi --release --lib
 # --target thumbv7em-none-eabihf --crate-type staticlib` (the staticlib alone: cargo
@@ -32,6 +38,15 @@ mkdir -p "$out"
 cflags=(-std=gnu11 -O2 -g -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes
     -fno-math-errno -I"$root/controller-ffi/include" -I"$here/demo")
 demo=("$here/demo/paper_demo.c" "$here/demo/print.c")
+# The Crazyflie app's portable code against the firmware stub (crazyflie-app/test).
+app=$root/crazyflie-app
+read -r -a app_flags <<<"${CFAPP_CFLAGS:-}"
+app_cflags=(-I"$app/src" -I"$app/src/blobs" -I"$app/stub" -I"$app/test" "${app_flags[@]}")
+app_src=("$app/src/agent_loop.c" "$app/src/formation.c" "$app/src/blobs/ph_blobs.c"
+    "$app/test/swarm.c" "$here/demo/print.c")
+arm_flags=(-mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard
+    -ffreestanding -ffunction-sections -fdata-sections -nostdlib
+    -T "$here/firmware/stm32f405.ld" -Wl,--gc-sections -Wl,-z,noexecstack)
 
 case $what in
 host)
@@ -59,8 +74,26 @@ firmware)
         "$lib" -lgcc
     echo "$out/c-firmware.elf"
     ;;
+cfapp-host)
+    (cd "$root" && "$cargo" build -q -p controller-ffi --release --lib)
+    lib=$target_dir/release/libcontroller_ffi.a
+    "${CC:-cc}" "${cflags[@]}" "${app_cflags[@]}" -o "$out/cfapp-host" \
+        "$app/test/host_main.c" "${app_src[@]}" \
+        "$lib" -lgcc_s -lutil -lrt -lpthread -lm -ldl
+    echo "$out/cfapp-host"
+    ;;
+cfapp-firmware)
+    (cd "$root" && "$cargo" rustc -q -p controller-ffi --release --lib \
+        --target thumbv7em-none-eabihf --crate-type staticlib)
+    lib=$target_dir/thumbv7em-none-eabihf/release/libcontroller_ffi.a
+    "${ARM_CC:-arm-none-eabi-gcc}" "${cflags[@]}" "${app_cflags[@]}" -I"$here/firmware" \
+        "${arm_flags[@]}" -Wl,-Map="$out/cfapp-firmware.map" -o "$out/cfapp-firmware.elf" \
+        "$here/firmware/startup.c" "$app/test/qemu_main.c" "${app_src[@]}" \
+        "$lib" -lgcc
+    echo "$out/cfapp-firmware.elf"
+    ;;
 *)
-    echo "$0: unknown target '$what' (host or firmware)" >&2
+    echo "$0: unknown target '$what' (host, firmware, cfapp-host or cfapp-firmware)" >&2
     exit 2
     ;;
 esac

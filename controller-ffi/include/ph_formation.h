@@ -459,6 +459,34 @@ typedef uint8_t ph_leader_role;
 typedef struct ph_agent ph_agent;
 
 /**
+ * The virtual plant `m v̇ = −D^r v + U` (SPEC S1) and its velocity setpoint. Fill it
+ * with `ph_actuator_init`; set `has_command = 0` to make the next `ph_actuate` start
+ * again from the measured velocity (e.g. when the formation takes over the vehicle).
+ */
+typedef struct {
+  /**
+   * Virtual mass `m` (kg, > 0).
+   */
+  float mass;
+  /**
+   * Friction `D^r` per axis (N s/m, ≥ 0): the agent's `ph_config.friction`.
+   */
+  float friction[2];
+  /**
+   * Largest setpoint speed (m/s, > 0; `INFINITY` for none): the vehicle's limit.
+   */
+  float max_speed;
+  /**
+   * The current velocity setpoint (m/s, world frame), valid when `has_command`.
+   */
+  float command[2];
+  /**
+   * 1 once `ph_actuate` has produced a setpoint.
+   */
+  uint8_t has_command;
+} ph_actuator;
+
+/**
  * One controlled angle `α = (apex; v, w)` of a triangle.
  */
 typedef struct {
@@ -869,6 +897,37 @@ extern "C" {
 #endif // __cplusplus
 
 /**
+ * Fills `*actuator` for `agent`: mass `mass`, the friction `D^r` of the agent's
+ * configuration (so that the controller cancels the friction the plant has), speed
+ * limit `max_speed`, no setpoint yet. `PH_ERR_ARGUMENT` for a mass that is not finite
+ * and positive or a `max_speed` that is NaN or not positive.
+ *
+ * # Safety
+ * `actuator` is NULL or writable; `agent` as for `ph_stats`.
+ */
+ph_status ph_actuator_init(ph_actuator *actuator,
+                           const ph_agent *agent,
+                           float mass,
+                           float max_speed);
+
+/**
+ * One control period: integrates S1 from the previous setpoint (the first time from
+ * `velocity[0..2]`, the vehicle's measured velocity) under `force[0..2]` (the
+ * `ph_output.force` of this tick) for `dt` seconds, and writes the new setpoint to
+ * `setpoint[0..2]` and `actuator->command`. `PH_ERR_ARGUMENT` (nothing written) for
+ * an actuator whose parameters `ph_actuator_init` would refuse.
+ *
+ * # Safety
+ * `actuator` is NULL or points to a `ph_actuator`; `force` and `velocity` are NULL or
+ * point to 2 readable floats; `setpoint` is NULL or points to 2 writable floats.
+ */
+ph_status ph_actuate(ph_actuator *actuator,
+                     const float *force,
+                     const float *velocity,
+                     float dt,
+                     float *setpoint);
+
+/**
  * The ABI version of this library (`PH_ABI_VERSION` of the header it was built with).
  */
 uint32_t ph_abi_version(void);
@@ -1019,6 +1078,15 @@ ph_status ph_owned_estimates(const ph_agent *agent,
  * As `ph_owned_estimates`.
  */
 ph_status ph_neighbours(const ph_agent *agent, uint8_t *out, size_t capacity, size_t *count);
+
+/**
+ * The leader partner of this agent: `*is_leader` = 1 and `*partner` its id for the
+ * two leaders (SPEC S11), else `*is_leader` = 0 (and `*partner` untouched).
+ *
+ * # Safety
+ * `agent` as for `ph_stats`; `partner` and `is_leader` are NULL or writable.
+ */
+ph_status ph_leader_partner(const ph_agent *agent, uint8_t *partner, uint8_t *is_leader);
 
 /**
  * Bare-metal builds: called if the library ever panics, before it traps (`udf`,

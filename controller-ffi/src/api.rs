@@ -24,7 +24,7 @@ use controller_core::{BearingMeasurement, Measurements, Vec2};
 pub type ph_send_fn = Option<unsafe extern "C" fn(ctx: *mut c_void, bytes: *const u8, len: usize)>;
 
 /// `PH_ERR_NULL` for NULL, `PH_ERR_ARGUMENT` for a misaligned pointer.
-fn check<T>(ptr: *const T) -> Result<(), ph_status> {
+pub(crate) fn check<T>(ptr: *const T) -> Result<(), ph_status> {
     if ptr.is_null() {
         Err(ph_status::PH_ERR_NULL)
     } else if !ptr.is_aligned() {
@@ -38,7 +38,7 @@ fn check<T>(ptr: *const T) -> Result<(), ph_status> {
 ///
 /// # Safety
 /// A non-null `ptr` points to a valid `T` for `'a`.
-unsafe fn input<'a, T>(ptr: *const T) -> Result<&'a T, ph_status> {
+pub(crate) unsafe fn input<'a, T>(ptr: *const T) -> Result<&'a T, ph_status> {
     check(ptr)?;
     // SAFETY: non-null and aligned; valid per the caller.
     Ok(unsafe { &*ptr })
@@ -49,7 +49,7 @@ unsafe fn input<'a, T>(ptr: *const T) -> Result<&'a T, ph_status> {
 ///
 /// # Safety
 /// A non-null `ptr` is valid for writes of a `T`.
-unsafe fn write<T>(ptr: *mut T, value: T) -> Result<(), ph_status> {
+pub(crate) unsafe fn write<T>(ptr: *mut T, value: T) -> Result<(), ph_status> {
     check(ptr)?;
     // SAFETY: non-null and aligned; valid for writes per the caller.
     unsafe { ptr.write(value) };
@@ -100,7 +100,7 @@ unsafe fn set_optional<T>(ptr: *mut T, value: T) {
     let _ = unsafe { write(ptr, value) };
 }
 
-fn status(r: Result<(), ph_status>) -> ph_status {
+pub(crate) fn status(r: Result<(), ph_status>) -> ph_status {
     match r {
         Ok(()) => ph_status::PH_OK,
         Err(e) => e,
@@ -445,6 +445,35 @@ pub unsafe extern "C" fn ph_neighbours(
             a.neighbours().all(put)
         })
     }
+}
+
+/// The leader partner of this agent: `*is_leader` = 1 and `*partner` its id for the
+/// two leaders (SPEC S11), else `*is_leader` = 0 (and `*partner` untouched).
+///
+/// # Safety
+/// `agent` as for `ph_stats`; `partner` and `is_leader` are NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ph_leader_partner(
+    agent: *const ph_agent,
+    partner: *mut u8,
+    is_leader: *mut u8,
+) -> ph_status {
+    // SAFETY: per this function's contract.
+    let r = unsafe { storage::agent_ref(agent) }.and_then(|a| {
+        check(partner.cast_const())?;
+        check(is_leader.cast_const())?;
+        match &a.config().leader {
+            Some(l) => {
+                // SAFETY: per this function's contract.
+                unsafe { write(partner, l.partner) }?;
+                // SAFETY: as above.
+                unsafe { write(is_leader, 1) }
+            }
+            // SAFETY: as above.
+            None => unsafe { write(is_leader, 0) },
+        }
+    });
+    status(r)
 }
 
 /// Fills `out[0..capacity]` with what `each` passes to `put` (which returns `false`

@@ -40,6 +40,7 @@
 #[cfg(not(target_os = "none"))]
 extern crate std;
 
+pub mod actuate;
 pub mod api;
 pub mod blob;
 pub mod config;
@@ -51,6 +52,7 @@ pub mod status;
 pub mod storage;
 pub mod tick;
 
+pub use actuate::ph_actuator;
 pub use blob::{decode_blob, encode_blob, BlobError};
 pub use config::{ph_config, to_core};
 pub use status::ph_status;

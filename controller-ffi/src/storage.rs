@@ -107,7 +107,7 @@ unsafe fn build(
     config: impl FnOnce() -> Result<FfiConfig, ph_status>,
     dst: *mut FfiAgent,
 ) -> Result<(), ph_status> {
-    let built = FfiAgent::new(config()?);
+    let built = FfiAgent::new(configure(config)?);
     match &built {
         Ok(agent) => {
             // SAFETY: `dst` is valid for writes (caller); this is a bitwise move of
@@ -118,6 +118,16 @@ unsafe fn build(
         }
         Err(e) => Err((*e).into()),
     }
+}
+
+/// `config()` out of line: its conversion's temporaries (a blob's decoder, the C
+/// struct's mapping) live in a frame of their own that is gone before `Agent::new`
+/// runs, instead of in `build`'s frame underneath it.
+#[inline(never)]
+fn configure(
+    config: impl FnOnce() -> Result<FfiConfig, ph_status>,
+) -> Result<FfiConfig, ph_status> {
+    config()
 }
 
 /// The agent in `memory`, if it holds one.

@@ -1,22 +1,45 @@
-//! `crazyflie-app/src/*.c` compile against the C API and the header-only stub of the
-//! Crazyflie firmware (`crazyflie-app/stub/`), warnings as errors: with the host C
-//! compiler (`-fsyntax-only`, always) and for the Crazyflie's Cortex-M4F with
-//! `arm-none-eabi-gcc -c` (ignored by default: needs scripts/firmware-deps.sh). The app
-//! cannot be built or linked against the real firmware here (crazyflie-app/README.md).
+//! The Crazyflie app (`crazyflie-app/`): its C compiles, its own per-tick code
+//! converges four simulated Crazyflies, and its stack fits `CONFIG_APP_STACKSIZE`.
+//!
+//! * `app_compiles_*`: `crazyflie-app/src/*.c` against the C API and the header-only
+//!   stub of the firmware (`crazyflie-app/stub/`), warnings as errors, with the host C
+//!   compiler (`-fsyntax-only`) and for the Cortex-M4F (`arm-none-eabi-gcc -c`).
+//! * `app_code_converges_four_simulated_crazyflies`: `agent_loop.c` + `formation.c` +
+//!   the exported blobs (`crazyflie-app/src/blobs`, loaded by agent id) run four agents
+//!   against simulated velocity-tracking vehicles and a broadcast radio
+//!   (`crazyflie-app/test/swarm.c`, built by `c/build.sh cfapp-host`), with bearings
+//!   and leader offsets from the shared positions (P2P port 1): they must end on the
+//!   square of `crazyflie-app/formation.toml` within 1 cm, and the run from the C
+//!   struct (`-DFORMATION_USE_STRUCT`) must print the same lines.
+//! * `position_accuracy_table_is_measured`: `cfapp-host --position-noise` re-measures
+//!   the shape error under position noise of docs/crazyflie.md's table.
+//! * `app_stack_fits_its_task_on_the_crazyflie_mcu` (QEMU): the same program on the
+//!   STM32F405 (`c/build.sh cfapp-firmware`) measures the app's stack at init and per
+//!   tick (painted stack); `CONFIG_APP_STACKSIZE × 4` in `crazyflie-app/app-config`
+//!   must be at least 1.25 × the peak, and docs/c-api.md must state the peaks.
+//!
+//! The ignored tests need `arm-none-eabi-gcc` and `qemu-system-arm`
+//! (scripts/firmware-deps.sh): `cargo test -p controller-ffi --test crazyflie_app --
+//! --include-ignored`.
 
 mod common;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use common::{build_with, max_difference, parse_demo_final, root, scratch};
+
 fn sources() -> Vec<PathBuf> {
-    let dir = common::root().join("crazyflie-app/src");
-    vec![dir.join("app.c"), dir.join("formation.c")]
+    let dir = root().join("crazyflie-app/src");
+    ["app.c", "agent_loop.c", "formation.c", "blobs/ph_blobs.c"]
+        .iter()
+        .map(|f| dir.join(f))
+        .collect()
 }
 
 fn compile(compiler: &str, extra: &[&str]) {
-    let root = common::root();
-    let out = common::scratch(&format!("crazyflie-app-{compiler}"));
+    let root = root();
+    let out = scratch(&format!("crazyflie-app-{compiler}"));
     for src in sources() {
         let obj = out.join(src.with_extension("o").file_name().expect("file name"));
         let run = Command::new(compiler)
@@ -24,6 +47,10 @@ fn compile(compiler: &str, extra: &[&str]) {
             .args(["-Wstrict-prototypes", "-Wmissing-prototypes"])
             .arg(format!("-I{}", root.join("crazyflie-app/stub").display()))
             .arg(format!("-I{}", root.join("crazyflie-app/src").display()))
+            .arg(format!(
+                "-I{}",
+                root.join("crazyflie-app/src/blobs").display()
+            ))
             .arg(format!(
                 "-I{}",
                 root.join("controller-ffi/include").display()
@@ -47,6 +74,7 @@ fn compile(compiler: &str, extra: &[&str]) {
 fn app_compiles_with_the_host_compiler() {
     let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
     compile(&cc, &["-fsyntax-only"]);
+    compile(&cc, &["-fsyntax-only", "-DFORMATION_USE_STRUCT"]);
 }
 
 #[test]
@@ -64,4 +92,199 @@ fn app_compiles_for_the_crazyflie_mcu() {
             "-mfloat-abi=hard",
         ],
     );
+}
+
+/// The square 1-2-4-3 of crazyflie-app/formation.toml as `q_i − q_1` (z* = (1, −1)).
+const ROOM_SQUARE: [[f64; 2]; 4] = [[0.0, 0.0], [-1.0, 1.0], [1.0, 1.0], [0.0, 2.0]];
+/// Largest distance of a final `q_i − q_1` from the square (m).
+const ROOM_TOLERANCE: f64 = 1e-2;
+
+/// Runs a built swarm program (directly, or under QEMU for an ELF): its output.
+fn run(program: &Path) -> String {
+    let mut cmd = if program.extension().is_some_and(|e| e == "elf") {
+        let mut c = Command::new("timeout");
+        c.args([
+            "-k",
+            "5",
+            "120",
+            "qemu-system-arm",
+            "-machine",
+            "netduinoplus2",
+        ])
+        .args(["-display", "none", "-monitor", "none", "-serial", "null"])
+        .args(["-semihosting-config", "enable=on,target=native", "-kernel"])
+        .arg(program);
+        c
+    } else {
+        Command::new(program)
+    };
+    let out = cmd
+        .stdin(std::process::Stdio::null())
+        .output()
+        .expect("run the swarm program");
+    let mut log = String::from_utf8_lossy(&out.stdout).into_owned();
+    log.push_str(&String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}: {}\n{log}",
+        program.display(),
+        out.status
+    );
+    log
+}
+
+/// Checks that the run converged on the room's square; returns its `CFAPP result` line.
+fn converged(log: &str) -> String {
+    assert!(log.contains("CFAPP result converged=true"), "{log}");
+    assert!(log.contains(" lost=0 error=PH_OK"), "{log}");
+    let (t, rel) = parse_demo_final(log).unwrap_or_else(|e| panic!("{e}\n{log}"));
+    let d = max_difference(&rel, &ROOM_SQUARE).unwrap_or_else(|e| panic!("{e}\n{log}"));
+    println!("app code: converged at t = {t} s, {d:.2e} m from the square");
+    assert!(
+        d <= ROOM_TOLERANCE,
+        "final shape {rel:?}: {d} m from the square\n{log}"
+    );
+    log.lines()
+        .find(|l| l.starts_with("CFAPP result"))
+        .unwrap_or_default()
+        .to_string()
+}
+
+#[test]
+fn app_code_converges_four_simulated_crazyflies() {
+    let blob = build_with("cfapp-host", &scratch("cfapp-blob"), &[]);
+    let from_blobs = run(&blob);
+    let line = converged(&from_blobs);
+    println!("{line}");
+    let strukt = build_with(
+        "cfapp-host",
+        &scratch("cfapp-struct"),
+        &[("CFAPP_CFLAGS", "-DFORMATION_USE_STRUCT")],
+    );
+    let from_struct = run(&strukt);
+    assert_eq!(
+        from_blobs, from_struct,
+        "the exported blobs and formation.c's C struct must be the same configuration"
+    );
+}
+
+/// `rms=` and `max=` of `cfapp-host --position-noise SIGMA --seconds 60`.
+fn shape_error(program: &Path, sigma: &str) -> (f64, f64) {
+    let out = Command::new(program)
+        .args(["--position-noise", sigma, "--seconds", "60"])
+        .output()
+        .expect("run cfapp-host");
+    let log = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(out.status.success(), "{log}");
+    let line = log
+        .lines()
+        .find(|l| l.starts_with("CFAPP shape"))
+        .unwrap_or_else(|| panic!("no shape line:\n{log}"));
+    let field = |name: &str| -> f64 {
+        line.split_whitespace()
+            .find_map(|f| f.strip_prefix(name))
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_else(|| panic!("no {name} in {line:?}"))
+    };
+    (field("rms="), field("max="))
+}
+
+#[test]
+fn position_accuracy_table_is_measured() {
+    let program = build_with("cfapp-host", &scratch("cfapp-noise"), &[]);
+    let doc = std::fs::read_to_string(root().join("docs/crazyflie.md")).expect("docs/crazyflie.md");
+    for sigma in ["0.001", "0.01"] {
+        let (rms, max) = shape_error(&program, sigma);
+        println!("position noise {sigma} m: shape error rms {rms} m, max {max} m");
+        let row = doc
+            .lines()
+            .find(|l| l.starts_with(&format!("| {sigma} | ")))
+            .unwrap_or_else(|| panic!("docs/crazyflie.md: no row for sigma = {sigma}"));
+        let cells: Vec<f64> = row
+            .split('|')
+            .filter_map(|c| c.trim().parse().ok())
+            .collect();
+        let close = |a: f64, b: f64| (a - b).abs() <= 0.02 * b.abs();
+        assert!(
+            cells.len() == 3 && close(cells[1], rms) && close(cells[2], max),
+            "docs/crazyflie.md states {row:?}; measured rms {rms}, max {max}: update it"
+        );
+    }
+}
+
+/// `CFAPP stack init_bytes=<n> tick_bytes=<n>` of a QEMU run.
+fn stack(log: &str) -> (u64, u64) {
+    let line = log
+        .lines()
+        .find(|l| l.starts_with("CFAPP stack"))
+        .unwrap_or_else(|| panic!("no stack line:\n{log}"));
+    let field = |name: &str| -> u64 {
+        line.split_whitespace()
+            .find_map(|f| f.strip_prefix(name))
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_else(|| panic!("no {name} in {line:?}"))
+    };
+    (field("init_bytes="), field("tick_bytes="))
+}
+
+/// `CONFIG_APP_STACKSIZE` of crazyflie-app/app-config, in words.
+pub fn app_stack_words() -> u64 {
+    let config = std::fs::read_to_string(root().join("crazyflie-app/app-config"))
+        .expect("read crazyflie-app/app-config");
+    config
+        .lines()
+        .find_map(|l| l.strip_prefix("CONFIG_APP_STACKSIZE="))
+        .and_then(|v| v.trim().parse().ok())
+        .expect("CONFIG_APP_STACKSIZE=<words> in crazyflie-app/app-config")
+}
+
+/// `1,234` → 1234 (the docs' thousands separator).
+fn number(text: &str) -> Option<u64> {
+    text.replace([',', ' '], "").parse().ok()
+}
+
+#[test]
+#[ignore = "needs arm-none-eabi-gcc and qemu-system-arm (scripts/firmware-deps.sh)"]
+fn app_stack_fits_its_task_on_the_crazyflie_mcu() {
+    let mut peak = 0;
+    let mut figures = Vec::new();
+    for (name, flags) in [("blob", ""), ("struct", "-DFORMATION_USE_STRUCT")] {
+        let elf = build_with(
+            "cfapp-firmware",
+            &scratch(&format!("cfapp-fw-{name}")),
+            &[("CFAPP_CFLAGS", flags)],
+        );
+        let log = run(&elf);
+        converged(&log);
+        let (init, tick) = stack(&log);
+        println!("app stack from the {name}: init {init} bytes, tick {tick} bytes");
+        peak = peak.max(init).max(tick);
+        figures.push((name, init, tick));
+    }
+    let words = app_stack_words();
+    println!(
+        "CONFIG_APP_STACKSIZE = {words} words = {} bytes; peak {peak} bytes: x{:.3}",
+        words * 4,
+        (words * 4) as f64 / peak as f64
+    );
+    assert!(
+        words * 4 * 4 >= peak * 5,
+        "CONFIG_APP_STACKSIZE = {words} words ({} bytes) is less than 1.25 x the app's \
+         stack peak of {peak} bytes: raise it to at least {} words in crazyflie-app/app-config",
+        words * 4,
+        (peak * 5).div_ceil(16)
+    );
+    // docs/c-api.md states the figures this test measures.
+    let doc = std::fs::read_to_string(root().join("docs/c-api.md")).expect("docs/c-api.md");
+    for (name, init, tick) in figures {
+        let row = doc
+            .lines()
+            .find(|l| l.starts_with(&format!("| Crazyflie app, configuration from the {name} |")))
+            .unwrap_or_else(|| panic!("docs/c-api.md: no stack row for the app from the {name}"));
+        let cells: Vec<Option<u64>> = row.split('|').map(|c| number(c.trim())).collect();
+        assert!(
+            cells.contains(&Some(init)) && cells.contains(&Some(tick)),
+            "docs/c-api.md states {row:?}; measured init {init}, tick {tick} bytes: update it"
+        );
+    }
 }

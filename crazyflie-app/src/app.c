@@ -1,19 +1,19 @@
 /*
  * ph-formation on a Crazyflie 2.x: an out-of-tree app running ONE agent of the
  * angle-based port-Hamiltonian formation controller through its C API
- * (controller-ffi/include/ph_formation.h, docs/c-api.md).
+ * (controller-ffi/include/ph_formation.h, docs/c-api.md, docs/crazyflie.md).
  *
- * Every 10 ms (100 Hz):
- *   1. ph_receive() every P2P frame heard since the last tick (queued by the radio
- *      callback, which runs in the radio link's task);
- *   2. read the own measurements (formation.c: bearings, velocity, leader offset);
- *   3. ph_step() -> force U (N, world frame) and status;
- *   4. turn U into a velocity setpoint for the Crazyflie's own position/velocity
- *      controller (the formation's plant model, see actuate());
- *   5. ph_frames_cb() -> radiolinkSendP2PPacketBroadcast() for each frame.
+ * This file is the FreeRTOS and Crazyflie glue; the per-tick logic is
+ * agent_loop.c (tested on the host and under QEMU). Every 10 ms (100 Hz):
+ *   1. agent_loop_receive() every P2P packet heard since the last tick (queued by
+ *      the radio callback, which runs in the radio link's task): the formation's
+ *      frames (port 0) and the neighbours' positions (port 1);
+ *   2. agent_loop_tick(): sensors (formation.c) -> ph_step() -> ph_actuate(), then
+ *      this tick's frames and own position -> radiolinkSendP2PPacketBroadcast();
+ *   3. the velocity setpoint -> commanderSetSetpoint().
  *
  * The agent's id is the last byte of the radio address (E7E7E7E701 is agent 1);
- * its configuration comes from formation.c.
+ * its configuration is its blob in blobs/ph_blobs.c (host-sim export --all).
  */
 #include <stdbool.h>
 #include <stddef.h>
@@ -30,88 +30,94 @@
 #define DEBUG_MODULE "PHFORM"
 #include "debug.h"
 
-#include "formation.h"
+#include "agent_loop.h"
 #include "ph_formation.h"
 
 #define CONTROL_PERIOD_MS 10u /* 100 Hz */
-/* P2P port of the formation's frames. The P2P API does not filter by port yet
- * and advises 0; every frame still carries the core's version and CRC, and
- * ph_receive() rejects anything else (counted in ph_stats()). */
-#define PH_P2P_PORT 0u
-/* Frames buffered between two ticks (the neighbours send one to two each). */
-#define RX_QUEUE_LEN 16u
-/* Our P2P payload must fit one P2P packet. */
+/* Packets buffered between two ticks: each neighbour sends one or two frames and one
+ * position packet per tick. */
+#define RX_QUEUE_LEN 24u
+/* A frame must fit one P2P packet (crazyflie-firmware src/hal/interface/radiolink.h:
+ * P2P_MAX_DATA_SIZE 60). */
 _Static_assert(PH_MAX_FRAME_LEN <= P2P_MAX_DATA_SIZE, "a frame must fit a P2P packet");
+_Static_assert(FORMATION_POSITION_LEN <= P2P_MAX_DATA_SIZE, "a position must fit a P2P packet");
 
 typedef struct {
+    uint8_t port;
     uint8_t len;
     uint8_t bytes[PH_MAX_FRAME_LEN];
-} rx_frame;
+} rx_packet;
 
-/* The agent lives here (PH_AGENT_SIZE bytes of .bss, about 3 KiB). */
+/* The agent lives here (PH_AGENT_SIZE bytes of .bss, 3,404 on the Crazyflie). */
 static uint8_t agent_memory[PH_AGENT_SIZE] __attribute__((aligned(PH_AGENT_ALIGN)));
-static ph_agent *const agent = (ph_agent *)agent_memory;
-static ph_config config; /* static: about 0.6 KiB, only needed at init */
+static agent_loop loop;
+#ifdef FORMATION_USE_STRUCT
+static ph_config scratch_config; /* 620 bytes, only read at init */
+#define SCRATCH (&scratch_config)
+#else
+#define SCRATCH NULL /* the configuration is this agent's blob */
+#endif
+static P2PPacket tx_packet;
 static QueueHandle_t rx_queue;
 static volatile uint32_t rx_dropped; /* queue full */
 
-static void copy(uint8_t *dst, const uint8_t *src, size_t n)
-{
-    for (size_t k = 0; k < n; k++)
-        dst[k] = src[k];
-}
-
-/* Radio link task: queue the frame for the app task (the agent is not
- * thread-safe: only the app task touches it). */
+/* Radio link task: queue the packet for the app task (the agent is not thread-safe:
+ * only the app task touches it). The P2P API does not filter ports
+ * (crazyflie-firmware docs/functional-areas/p2p_api.md): agent_loop_receive does. */
 static void p2p_received(P2PPacket *p)
 {
-    rx_frame f;
-    if (p->port != PH_P2P_PORT || p->size == 0 || p->size > PH_MAX_FRAME_LEN)
+    rx_packet f;
+    if (p->size == 0 || p->size > PH_MAX_FRAME_LEN)
         return;
+    f.port = p->port;
     f.len = p->size;
-    copy(f.bytes, p->data, p->size);
+    __builtin_memcpy(f.bytes, p->data, p->size);
     if (xQueueSend(rx_queue, &f, 0) != pdTRUE)
         rx_dropped++;
 }
 
-/* ph_send_fn: one frame to the P2P broadcast. */
-static void p2p_send(void *ctx, const uint8_t *bytes, size_t len)
+/* agent_loop_send_fn: one packet to the P2P broadcast. */
+static void p2p_send(void *ctx, uint8_t port, const uint8_t *bytes, size_t len)
 {
-    P2PPacket *packet = ctx;
-    packet->port = PH_P2P_PORT;
-    packet->size = (uint8_t)len;
-    copy(packet->data, bytes, len);
-    radiolinkSendP2PPacketBroadcast(packet);
+    (void)ctx;
+    tx_packet.port = port;
+    tx_packet.size = (uint8_t)len;
+    __builtin_memcpy(tx_packet.data, bytes, len);
+    radiolinkSendP2PPacketBroadcast(&tx_packet);
 }
 
-/* The formation's plant is a double integrator with friction per axis,
- *   m dv/dt = -D^r v + U            (SPEC S1, formation.h: FORMATION_MASS, _FRICTION),
- * and the controller cancels D^r at the reference velocity. The Crazyflie's own
- * controller tracks velocity setpoints well, so the app integrates this model
- * and commands the result as the velocity setpoint (world frame), holding the
- * altitude. Start from the measured velocity so that the setpoint does not
- * jump when the app takes over. */
-static void actuate(const float force[2], const float velocity[2], float dt, bool first)
+/* The velocity setpoint (world frame) for the Crazyflie's own velocity controller,
+ * holding the altitude and the heading (bearings need the world frame). */
+static void command(const float velocity[2])
 {
-    static float v_cmd[2];
     static setpoint_t sp;
-    for (int k = 0; k < 2; k++) {
-        if (first)
-            v_cmd[k] = velocity[k];
-        v_cmd[k] += dt / FORMATION_MASS * (force[k] - FORMATION_FRICTION * v_cmd[k]);
-    }
     sp.mode.x = modeVelocity;
     sp.mode.y = modeVelocity;
     sp.mode.z = modeAbs;
     sp.mode.roll = modeDisable;
     sp.mode.pitch = modeDisable;
     sp.mode.yaw = modeVelocity;
-    sp.velocity.x = v_cmd[0];
-    sp.velocity.y = v_cmd[1];
+    sp.velocity.x = velocity[0];
+    sp.velocity.y = velocity[1];
     sp.position.z = FORMATION_ALTITUDE;
-    sp.attitudeRate.yaw = 0.0f; /* keep the heading: bearings need the world frame */
+    sp.attitudeRate.yaw = 0.0f;
     sp.velocity_body = false;
     commanderSetSetpoint(&sp, COMMANDER_PRIORITY_EXTRX);
+}
+
+static void report(const agent_loop *l, TickType_t now)
+{
+    if (l->status != PH_OK || (l->out.status != PH_OUTPUT_NOMINAL && l->ticks % 100u == 0u))
+        DEBUG_PRINT("t=%u ms: %s, fault %u (neighbour %d)\n", (unsigned)T2M(now),
+                    ph_status_str(l->status), (unsigned)l->out.fault,
+                    (int)l->out.fault_neighbour);
+    if (l->ticks % 1000u == 0u) {
+        ph_frame_stats st;
+        if (ph_stats(l->agent, &st) == PH_OK)
+            DEBUG_PRINT("10 s: %u frames accepted, %u from others, %u queue drops, %u safe ticks\n",
+                        (unsigned)st.accepted, (unsigned)st.unknown_sender,
+                        (unsigned)rx_dropped, (unsigned)l->safe_ticks);
+    }
 }
 
 void appMain(void)
@@ -123,72 +129,31 @@ void appMain(void)
         DEBUG_PRINT("ph_formation.h does not match the linked library\n");
         return;
     }
-    /* Needs about 7 KiB of stack once (CONFIG_APP_STACKSIZE in app-config). */
-    ph_status s = formation_config(id, &config);
-    if (s == PH_OK)
-        s = ph_agent_init(agent, sizeof agent_memory, &config);
+    /* The app's stack peak (CONFIG_APP_STACKSIZE in app-config; docs/c-api.md). */
+    ph_status s = agent_loop_init(&loop, agent_memory, sizeof agent_memory, id, SCRATCH);
     if (s != PH_OK) {
         DEBUG_PRINT("no formation agent %u: %s\n", (unsigned)id, ph_status_str(s));
         return;
     }
-    rx_queue = xQueueCreate(RX_QUEUE_LEN, sizeof(rx_frame));
+    rx_queue = xQueueCreate(RX_QUEUE_LEN, sizeof(rx_packet));
     if (rx_queue == NULL) {
         DEBUG_PRINT("no memory for the P2P queue\n");
         return;
     }
     p2pRegisterCB(p2p_received);
 
-    static P2PPacket tx_packet;
-    ph_bearing bearings[PH_MAX_NEIGHBOURS];
     TickType_t wake = xTaskGetTickCount();
     TickType_t previous = wake;
-    bool first = true;
-    uint32_t ticks = 0, safe = 0;
-
     for (;;) {
         vTaskDelayUntil(&wake, M2T(CONTROL_PERIOD_MS));
         TickType_t now = xTaskGetTickCount();
-
-        /* 1. Frames heard since the last tick (rejections are counted by the
-         * agent: ph_stats()). */
-        rx_frame f;
+        float t = (float)T2M(now) / 1000.0f;
+        rx_packet f;
         while (xQueueReceive(rx_queue, &f, 0) == pdTRUE)
-            (void)ph_receive(agent, f.bytes, f.len);
-
-        /* 2. Own measurements. */
-        ph_measurements m = {0};
-        m.time = (float)T2M(now) / 1000.0f;
-        m.dt = first ? 0.0f : (float)T2M(now - previous) / 1000.0f;
-        formation_read_velocity(m.velocity);
-        m.bearings = bearings;
-        m.bearing_count = formation_read_bearings(agent, bearings, PH_MAX_NEIGHBOURS);
-        m.has_partner_offset = formation_read_partner_offset(m.partner_offset) ? 1u : 0u;
-
-        /* 3. Control step. A refused call (a bug here) leaves out as a zero,
-         * safe force: still apply it. */
-        ph_output out;
-        s = ph_step(agent, &m, &out);
-        if (out.status != PH_OUTPUT_NOMINAL && !first)
-            safe++;
-
-        /* 4. Actuate. */
-        actuate(out.force, m.velocity, m.dt, first);
-
-        /* 5. Broadcast this tick's frames. */
-        (void)ph_frames_cb(agent, p2p_send, &tx_packet, NULL);
-
-        if (s != PH_OK || (out.status != PH_OUTPUT_NOMINAL && ticks % 100u == 0u))
-            DEBUG_PRINT("t=%u ms: %s, fault %u (neighbour %d)\n", (unsigned)T2M(now),
-                        ph_status_str(s), (unsigned)out.fault, (int)out.fault_neighbour);
-        if (ticks % 1000u == 0u) {
-            ph_frame_stats st;
-            if (ph_stats(agent, &st) == PH_OK)
-                DEBUG_PRINT("10 s: %u frames accepted, %u from others, %u queue drops, %u safe ticks\n",
-                            (unsigned)st.accepted, (unsigned)st.unknown_sender,
-                            (unsigned)rx_dropped, (unsigned)safe);
-        }
+            agent_loop_receive(&loop, f.port, f.bytes, f.len, t);
+        (void)agent_loop_tick(&loop, t, (float)T2M(now - previous) / 1000.0f, p2p_send, NULL);
+        command(loop.setpoint);
+        report(&loop, now);
         previous = now;
-        first = false;
-        ticks++;
     }
 }

@@ -1,24 +1,35 @@
 /*
- * The formation of this example: the paper's four agents (SPEC §9, triangles
- * {1,2,3} and {2,3,4}, the square 1-2-4-3), scaled for a room: leader edge
- * z* = q1 - q2 = (1, -1) m (a square of side 1.41 m), hovering (v* = 0), the
- * force limited to 2 N of the virtual unit mass. These numbers are a starting
- * point, not flight-tested: simulate them first (host-sim scenario with the same
- * values, radio loss and latency) and tune the gains there.
+ * The formation of this app and its sensors (formation.h).
  *
- * Alternative to the C struct: a configuration blob from a host tool, loaded
- * with ph_agent_init_blob() (docs/c-api.md).
+ * Configuration: by default the blob of this agent from blobs/ph_blobs.c, written by
+ *   host-sim export --all crazyflie-app/formation.toml --vehicle crazyflie \
+ *       -o crazyflie-app/src/blobs
+ * (the paper's four agents, SPEC §9, scaled for a room: docs/crazyflie.md). The C
+ * struct of formation_config() is the alternative (-DFORMATION_USE_STRUCT); it holds
+ * the same numbers as crazyflie-app/formation.toml.
  *
- * The read functions are where the sensors plug in. As shipped, only the
- * velocity is wired (the state estimator); without bearings the controller
- * answers with its safe output (U = -safe_damping * v, fault
- * PH_FAULT_MISSING_BEARING), i.e. the app only damps the velocity.
+ * Sensors: the state estimator's position and velocity (Kalman filter with
+ * Lighthouse, Loco or motion capture), and the neighbours' positions heard on the
+ * P2P port FORMATION_POSITION_PORT. For bearings from a camera (AI deck) or a UWB
+ * angle-of-arrival deck instead, replace formation_read_bearings(): body-frame
+ * direction rotated by the estimated yaw into the world frame (S2), and set
+ * PH_BEARING_HAS_RATE only if the sensor measures the bearing rate.
  */
 #include "formation.h"
 
 #include "log.h"
+#include "ph_blobs.h"
 
 #define COS_45 0.70710678f
+
+ph_status formation_blob(uint8_t id, const uint8_t **blob, size_t *len)
+{
+    if (id >= ph_blob_count || ph_blobs[id] == NULL)
+        return PH_ERR_CONFIG_NOT_IN_TRIANGLE;
+    *blob = ph_blobs[id];
+    *len = ph_blob_lens[id];
+    return PH_OK;
+}
 
 static void constant(ph_schedule *s, float x, float y)
 {
@@ -32,9 +43,9 @@ static void angle(ph_angle *a, uint8_t apex, float cos_desired)
 {
     a->apex = apex;
     a->cos_desired = cos_desired; /* the core takes cosines: no trigonometry on board */
-    a->stiffness = 1000.0f;       /* c (S7) */
+    a->stiffness = 30.0f;         /* c (S7) */
     a->damping = 10.0f;           /* d (S7) */
-    a->estimator_gain = 1000.0f;  /* c_e (S9) */
+    a->estimator_gain = 100.0f;   /* c_e (S9) */
 }
 
 ph_status formation_config(uint8_t id, ph_config *c)
@@ -44,7 +55,7 @@ ph_status formation_config(uint8_t id, ph_config *c)
     ph_status s = ph_config_default(c, id);
     if (s != PH_OK)
         return s;
-    c->friction[0] = c->friction[1] = FORMATION_FRICTION;
+    c->friction[0] = c->friction[1] = 0.5f; /* D^r */
     c->velocity_damping[0] = c->velocity_damping[1] = 1.8f;
     constant(&c->velocity_reference, 0.0f, 0.0f);
     c->limits.max_force = 2.0f;
@@ -69,67 +80,136 @@ ph_status formation_config(uint8_t id, ph_config *c)
         c->has_leader = 1;
         c->leader.role = id == 1 ? PH_LEADER_A : PH_LEADER_B;
         c->leader.partner = id == 1 ? 2 : 1;
-        c->leader.stiffness = 1.0f;
-        c->leader.damping[0] = c->leader.damping[1] = 0.8f;
+        c->leader.stiffness = 4.0f;
+        c->leader.damping[0] = c->leader.damping[1] = 2.0f;
         constant(&c->leader.displacement, 1.0f, -1.0f);
     }
     return PH_OK;
 }
 
-/* Velocity: the state estimator's (Kalman filter with the flow deck, Lighthouse
- * or Loco positioning), world frame. */
+ph_status formation_state_init(formation_state *state, const ph_agent *agent)
+{
+    uint8_t ids[PH_MAX_NEIGHBOURS];
+    size_t n = 0;
+    __builtin_memset(state, 0, sizeof *state);
+    ph_status s = ph_neighbours(agent, ids, PH_MAX_NEIGHBOURS, &n);
+    if (s != PH_OK)
+        return s;
+    for (size_t k = 0; k < n; k++)
+        state->peers[k].id = ids[k];
+    state->peer_count = n;
+    return ph_leader_partner(agent, &state->partner, &state->has_partner);
+}
+
+/* A log variable of the state estimator (0 when the firmware has none). */
+static float estimate(logVarId_t *id, bool *ready, const char *name)
+{
+    if (!*ready) {
+        *id = logGetVarId("stateEstimate", name);
+        *ready = true;
+    }
+    return logVarIdIsValid(*id) ? logGetFloat(*id) : 0.0f;
+}
+
 void formation_read_velocity(float velocity[2])
 {
     static logVarId_t vx, vy;
-    static bool ready;
-    if (!ready) {
-        vx = logGetVarId("stateEstimate", "vx");
-        vy = logGetVarId("stateEstimate", "vy");
-        ready = true;
-    }
-    velocity[0] = logVarIdIsValid(vx) ? logGetFloat(vx) : 0.0f;
-    velocity[1] = logVarIdIsValid(vy) ? logGetFloat(vy) : 0.0f;
+    static bool rx, ry;
+    velocity[0] = estimate(&vx, &rx, "vx");
+    velocity[1] = estimate(&vy, &ry, "vy");
 }
 
-/* Bearing to neighbour `id` as a unit vector in the WORLD frame, or false.
- *
- * Wire your sensor here, e.g.
- *  - a camera (AI deck) finding the neighbour's LED ring: pixel -> direction in
- *    the body frame, then rotate by the estimator's yaw (stateEstimate.yaw) into
- *    the world frame (the formation needs one shared orientation: S2);
- *  - a UWB angle-of-arrival deck: the AoA in the body frame, rotated likewise;
- *  - for a first test under a positioning system: (q_j - q_i) / |q_j - q_i| from
- *    the estimator's own position and the neighbour's (sent on another P2P port).
- * Set PH_BEARING_HAS_RATE with `rate` only if the sensor measures the bearing
- * rate; otherwise the controller differentiates successive bearings. */
-static bool sensor_bearing(uint8_t id, float direction[2])
+void formation_read_position(float position[2])
 {
-    (void)id;
-    (void)direction;
-    return false; /* not wired in this template */
+    static logVarId_t x, y;
+    static bool rx, ry;
+    position[0] = estimate(&x, &rx, "x");
+    position[1] = estimate(&y, &ry, "y");
 }
 
-size_t formation_read_bearings(const ph_agent *agent, ph_bearing *out, size_t capacity)
+size_t formation_position_packet(uint8_t id, const float position[2], uint8_t *out,
+                                 size_t capacity)
 {
-    uint8_t ids[PH_MAX_NEIGHBOURS];
-    size_t n = 0, written = 0;
-    if (ph_neighbours(agent, ids, PH_MAX_NEIGHBOURS, &n) != PH_OK)
+    if (capacity < FORMATION_POSITION_LEN)
         return 0;
-    /* In ph_neighbours() order: the agent's fast path. */
-    for (size_t k = 0; k < n && written < capacity; k++) {
-        ph_bearing *b = &out[written];
-        b->neighbour = ids[k];
+    out[0] = FORMATION_POSITION_VERSION;
+    out[1] = id;
+    __builtin_memcpy(&out[2], &position[0], 4); /* Cortex-M4 and x86-64: little-endian */
+    __builtin_memcpy(&out[6], &position[1], 4);
+    return FORMATION_POSITION_LEN;
+}
+
+static bool is_finite(float x)
+{
+    return x - x == 0.0f; /* false for NaN and the infinities */
+}
+
+bool formation_position_received(formation_state *state, const uint8_t *bytes, size_t len,
+                                 float now)
+{
+    if (len != FORMATION_POSITION_LEN || bytes[0] != FORMATION_POSITION_VERSION)
+        return false;
+    float p[2];
+    __builtin_memcpy(&p[0], &bytes[2], 4);
+    __builtin_memcpy(&p[1], &bytes[6], 4);
+    if (!is_finite(p[0]) || !is_finite(p[1]))
+        return false;
+    for (size_t k = 0; k < state->peer_count; k++) {
+        formation_peer *peer = &state->peers[k];
+        if (peer->id == bytes[1]) {
+            peer->heard = 1;
+            peer->time = now;
+            peer->position[0] = p[0];
+            peer->position[1] = p[1];
+            return true;
+        }
+    }
+    return false; /* not a neighbour: broadcast radio */
+}
+
+static const formation_peer *fresh(const formation_state *state, uint8_t id, float now)
+{
+    for (size_t k = 0; k < state->peer_count; k++) {
+        const formation_peer *peer = &state->peers[k];
+        if (peer->id == id)
+            return peer->heard && now - peer->time <= FORMATION_POSITION_MAX_AGE ? peer : NULL;
+    }
+    return NULL;
+}
+
+size_t formation_read_bearings(const formation_state *state, const float own[2], float now,
+                               ph_bearing *out, size_t capacity)
+{
+    size_t written = 0;
+    for (size_t k = 0; k < state->peer_count && written < capacity; k++) {
+        const formation_peer *peer = fresh(state, state->peers[k].id, now);
+        if (peer == NULL)
+            continue;
+        /* SPEC S2: the bearing g_ij = (q_j - q_i) / |q_j - q_i|, world frame. */
+        float dx = peer->position[0] - own[0], dy = peer->position[1] - own[1];
+        float d = __builtin_sqrtf(dx * dx + dy * dy);
+        if (!(d > 1e-3f)) /* coincident positions have no bearing */
+            continue;
+        ph_bearing *b = &out[written++];
+        b->neighbour = peer->id;
         b->flags = 0;
-        if (sensor_bearing(ids[k], b->direction))
-            written++;
+        b->direction[0] = dx / d;
+        b->direction[1] = dy / d;
+        b->rate[0] = b->rate[1] = 0.0f;
+        b->range = 0.0f;
     }
     return written;
 }
 
-/* Leaders 1 and 2 need q_partner - q_self (S11): e.g. UWB two-way ranging plus
- * the bearing to the partner, or both positions from a positioning system. */
-bool formation_read_partner_offset(float offset[2])
+bool formation_read_partner_offset(const formation_state *state, const float own[2],
+                                   float now, float offset[2])
 {
-    (void)offset;
-    return false; /* not wired in this template */
+    if (!state->has_partner)
+        return false;
+    const formation_peer *peer = fresh(state, state->partner, now);
+    if (peer == NULL)
+        return false;
+    offset[0] = peer->position[0] - own[0];
+    offset[1] = peer->position[1] - own[1];
+    return true;
 }

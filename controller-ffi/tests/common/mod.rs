@@ -28,8 +28,14 @@ pub fn scratch(name: &str) -> PathBuf {
 /// Runs `controller-ffi/c/build.sh <what> <out>` (which builds the staticlib with cargo
 /// and compiles the C program against it); returns the path it printed.
 pub fn build(what: &str, out: &Path) -> PathBuf {
+    build_with(what, out, &[])
+}
+
+/// [`build`] with environment variables (e.g. `CFAPP_CFLAGS`).
+pub fn build_with(what: &str, out: &Path, env: &[(&str, &str)]) -> PathBuf {
     let script = root().join("controller-ffi/c/build.sh");
     let run = Command::new("bash")
+        .envs(env.iter().copied())
         .arg(&script)
         .arg(what)
         .arg(out)

@@ -39,7 +39,7 @@ pub const CONTROL_HZ: u32 = 100;
 /// Plant steps per control tick.
 pub const SUBSTEPS: u32 = PLANT_HZ / CONTROL_HZ;
 /// Frames that can be on the air in one control tick (all robots together).
-/// (The paper's robots send 1 + 1 + 2 + 1 = 5 frames per tick.)
+/// (With wire v3 the paper's robots send one frame each: 4 frames per tick.)
 pub const AIR_CAPACITY: usize = 8;
 /// Frames one robot's radio can hold between two ticks.
 pub const INBOX_CAPACITY: usize = 8;

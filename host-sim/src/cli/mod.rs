@@ -6,6 +6,7 @@ mod design;
 mod export;
 mod run;
 mod sweep;
+mod vehicle;
 
 pub use design::{DesignArgs, Shape};
 
@@ -56,7 +57,7 @@ pub enum Command {
     Design(DesignArgs),
     /// Run a Monte Carlo sweep (docs/sweeps.md) on every core, or merge its shards.
     Sweep(sweep::SweepArgs),
-    /// Write one agent's configuration as the C API's checked blob (docs/c-api.md).
+    /// Write agents' configurations as the C API's checked blobs (docs/c-api.md).
     Export(ExportArgs),
 }
 
@@ -66,16 +67,28 @@ pub struct ExportArgs {
     /// Scenario file or built-in name.
     pub scenario: String,
     /// The agent's id in the scenario.
-    #[arg(long, value_name = "ID")]
-    pub agent: String,
+    #[arg(
+        long,
+        value_name = "ID",
+        required_unless_present = "all",
+        conflicts_with = "all"
+    )]
+    pub agent: Option<String>,
+    /// Every agent: `-o DIR` gets `agent<ID>.blob` each and `ph_blobs.c`/`.h` (all blobs
+    /// in one C table indexed by wire id, docs/crazyflie.md).
+    #[arg(long, requires = "out")]
+    pub all: bool,
+    /// Refuse limits beyond what this vehicle can do (force over mass, `v*`).
+    #[arg(long, value_name = "NAME")]
+    pub vehicle: Option<vehicle::Vehicle>,
     /// Override a field first, e.g. `--set integrity=link`.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
-    /// Output file (default: standard output).
+    /// Output file (default: standard output); with `--all` the directory.
     #[arg(short, long, value_name = "FILE")]
     pub out: Option<PathBuf>,
     /// Write C source (`const uint8_t ph_blob[]`) instead of the raw bytes.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "all")]
     pub c_array: bool,
 }
 

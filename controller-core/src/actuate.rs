@@ -1,0 +1,261 @@
+//! Actuation through a virtual mass: the controller's force `U` turned into velocity
+//! setpoints for a vehicle whose own controller tracks velocity (a Crazyflie's
+//! position/velocity controller, a ground robot's wheel controller).
+//!
+//! The controller assumes the plant of SPEC S1 per agent,
+//! `m v̇ = −D^r v + U`. A vehicle that tracks velocity setpoints well behaves like
+//! that plant when it is commanded the velocity of a *virtual* mass `m` with
+//! friction `D^r` driven by `U`: this module integrates S1 over each control period
+//! and returns the new velocity, the setpoint. `D^r` must be the `friction` of the
+//! agent's configuration (the controller cancels it at the reference velocity, S10).
+//!
+//! The step is implicit in the friction and explicit in the force (semi-implicit
+//! Euler, first order):
+//!
+//! `v_{k+1} = (v_k + Δt/m · U_k) / (1 + Δt/m · D^r)` (per axis, S1)
+//!
+//! which is stable for every `Δt ≥ 0` (a late tick never makes the setpoint
+//! oscillate), and tends to the exact solution of S1 as `Δt → 0` (the test below
+//! compares it with the closed form `v(t) = U/D + (v₀ − U/D) e^{−D t/m}`).
+//!
+//! One implementation for every user: the C API's `ph_actuate` (controller-ffi, called
+//! by `crazyflie-app/src/agent_loop.c`) and any simulated velocity-tracking vehicle.
+
+use crate::Real;
+
+/// Why a [`VirtualMass`] was refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ActuateError {
+    /// The mass is not finite and positive.
+    Mass,
+    /// A friction coefficient is not finite and non-negative.
+    Friction,
+    /// The speed limit is NaN or not positive (use infinity for none).
+    MaxSpeed,
+}
+
+/// The virtual plant of SPEC S1 for one agent: mass, friction `D^r` per axis, and the
+/// vehicle's largest velocity setpoint.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VirtualMass<T> {
+    mass: T,
+    friction: [T; 2],
+    max_speed: T,
+}
+
+impl<T: Real> VirtualMass<T> {
+    /// A virtual mass `mass` (kg, finite, > 0) with friction `friction` (`D^r`, N s/m
+    /// per axis, finite, ≥ 0); setpoints are limited to `max_speed` (m/s, > 0;
+    /// infinity for no limit), scaling the vector so that its direction is kept.
+    pub fn new(mass: T, friction: [T; 2], max_speed: T) -> Result<Self, ActuateError> {
+        if !(mass.finite() && is_positive(mass)) {
+            return Err(ActuateError::Mass);
+        }
+        if !friction.iter().all(|d| d.finite() && *d >= T::zero()) {
+            return Err(ActuateError::Friction);
+        }
+        if !is_positive(max_speed) {
+            return Err(ActuateError::MaxSpeed);
+        }
+        Ok(Self {
+            mass,
+            friction,
+            max_speed,
+        })
+    }
+
+    /// The mass.
+    pub fn mass(&self) -> T {
+        self.mass
+    }
+
+    /// The friction `D^r` per axis.
+    pub fn friction(&self) -> [T; 2] {
+        self.friction
+    }
+
+    /// The speed limit of the setpoints.
+    pub fn max_speed(&self) -> T {
+        self.max_speed
+    }
+
+    /// One period `dt` (s) of S1 from velocity `velocity` under force `force` (N, world
+    /// frame): the next velocity, limited to the speed limit. A negative or non-finite
+    /// `dt`, or a non-finite force, leaves the velocity as it is (still limited).
+    pub fn step(&self, velocity: [T; 2], force: [T; 2], dt: T) -> [T; 2] {
+        let usable = dt.finite() && dt >= T::zero() && force.iter().all(|u| u.finite());
+        let h = if usable { dt / self.mass } else { T::zero() };
+        let force = if usable { force } else { [T::zero(); 2] };
+        // S1, semi-implicit: v' = (v + h U) / (1 + h D^r).
+        let next = [0, 1].map(|k| {
+            let (v, u, d) = match (velocity.get(k), force.get(k), self.friction.get(k)) {
+                (Some(v), Some(u), Some(d)) => (*v, *u, *d),
+                _ => (T::zero(), T::zero(), T::zero()),
+            };
+            (v + h * u) / (T::one() + h * d)
+        });
+        self.limit(next)
+    }
+
+    /// `v` scaled down to the speed limit if faster (a non-finite `v` becomes zero).
+    fn limit(&self, v: [T; 2]) -> [T; 2] {
+        let [x, y] = v;
+        let speed = (x * x + y * y).sqrt_fast();
+        if !speed.finite() {
+            [T::zero(); 2]
+        } else if speed > self.max_speed {
+            let s = self.max_speed / speed;
+            [x * s, y * s]
+        } else {
+            v
+        }
+    }
+}
+
+/// `x > 0` (false for NaN).
+fn is_positive<T: Real>(x: T) -> bool {
+    x.partial_cmp(&T::zero()) == Some(core::cmp::Ordering::Greater)
+}
+
+/// The velocity setpoint of one agent over time: a [`VirtualMass`] and its state.
+/// The first step after [`VelocityCommand::new`] or [`VelocityCommand::restart`]
+/// starts from the measured velocity, so that the setpoint does not jump when the
+/// formation takes over the vehicle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VelocityCommand<T> {
+    plant: VirtualMass<T>,
+    command: Option<[T; 2]>,
+}
+
+impl<T: Real> VelocityCommand<T> {
+    /// Starts a command with no state yet.
+    pub fn new(plant: VirtualMass<T>) -> Self {
+        Self {
+            plant,
+            command: None,
+        }
+    }
+
+    /// Resumes a command at setpoint `command` (`None`: no state yet), e.g. state kept
+    /// by a C caller between calls.
+    pub fn resume(plant: VirtualMass<T>, command: Option<[T; 2]>) -> Self {
+        Self { plant, command }
+    }
+
+    /// The next step starts again from the measured velocity.
+    pub fn restart(&mut self) {
+        self.command = None;
+    }
+
+    /// The current setpoint (`None` before the first step).
+    pub fn command(&self) -> Option<[T; 2]> {
+        self.command
+    }
+
+    /// The plant.
+    pub fn plant(&self) -> &VirtualMass<T> {
+        &self.plant
+    }
+
+    /// One control period: integrates S1 from the previous setpoint (or, on the first
+    /// step, from `measured`, the vehicle's velocity) under `force` for `dt` seconds and
+    /// returns the new setpoint.
+    pub fn step(&mut self, force: [T; 2], measured: [T; 2], dt: T) -> [T; 2] {
+        let from = self.command.unwrap_or(measured);
+        let next = self.plant.step(from, force, dt);
+        self.command = Some(next);
+        next
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn exact(v0: f64, u: f64, d: f64, m: f64, t: f64) -> f64 {
+        u / d + (v0 - u / d) * libm::exp(-d * t / m)
+    }
+
+    #[test]
+    fn converges_to_the_closed_form_of_s1() {
+        let (m, d, u, v0, t_end) = (1.5_f64, 0.5, 2.0, -0.3, 4.0);
+        let plant = VirtualMass::new(m, [d, 2.0 * d], f64::INFINITY).unwrap();
+        let mut errors = [0.0; 2];
+        for (e, steps) in errors.iter_mut().zip([400_u32, 800]) {
+            let dt = t_end / f64::from(steps);
+            let mut v = [v0, v0];
+            for _ in 0..steps {
+                v = plant.step(v, [u, u], dt);
+            }
+            let want = [exact(v0, u, d, m, t_end), exact(v0, u, 2.0 * d, m, t_end)];
+            *e = (v[0] - want[0]).abs().max((v[1] - want[1]).abs());
+        }
+        // First order: halving the step halves the error (2.5e-3 m/s at Δt = 10 ms).
+        assert!(errors[0] < 4e-3, "{errors:?}");
+        let ratio = errors[0] / errors[1];
+        assert!((1.8..2.2).contains(&ratio), "order: {errors:?}");
+    }
+
+    #[test]
+    fn without_friction_the_force_is_integrated_exactly() {
+        let plant = VirtualMass::new(2.0_f64, [0.0, 0.0], f64::INFINITY).unwrap();
+        let v = plant.step([1.0, -1.0], [4.0, 2.0], 0.5);
+        assert_eq!(v, [2.0, -0.5]);
+    }
+
+    #[test]
+    fn stable_for_any_step_and_limited() {
+        let plant = VirtualMass::new(1.0_f32, [5.0, 5.0], 1.0).unwrap();
+        // A 10 s hiccup with strong friction: relaxes toward U/D, no overshoot.
+        let v = plant.step([0.0, 0.0], [2.0, 0.0], 10.0);
+        assert!(v[0] > 0.0 && v[0] < 0.4 && v[1] == 0.0, "{v:?}");
+        // A setpoint faster than the limit keeps its direction at the limit.
+        let v = plant.step([3.0, 4.0], [0.0, 0.0], 0.0);
+        assert!(
+            (v[0] - 0.6).abs() < 1e-3 && (v[1] - 0.8).abs() < 1e-3,
+            "{v:?}"
+        );
+        // Bad inputs hold the velocity.
+        assert_eq!(plant.step([0.5, 0.0], [f32::NAN, 0.0], 0.01), [0.5, 0.0]);
+        assert_eq!(plant.step([0.5, 0.0], [1.0, 0.0], -1.0), [0.5, 0.0]);
+    }
+
+    #[test]
+    fn bad_parameters_are_refused() {
+        let inf = f32::INFINITY;
+        assert_eq!(
+            VirtualMass::new(0.0, [0.0; 2], inf),
+            Err(ActuateError::Mass)
+        );
+        assert_eq!(
+            VirtualMass::new(inf, [0.0; 2], inf),
+            Err(ActuateError::Mass)
+        );
+        assert_eq!(
+            VirtualMass::new(1.0, [-1.0, 0.0], inf),
+            Err(ActuateError::Friction)
+        );
+        assert_eq!(
+            VirtualMass::new(1.0, [0.0; 2], f32::NAN),
+            Err(ActuateError::MaxSpeed)
+        );
+        assert_eq!(
+            VirtualMass::new(1.0, [0.0; 2], 0.0),
+            Err(ActuateError::MaxSpeed)
+        );
+    }
+
+    #[test]
+    fn the_command_starts_from_the_measured_velocity() {
+        let plant = VirtualMass::new(1.0_f64, [0.5, 0.5], f64::INFINITY).unwrap();
+        let mut c = VelocityCommand::new(plant);
+        assert_eq!(c.command(), None);
+        let first = c.step([0.0, 0.0], [0.2, -0.1], 0.01);
+        assert!((first[0] - 0.2 / 1.005).abs() < 1e-12, "{first:?}");
+        // Later steps ignore the measurement.
+        let second = c.step([0.0, 0.0], [9.0, 9.0], 0.01);
+        assert!((second[0] - first[0] / 1.005).abs() < 1e-12);
+        c.restart();
+        assert_eq!(c.step([0.0, 0.0], [1.0, 0.0], 0.0), [1.0, 0.0]);
+    }
+}

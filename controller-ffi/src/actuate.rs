@@ -1,0 +1,101 @@
+//! Actuation through the virtual mass of SPEC S1 (`controller_core::actuate`): the
+//! force of `ph_step` turned into a velocity setpoint, for vehicles that track velocity
+//! (the Crazyflie app, `crazyflie-app/src/agent_loop.c`).
+
+use controller_core::actuate::{VelocityCommand, VirtualMass};
+
+use crate::api::{check, input, status, write};
+use crate::status::ph_status;
+use crate::storage::{self, ph_agent};
+
+/// The virtual plant `m v̇ = −D^r v + U` (SPEC S1) and its velocity setpoint. Fill it
+/// with `ph_actuator_init`; set `has_command = 0` to make the next `ph_actuate` start
+/// again from the measured velocity (e.g. when the formation takes over the vehicle).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ph_actuator {
+    /// Virtual mass `m` (kg, > 0).
+    pub mass: f32,
+    /// Friction `D^r` per axis (N s/m, ≥ 0): the agent's `ph_config.friction`.
+    pub friction: [f32; 2],
+    /// Largest setpoint speed (m/s, > 0; `INFINITY` for none): the vehicle's limit.
+    pub max_speed: f32,
+    /// The current velocity setpoint (m/s, world frame), valid when `has_command`.
+    pub command: [f32; 2],
+    /// 1 once `ph_actuate` has produced a setpoint.
+    pub has_command: u8,
+}
+
+/// Fills `*actuator` for `agent`: mass `mass`, the friction `D^r` of the agent's
+/// configuration (so that the controller cancels the friction the plant has), speed
+/// limit `max_speed`, no setpoint yet. `PH_ERR_ARGUMENT` for a mass that is not finite
+/// and positive or a `max_speed` that is NaN or not positive.
+///
+/// # Safety
+/// `actuator` is NULL or writable; `agent` as for `ph_stats`.
+#[no_mangle]
+pub unsafe extern "C" fn ph_actuator_init(
+    actuator: *mut ph_actuator,
+    agent: *const ph_agent,
+    mass: f32,
+    max_speed: f32,
+) -> ph_status {
+    // SAFETY: per this function's contract.
+    let r = unsafe { storage::agent_ref(agent) }.and_then(|a| {
+        let friction = a.config().friction;
+        let plant =
+            VirtualMass::new(mass, friction, max_speed).map_err(|_| ph_status::PH_ERR_ARGUMENT)?;
+        let value = ph_actuator {
+            mass: plant.mass(),
+            friction: plant.friction(),
+            max_speed: plant.max_speed(),
+            command: [0.0; 2],
+            has_command: 0,
+        };
+        // SAFETY: per this function's contract.
+        unsafe { write(actuator, value) }
+    });
+    status(r)
+}
+
+/// One control period: integrates S1 from the previous setpoint (the first time from
+/// `velocity[0..2]`, the vehicle's measured velocity) under `force[0..2]` (the
+/// `ph_output.force` of this tick) for `dt` seconds, and writes the new setpoint to
+/// `setpoint[0..2]` and `actuator->command`. `PH_ERR_ARGUMENT` (nothing written) for
+/// an actuator whose parameters `ph_actuator_init` would refuse.
+///
+/// # Safety
+/// `actuator` is NULL or points to a `ph_actuator`; `force` and `velocity` are NULL or
+/// point to 2 readable floats; `setpoint` is NULL or points to 2 writable floats.
+#[no_mangle]
+pub unsafe extern "C" fn ph_actuate(
+    actuator: *mut ph_actuator,
+    force: *const f32,
+    velocity: *const f32,
+    dt: f32,
+    setpoint: *mut f32,
+) -> ph_status {
+    let r = (|| {
+        // SAFETY: per this function's contract (2 floats each).
+        let force = unsafe { input(force.cast::<[f32; 2]>()) }?;
+        // SAFETY: as above.
+        let velocity = unsafe { input(velocity.cast::<[f32; 2]>()) }?;
+        check(setpoint.cast_const())?;
+        // SAFETY: per this function's contract.
+        let a = unsafe { input(actuator.cast_const()) }?;
+        let plant = VirtualMass::new(a.mass, a.friction, a.max_speed)
+            .map_err(|_| ph_status::PH_ERR_ARGUMENT)?;
+        let mut command = VelocityCommand::resume(plant, (a.has_command != 0).then_some(a.command));
+        let next = command.step(*force, *velocity, dt);
+        let updated = ph_actuator {
+            command: next,
+            has_command: 1,
+            ..*a
+        };
+        // SAFETY: per this function's contract.
+        unsafe { write(actuator, updated) }?;
+        // SAFETY: per this function's contract (2 writable floats).
+        unsafe { write(setpoint.cast::<[f32; 2]>(), next) }
+    })();
+    status(r)
+}

@@ -1,0 +1,92 @@
+/*
+ * One formation agent's per-tick logic (agent_loop.h).
+ */
+#include "agent_loop.h"
+
+ph_status agent_loop_init(agent_loop *loop, uint8_t *memory, size_t size, uint8_t id,
+                          ph_config *scratch)
+{
+    __builtin_memset(loop, 0, sizeof *loop);
+    loop->agent = (ph_agent *)memory;
+    loop->id = id;
+    loop->first = true;
+#ifdef FORMATION_USE_STRUCT
+    ph_status s = formation_config(id, scratch);
+    if (s == PH_OK)
+        s = ph_agent_init(loop->agent, size, scratch);
+#else
+    (void)scratch;
+    const uint8_t *blob = NULL;
+    size_t len = 0;
+    ph_status s = formation_blob(id, &blob, &len);
+    if (s == PH_OK)
+        s = ph_agent_init_blob(loop->agent, size, blob, len);
+#endif
+    if (s == PH_OK)
+        s = ph_actuator_init(&loop->actuator, loop->agent, FORMATION_MASS, FORMATION_MAX_SPEED);
+    if (s == PH_OK)
+        s = formation_state_init(&loop->formation, loop->agent);
+    return s;
+}
+
+void agent_loop_receive(agent_loop *loop, uint8_t port, const uint8_t *bytes, size_t len,
+                        float now)
+{
+    if (port == AGENT_LOOP_FRAME_PORT)
+        (void)ph_receive(loop->agent, bytes, len); /* rejections: ph_stats() */
+    else if (port == FORMATION_POSITION_PORT)
+        (void)formation_position_received(&loop->formation, bytes, len, now);
+}
+
+typedef struct {
+    agent_loop_send_fn send;
+    void *ctx;
+} frame_sink;
+
+/* ph_send_fn: one formation frame to the P2P broadcast. */
+static void send_frame(void *ctx, const uint8_t *bytes, size_t len)
+{
+    const frame_sink *sink = ctx;
+    sink->send(sink->ctx, AGENT_LOOP_FRAME_PORT, bytes, len);
+}
+
+ph_status agent_loop_tick(agent_loop *loop, float now, float dt, agent_loop_send_fn send,
+                          void *ctx)
+{
+    ph_bearing bearings[PH_MAX_NEIGHBOURS];
+    float position[2];
+    ph_measurements m = {0};
+    m.time = now;
+    m.dt = loop->first ? 0.0f : dt;
+    formation_read_velocity(m.velocity);
+    formation_read_position(position);
+    m.bearings = bearings;
+    m.bearing_count =
+        formation_read_bearings(&loop->formation, position, now, bearings, PH_MAX_NEIGHBOURS);
+    m.has_partner_offset =
+        formation_read_partner_offset(&loop->formation, position, now, m.partner_offset) ? 1u
+                                                                                          : 0u;
+
+    /* A refused call (a bug here) leaves out as a zero, safe force: still apply it. */
+    loop->status = ph_step(loop->agent, &m, &loop->out);
+    if (loop->out.status != PH_OUTPUT_NOMINAL && !loop->first)
+        loop->safe_ticks++;
+
+    /* The velocity setpoint: S1 integrated by the core (ph_actuate); the first tick
+     * starts from the measured velocity. */
+    if (loop->first)
+        loop->actuator.has_command = 0;
+    if (ph_actuate(&loop->actuator, loop->out.force, m.velocity, m.dt, loop->setpoint) != PH_OK)
+        loop->setpoint[0] = loop->setpoint[1] = 0.0f;
+
+    frame_sink sink = {send, ctx};
+    (void)ph_frames_cb(loop->agent, send_frame, &sink, NULL);
+    uint8_t packet[FORMATION_POSITION_LEN];
+    size_t n = formation_position_packet(loop->id, position, packet, sizeof packet);
+    if (n > 0)
+        send(ctx, FORMATION_POSITION_PORT, packet, n);
+
+    loop->first = false;
+    loop->ticks++;
+    return loop->status;
+}
