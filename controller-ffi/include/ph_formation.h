@@ -62,10 +62,11 @@
 #define PH_MAX_OWNED_ESTIMATES (4 * PH_MAX_TRIANGLES)
 
 /**
- * Version of this C ABI (the header's structs and functions). Compare the header's
+ * Version of this C ABI (the header's structs and functions; 3: `ph_config` gained
+ * `bearing_filter`). Compare the header's
  * value with `ph_abi_version()` of the library you link.
  */
-#define PH_ABI_VERSION 2
+#define PH_ABI_VERSION 3
 
 /**
  * An upper bound of a blob's length: a configuration with every capacity used
