@@ -210,27 +210,29 @@ pub(crate) fn check_mode(
     let [mode, sender, q0, q1, ref velocity @ ..] = *head;
     let [ref vx @ .., _, _, _, _] = *velocity;
     let [_, _, _, _, ref vy @ ..] = *velocity;
-    // Bits 7–4: 8 + the item count (version 4); bits 3–0: the modes.
-    let Some(count) = items_of_mode(mode) else {
-        return Err(FrameError::UnknownVersion(mode >> 4));
-    };
-    if mode & 0x0F != expected_mode & 0x0F {
-        return Err(FrameError::ModeMismatch(mode));
+    // Bits 7–4: 8 + the item count (version 4); bits 3–0: the modes. With the expected
+    // mode byte's nibble 8, `mode − expected` is `0x10 · count` exactly when the modes
+    // agree and the nibble is 8..=12: one subtraction, one rotation, one comparison.
+    let count = mode.wrapping_sub(expected_mode).rotate_right(4);
+    if usize::from(count) > MAX_ANGLES_PER_FRAME {
+        return Err(mode_error(mode));
     }
     let seq = u16::from_le_bytes([q0, q1]);
     let (items, rest) = items.as_chunks::<ANGLE_ITEM_LEN>();
-    if items.len() != count {
+    if items.len() != usize::from(count) {
         return Err(FrameError::Malformed);
     }
     // `auth`: the counter extension exactly when there is room for it (at most 3 items).
     let signed = match (integrity, rest, trailer.first_chunk::<TAG_LEN>()) {
-        (Integrity::Auth(_), [], Some(tag)) if count == MAX_ANGLES_PER_FRAME => Some(Signed {
-            bytes: body,
-            tag,
-            counter: None,
-        }),
+        (Integrity::Auth(_), [], Some(tag)) if usize::from(count) == MAX_ANGLES_PER_FRAME => {
+            Some(Signed {
+                bytes: body,
+                tag,
+                counter: None,
+            })
+        }
         (Integrity::Auth(_), [e0, e1, e2, e3, h0, h1], Some(tag))
-            if count < MAX_ANGLES_PER_FRAME =>
+            if usize::from(count) < MAX_ANGLES_PER_FRAME =>
         {
             let epoch = u32::from_le_bytes([*e0, *e1, *e2, *e3]);
             let high = u32::from(u16::from_le_bytes([*h0, *h1]));
@@ -253,6 +255,15 @@ pub(crate) fn check_mode(
         items,
         signed,
     })
+}
+
+/// Why a mode byte is not the receiver's (cold): another version, or other modes.
+#[cold]
+fn mode_error(mode: u8) -> FrameError {
+    match items_of_mode(mode) {
+        None => FrameError::UnknownVersion(mode >> 4),
+        Some(_) => FrameError::ModeMismatch(mode),
+    }
 }
 
 /// Checks a frame ([`check_frame`] and [`FrameView::validate`] with any positive
