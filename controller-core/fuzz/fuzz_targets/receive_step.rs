@@ -81,7 +81,11 @@ fn decoders_agree(bytes: &[u8], integrity: Integrity) {
         })
         .and_then(|(body, _)| postcard::take_from_bytes::<Frame>(body).ok())
         .filter(|(f, rest)| rest.is_empty() && f.header.mode == mode_byte(integrity, est));
-    assert_eq!(fast.is_ok(), slow.is_some(), "{integrity}: {fast:?} {bytes:02x?}");
+    assert_eq!(
+        fast.is_ok(),
+        slow.is_some(),
+        "{integrity}: {fast:?} {bytes:02x?}"
+    );
     if let (Ok(view), Some((frame, _))) = (fast, slow) {
         let from_view = Frame {
             header: view.header,
@@ -93,7 +97,11 @@ fn decoders_agree(bytes: &[u8], integrity: Integrity) {
     }
     let fast = decode_frame(bytes, integrity, est);
     let slow = Frame::decode(bytes, integrity, est);
-    assert_eq!(fast.is_ok(), slow.is_ok(), "{integrity}: {fast:?} {slow:?} {bytes:02x?}");
+    assert_eq!(
+        fast.is_ok(),
+        slow.is_ok(),
+        "{integrity}: {fast:?} {slow:?} {bytes:02x?}"
+    );
     if let (Ok(a), Ok(b)) = (&fast, &slow) {
         assert!(same(a, b), "{a:?} {b:?}");
     }
