@@ -115,8 +115,8 @@ const fn carries_extension(mode: u8, items: usize) -> bool {
     (mode >> 2) & 0b11 == AUTH_CODE && items < MAX_ANGLES_PER_FRAME
 }
 
-/// The integrity code of `auth`.
-const AUTH_CODE: u8 = 2;
+/// The integrity code of `auth` (the key does not matter).
+const AUTH_CODE: u8 = Integrity::Auth(super::SwarmKey::new([0; 16])).code();
 
 /// Elements of the longest frame tuple: mode, sender, sequence number, velocity, items.
 const MAX_ELEMENTS: usize = 4 + MAX_ANGLES_PER_FRAME;
