@@ -123,6 +123,11 @@ fn frames_carry_the_counter_when_it_fits_and_a_tag_over_counter_and_bytes() {
         assert_eq!(f.len(), 12 + 10 * items + ext + TAG_LEN, "{items} items");
         assert!(f.len() <= 60);
         assert_eq!(f[0] >> 2 & 3, 2, "integrity code 2");
+        assert_eq!(
+            usize::from(f[0] >> 4),
+            8 + items,
+            "bits 7-4: 8 + the item count"
+        );
         assert_eq!(&f[2..4], &[0x08, 0x07], "low 16 bits of the counter");
         if ext > 0 {
             let e = 12 + 10 * items;

@@ -9,7 +9,9 @@
 //! --nocapture`) and recorded in docs/core.md ("auth").
 
 use controller_core::wire::auth::{counter, Counter};
-use controller_core::wire::{mode_byte, FrameWriter, Integrity, SwarmKey, MAX_FRAME_LEN};
+use controller_core::wire::{
+    mode_byte, mode_with_items, FrameWriter, Integrity, SwarmKey, MAX_FRAME_LEN,
+};
 use controller_core::{Agent, AgentConfig, AgentId, EstimatorMode, FrameError, FrameStats};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -120,10 +122,15 @@ fn random_frames_are_rejected() {
     campaign("random frames", START, START + 1, |_, rng| {
         let len = rng.random_range(0..=MAX_FRAME_LEN + 4);
         let mut b: Vec<u8> = (0..len).map(|_| rng.random()).collect();
-        // Most attempts get a plausible header (the receiver's mode byte, a neighbour's
-        // id) so that they reach the tag check.
+        // Most attempts get a plausible header (the receiver's mode byte with the item
+        // count that fits the length, a neighbour's id) so that they reach the tag check.
         if len >= 2 && rng.random_bool(0.9) {
-            b[0] = mode();
+            let items = if len == MAX_FRAME_LEN {
+                4
+            } else {
+                (len.saturating_sub(26) / 10).min(3)
+            };
+            b[0] = mode_with_items(mode(), items);
             b[1] = if rng.random_bool(0.5) { SENDER } else { OTHER };
         }
         b

@@ -1,4 +1,4 @@
-//! Wire frames (version 3) between agents: round trip within the documented rounding,
+//! Wire frames (version 4) between agents: round trip within the documented rounding,
 //! one compact frame per agent and tick, rejection of corrupt, stale, repeated, foreign,
 //! misconfigured and non-finite frames, an independent decoder of the documented layout,
 //! and fuzzing of the decoder.
@@ -6,8 +6,8 @@
 mod testkit;
 
 use controller_core::wire::{
-    check_frame, decode_frame, mode_byte, quant, FrameWriter, Integrity, MAX_FRAME_LEN,
-    WIRE_VERSION,
+    check_frame, decode_frame, mode_byte, mode_with_items, quant, FrameWriter, Integrity,
+    MAX_FRAME_LEN,
 };
 use controller_core::{EstimatorMode, FrameError, Measurements, Vec2};
 use proptest::prelude::*;
@@ -86,11 +86,12 @@ fn frames_round_trip_between_agents_within_the_rounding_bound() {
                             // |γ σ / r| with the distance the far vertex divides by (the
                             // test's distances and estimates are ≥ 0.3).
                             let r = if mode == EstimatorMode::Shared {
-                                it.rho[k]
+                                f32::from(it.rho[k])
                             } else {
                                 0.3
                             };
-                            received += f64::from((it.gamma * it.sigma / r).abs());
+                            let (g, s) = (f32::from(it.gamma), f32::from(it.sigma));
+                            received += f64::from((g * s / r).abs());
                         }
                     }
                 }
@@ -217,13 +218,17 @@ fn wrong_version_mode_length_and_values_are_rejected_and_counted() {
     let rx = &mut agents[0];
     const ONE: u16 = 0x3C00;
     let good = frame(2, 1, [0.5, 0.5], &[([1, 3], [ONE, 0xB800, ONE, ONE])]);
-    // Version nibble.
-    let mut v4 = good[..good.len() - 2].to_vec();
-    v4[0] = (4 << 4) | (SHARED & 0x0F);
-    assert_eq!(
-        rx.receive(&with_crc(&v4)),
-        Err(FrameError::UnknownVersion(4))
-    );
+    // Version: bits 7–4 of the mode byte are 8 + the item count (here 9); a version-3
+    // frame's nibble (3) and the nibbles no count gives (13: 5 items) are other versions.
+    assert_eq!(good[0] >> 4, 9);
+    for nibble in [3, 13] {
+        let mut other = good[..good.len() - 2].to_vec();
+        other[0] = (nibble << 4) | (SHARED & 0x0F);
+        assert_eq!(
+            rx.receive(&with_crc(&other)),
+            Err(FrameError::UnknownVersion(nibble))
+        );
+    }
     // Integrity and estimator bits that differ from the receiver's.
     for mode in [
         mode_byte(Integrity::Link, EstimatorMode::Shared),
@@ -232,16 +237,22 @@ fn wrong_version_mode_length_and_values_are_rejected_and_counted() {
         SHARED | 0x03,
     ] {
         let mut b = good[..good.len() - 2].to_vec();
-        b[0] = mode;
+        b[0] = mode_with_items(mode, 1);
         assert_eq!(
             rx.receive(&with_crc(&b)),
-            Err(FrameError::ModeMismatch(mode))
+            Err(FrameError::ModeMismatch(b[0]))
         );
     }
-    // Lengths: not a whole number of items, too short, too long.
+    // Lengths: not the announced number of items (one byte more; one item more or
+    // fewer than announced), too short, too long.
     let mut odd = good[..good.len() - 2].to_vec();
     odd.push(0);
     assert_eq!(rx.receive(&with_crc(&odd)), Err(FrameError::Malformed));
+    for count in [0, 2] {
+        let mut b = good[..good.len() - 2].to_vec();
+        b[0] = mode_with_items(SHARED, count);
+        assert_eq!(rx.receive(&with_crc(&b)), Err(FrameError::Malformed));
+    }
     assert_eq!(
         rx.receive(&with_crc(&good[..11])),
         Err(FrameError::TooShort)
@@ -285,7 +296,7 @@ fn wrong_version_mode_length_and_values_are_rejected_and_counted() {
             st.invalid_value,
             st.accepted
         ),
-        (1, 4, 2, 3, 11, 0)
+        (2, 4, 4, 3, 11, 0)
     );
     // Nothing of the rejected frames was applied; σ = ±1 and ρ = r_min (rounded) are in
     // range.
@@ -333,9 +344,10 @@ fn f16_reference(code: u16) -> Option<f64> {
 }
 
 /// An independent decoder of the layout table in `wire`'s documentation: byte offsets
-/// and types as documented, binary16 from the standard.
+/// and types as documented, binary16 from the standard. Returns the mode byte's bits
+/// 3–0 and its item count (bits 7–4 minus 8) first.
 #[allow(clippy::type_complexity)]
-fn reference_decode(b: &[u8]) -> (u8, u8, u16, [f32; 2], Vec<([u8; 2], [f64; 4])>) {
+fn reference_decode(b: &[u8]) -> (u8, usize, u8, u16, [f32; 2], Vec<([u8; 2], [f64; 4])>) {
     let f32_at = |i: usize| f32::from_le_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]);
     let u16_at = |i: usize| u16::from_le_bytes([b[i], b[i + 1]]);
     let items = (12..b.len() - 2)
@@ -345,7 +357,14 @@ fn reference_decode(b: &[u8]) -> (u8, u8, u16, [f32; 2], Vec<([u8; 2], [f64; 4])
             ([b[i], b[i + 1]], [v(2), v(4), v(6), v(8)])
         })
         .collect();
-    (b[0], b[1], u16_at(2), [f32_at(4), f32_at(8)], items)
+    (
+        b[0] & 0x0F,
+        usize::from(b[0] >> 4) - 8,
+        b[1],
+        u16_at(2),
+        [f32_at(4), f32_at(8)],
+        items,
+    )
 }
 
 /// Valid codes of `[γ, σ, ρ_v, ρ_w]`: finite γ, |σ| ≤ 1, ρ ≥ 0.1.
@@ -392,8 +411,9 @@ proptest! {
         let bytes = frame(sender, seq, vel, &items);
         prop_assert_eq!(bytes.len(), 12 + 10 * items.len() + 2);
         prop_assert_eq!(&bytes, &with_crc(&bytes[..bytes.len() - 2]));
-        let (mode, s, q, v, its) = reference_decode(&bytes);
-        prop_assert_eq!((mode, s, q, v[0].to_bits(), v[1].to_bits()), (SHARED, sender, seq, vel[0].to_bits(), vel[1].to_bits()));
+        let (mode, count, s, q, v, its) = reference_decode(&bytes);
+        prop_assert_eq!((mode, count, s, q, v[0].to_bits(), v[1].to_bits()), (SHARED & 0x0F, items.len(), sender, seq, vel[0].to_bits(), vel[1].to_bits()));
+        prop_assert_eq!(its.len(), items.len());
         let decoded = decode_frame(&bytes, Integrity::Crc16, EstimatorMode::Shared).expect("valid");
         prop_assert_eq!(decoded.header.sender, sender);
         prop_assert_eq!(decoded.header.seq, seq);
@@ -405,14 +425,16 @@ proptest! {
             let got = [it.gamma, it.sigma, it.rho[0], it.rho[1]];
             for k in 0..4 {
                 prop_assert_eq!(f64::from(got[k]), re[k]);
-                prop_assert_eq!(quant::encode(got[k]).0 & 0x7FFF, codes[k] & 0x7FFF);
+                prop_assert_eq!(got[k].0, codes[k]);
+                prop_assert_eq!(quant::encode(f32::from(got[k])).0 & 0x7FFF, codes[k] & 0x7FFF);
             }
         }
     }
 
     /// Any bytes behind a valid CRC: the core's decoder accepts a frame exactly when the
-    /// documented layout holds (version 3, the receiver's modes, a whole number of items
-    /// with two distinct far vertices, finite values, |σ| ≤ 1, ρ > 0).
+    /// documented layout holds (version 4: bits 7–4 of the mode byte are 8 + the item
+    /// count, the receiver's modes in bits 3–0, the announced number of items with two
+    /// distinct far vertices, finite values, |σ| ≤ 1, ρ > 0).
     #[test]
     fn decoder_accepts_exactly_the_documented_frames(
         body in proptest::collection::vec(any::<u8>(), 0..60),
@@ -420,14 +442,15 @@ proptest! {
     ) {
         let mut body = body;
         if fix_mode && !body.is_empty() {
-            body[0] = SHARED;
+            body[0] = mode_with_items(SHARED, (body.len().saturating_sub(12) / 10).min(4));
         }
         let bytes = with_crc(&body);
         let ours = decode_frame(&bytes, Integrity::Crc16, EstimatorMode::Shared);
         let documented = bytes.len() <= MAX_FRAME_LEN
             && body.len() >= 12
-            && body[0] == SHARED
-            && (body.len() - 12) % 10 == 0
+            && body[0] & 0x0F == SHARED & 0x0F
+            && (8..=12).contains(&(body[0] >> 4))
+            && body.len() == 12 + 10 * usize::from((body[0] >> 4) - 8)
             && f32::from_le_bytes([body[4], body[5], body[6], body[7]]).is_finite()
             && f32::from_le_bytes([body[8], body[9], body[10], body[11]]).is_finite()
             && body[12..].chunks(10).all(|c| {
@@ -439,7 +462,7 @@ proptest! {
                     && v(8).is_some_and(|r| r > 0.0)
             });
         prop_assert_eq!(ours.is_ok(), documented, "{:?}", ours);
-        if body.len() >= 12 && body[0] >> 4 != WIRE_VERSION && bytes.len() <= MAX_FRAME_LEN {
+        if body.len() >= 12 && !(8..=12).contains(&(body[0] >> 4)) && bytes.len() <= MAX_FRAME_LEN {
             prop_assert_eq!(ours, Err(FrameError::UnknownVersion(body[0] >> 4)));
         }
     }

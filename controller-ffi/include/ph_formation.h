@@ -51,7 +51,7 @@
 
 /**
  * Most frames one `ph_frames` call produces: an agent is the apex of at most one
- * controlled angle per triangle, a frame holds four (wire v3, every integrity mode),
+ * controlled angle per triangle, a frame holds four (wire v4, every integrity mode),
  * and with `PH_INTEGRITY_AUTH` a broadcast of full frames may add one sync frame.
  */
 #define PH_MAX_FRAMES_PER_TICK (((PH_MAX_TRIANGLES + 3) / 4) + 1)

@@ -69,7 +69,7 @@ pub const PH_MAX_SCHEDULE_STEPS: usize = 8;
 /// buffer of `ph_frames`.
 pub const PH_MAX_FRAME_LEN: usize = 60;
 /// Most frames one `ph_frames` call produces: an agent is the apex of at most one
-/// controlled angle per triangle, a frame holds four (wire v3, every integrity mode),
+/// controlled angle per triangle, a frame holds four (wire v4, every integrity mode),
 /// and with `PH_INTEGRITY_AUTH` a broadcast of full frames may add one sync frame.
 // Written out (not `div_ceil(4) + 1`) so that cbindgen can put it in the header.
 #[allow(clippy::manual_div_ceil)]

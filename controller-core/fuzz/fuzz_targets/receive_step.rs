@@ -7,9 +7,15 @@
 //! is one `decode_frame` accepts (`auth`: when it carries its counter); with `auth` the
 //! carried counters accepted from one sender strictly increase; the force is always
 //! finite and within `max_force`; every outgoing frame is at most 60 bytes and decodes.
+//! And the two decoders agree on every frame, incoming and outgoing, for every agent:
+//! the fast path (`check_frame`, `decode_frame`) and postcard's deserializer
+//! (`postcard::take_from_bytes::<Frame>`, `Frame::decode`) accept and reject alike and
+//! give the same frame.
 #![no_main]
 
-use controller_core::wire::{auth, check_frame, decode_frame, Integrity, SwarmKey};
+use controller_core::wire::{
+    auth, check_frame, decode_frame, mode_byte, CounterExt, Frame, Integrity, SwarmKey,
+};
 use controller_core::{
     Agent, AgentConfig, AngleConfig, BearingMeasurement, EstimatorMode, Measurements,
     TriangleConfig, Vec2,
@@ -49,6 +55,57 @@ fn f32_at(data: &[u8], i: usize) -> f32 {
 }
 
 const KEY: SwarmKey = SwarmKey::new(*b"fuzzing key 16 B");
+
+/// Frames equal field for field, the velocity bit for bit.
+fn same(a: &Frame, b: &Frame) -> bool {
+    a.header == b.header
+        && a.velocity.map(f32::to_bits) == b.velocity.map(f32::to_bits)
+        && a.angles == b.angles
+        && a.counter_ext == b.counter_ext
+}
+
+/// The fast decoders and postcard's agree on `bytes` for a receiver with `integrity`
+/// (shared estimates): structurally (`check_frame` against `take_from_bytes` of the
+/// bytes before the trailer, nothing left over, the receiver's modes, the CRC) and
+/// completely (`decode_frame` against `Frame::decode`).
+fn decoders_agree(bytes: &[u8], integrity: Integrity) {
+    let est = EstimatorMode::Shared;
+    let fast = check_frame(bytes, integrity, est);
+    let trailer = integrity.trailer_len();
+    let slow = (bytes.len() <= 60)
+        .then(|| bytes.split_at_checked(bytes.len().checked_sub(trailer)?))
+        .flatten()
+        .filter(|(body, crc)| match integrity {
+            Integrity::Crc16 => crc16(body) == **crc,
+            _ => true,
+        })
+        .and_then(|(body, _)| postcard::take_from_bytes::<Frame>(body).ok())
+        .filter(|(f, rest)| rest.is_empty() && f.header.mode == mode_byte(integrity, est));
+    assert_eq!(
+        fast.is_ok(),
+        slow.is_some(),
+        "{integrity}: {fast:?} {bytes:02x?}"
+    );
+    if let (Ok(view), Some((frame, _))) = (fast, slow) {
+        let from_view = Frame {
+            header: view.header,
+            velocity: view.velocity,
+            angles: view.angles().collect(),
+            counter_ext: view.carried_counter().map(CounterExt::of_counter),
+        };
+        assert!(same(&from_view, &frame), "{from_view:?} {frame:?}");
+    }
+    let fast = decode_frame(bytes, integrity, est);
+    let slow = Frame::decode(bytes, integrity, est);
+    assert_eq!(
+        fast.is_ok(),
+        slow.is_ok(),
+        "{integrity}: {fast:?} {slow:?} {bytes:02x?}"
+    );
+    if let (Ok(a), Ok(b)) = (&fast, &slow) {
+        assert!(same(a, b), "{a:?} {b:?}");
+    }
+}
 
 /// Re-signs an `auth` frame that carries its counter (tag over that counter and the bytes).
 fn sign(bytes: &mut [u8]) {
@@ -106,6 +163,7 @@ fuzz_target!(|data: &[u8]| {
             if matches!(integrity, Integrity::Auth(_)) && head & 64 != 0 {
                 sign(&mut bytes);
             }
+            decoders_agree(&bytes, *integrity);
             if a.receive(&bytes).is_ok() {
                 let view = check_frame(&bytes, *integrity, EstimatorMode::Shared);
                 let carried = view.ok().and_then(|v| v.carried_counter());
@@ -127,6 +185,7 @@ fuzz_target!(|data: &[u8]| {
                 assert!(f.len() <= 60);
                 let d = decode_frame(f, integrity, EstimatorMode::Shared);
                 assert!(d.is_ok(), "{integrity}: {d:?} {f:02x?}");
+                decoders_agree(f, integrity);
             });
         }
         rest = tail.get(40..).unwrap_or(&[]);

@@ -1,7 +1,7 @@
 //! A frame's CRC-16 checked once for several receivers ([`CrcCheck`]).
 
-use super::{mode_byte, Integrity, MAX_FRAME_LEN};
-use crate::{crc16, EstimatorMode};
+use super::{items_of_mode, Integrity, MAX_FRAME_LEN};
+use crate::crc16;
 use core::num::NonZeroU8;
 
 /// The result of the CRC-16 check of one `crc16` frame, computed once
@@ -27,18 +27,16 @@ pub struct CrcCheck {
 /// Bit 7 of [`CrcCheck::len_ok`].
 const OK: u8 = 0x80;
 
-/// The mode byte of a version-3 `crc16` frame, bits 1–0 (the estimator mode,
-/// [`super::estimator_code`]) cleared.
-const CRC16_MODE: u8 = mode_byte(Integrity::Crc16, EstimatorMode::Shared);
-/// The estimator bits of the mode byte.
-const ESTIMATOR_BITS: u8 = 0b11;
+/// The integrity bits of the mode byte (3–2).
+const INTEGRITY_BITS: u8 = 0b1100;
 
 impl CrcCheck {
-    /// The CRC check of `bytes` if they are a version-3 `crc16` frame of at most
+    /// The CRC check of `bytes` if they are a version-4 `crc16` frame of at most
     /// [`MAX_FRAME_LEN`] bytes (mode byte and length); `None` otherwise (then a
     /// receiver checks the frame itself, as always).
     pub fn of(bytes: &[u8]) -> Option<Self> {
-        if bytes.first()? & !ESTIMATOR_BITS != CRC16_MODE {
+        let mode = *bytes.first()?;
+        if items_of_mode(mode).is_none() || mode & INTEGRITY_BITS != Integrity::Crc16.code() << 2 {
             return None;
         }
         let (body, trailer) = bytes.split_last_chunk::<2>()?;

@@ -1,24 +1,38 @@
-//! Wire frames, version 3: what one agent broadcasts per communication tick, in one
-//! fixed-layout frame of at most [`MAX_FRAME_LEN`] bytes (the Crazyflie peer-to-peer
-//! payload), and COBS framing for byte streams (UART).
+//! Wire frames, version 4: what one agent broadcasts per communication tick, in one
+//! frame of at most [`MAX_FRAME_LEN`] bytes (the Crazyflie peer-to-peer payload), and
+//! COBS framing for byte streams (UART).
 //!
-//! # Layout (all multi-byte fields little-endian)
+//! # Definition
+//!
+//! A frame is **postcard of [`Frame`]**, followed by its integrity trailer:
+//! `postcard::to_slice(&frame)` and then the CRC-16/IBM-SDLC of those bytes
+//! ([`Integrity::Crc16`]: exactly postcard's own CRC flavour,
+//! `postcard::ser_flavors::crc::to_slice_u16` with that CRC), nothing
+//! ([`Integrity::Link`]), or the SipHash-2-4 tag ([`Integrity::Auth`], see [`auth`]).
+//! [`Frame::encode`] and [`Frame::decode`] are that definition in code (postcard's own
+//! serializer and deserializer); [`FrameWriter`] and [`check_frame`] are the hand-written
+//! fast path the agents use, proven byte for byte equal to them
+//! (`tests/wire_postcard.rs`, a property test over every integrity and estimator mode and
+//! item count, valid, random and corrupted bytes).
+//!
+//! # Layout (the consequence; all multi-byte fields little-endian)
 //!
 //! | offset | bytes | field |
 //! |---|---|---|
-//! | 0 | 1 | mode byte: bits 7–4 [`WIRE_VERSION`], bits 3–2 [`Integrity`], bits 1–0 [`EstimatorMode`] |
+//! | 0 | 1 | mode byte: bits 7–4 `8 +` the number `k` of angle items (0–4; wire version 4), bits 3–2 [`Integrity`], bits 1–0 [`EstimatorMode`] |
 //! | 1 | 1 | sender id ([`AgentId`]) |
-//! | 2 | 2 | sequence number (`u16`, +1 per frame, wrapping) |
+//! | 2 | 2 | sequence number (`u16`, +1 per frame, wrapping; postcard `fixint`) |
 //! | 4 | 8 | sender velocity `v_n` (S1): `f32` x, `f32` y (m/s) |
-//! | 12 | 10·k | k angle items (below) |
+//! | 12 | 10·k | k angle items ([`AngleItem`], below) |
 //! | 12 + 10k | 0 or 2 | integrity trailer: CRC-16/IBM-SDLC of bytes `0..12+10k` ([`Integrity::Crc16`]), nothing ([`Integrity::Link`]) |
 //!
-//! With [`Integrity::Auth`] the items are followed by a 6-byte counter extension when it
-//! fits (at most 3 items) and then an 8-byte tag ([`auth`]):
+//! With [`Integrity::Auth`] a frame of at most 3 items carries a 6-byte counter
+//! extension ([`CounterExt`]) after its items (a frame of 4 has no room for it), and
+//! every frame ends with an 8-byte tag ([`auth`]):
 //!
 //! | offset | bytes | field |
 //! |---|---|---|
-//! | 12 + 10k | 0 or 6 | counter extension: boot epoch (`u32`), high 16 bits of the frame number (`u16`) |
+//! | 12 + 10k | 6 (k ≤ 3) or 0 (k = 4) | counter extension: boot epoch (`u32`), high 16 bits of the frame number (`u16`) |
 //! | end − 8 | 8 | SipHash-2-4 tag of the sender's full counter and every byte before the tag |
 //!
 //! One angle item per controlled angle `α = (n; v, w)` whose apex `n` is the sender
@@ -38,20 +52,37 @@
 //! `g_{α,k}`, brings `γ_α` up to date with its own motion since, and applies S8 with
 //! `ρ_k` (shared estimates: SPEC §6) or its own distance (per-agent copy, range).
 //!
-//! The item count follows from the length. A frame holds at most
-//! [`Integrity::max_angles`] items (4); an agent that is the apex of more angles sends
-//! several frames, each with its own sequence number and the velocity.
+//! # Where postcard's item count lives
+//!
+//! postcard writes the length of a variable sequence (or an enum's tag) as one byte of
+//! its own. Here it would cost a byte that the budget does not have: `auth` at 4 items
+//! is 12 + 40 + 8 = 60 bytes, the Crazyflie limit. The count therefore lives in the
+//! mode byte's top nibble, which held the version (3) and now holds `8 + k`: the bits
+//! that integrity and estimator mode use (3–0) keep their meaning, a version-3 receiver
+//! reads nibbles 8–12 as unknown versions, and this one reads 0–7 (earlier versions) and
+//! 13–15 the same way ([`FrameError::UnknownVersion`]). A derived struct cannot share a
+//! byte between two fields, so [`Frame`]'s `Serialize` and `Deserialize` are written by
+//! hand: a tuple whose first element, the mode byte, says how many items (and whether a
+//! counter extension) follow; every element is a derived type with postcard's `fixint`
+//! for the fixed-width integers. The other homes cost more: a sequence number of 8 bits
+//! would shrink the replay window of `auth` to 128 frames and the stale-sequence window
+//! to 127; an item-count enum's tag is the same extra byte.
+//!
+//! An agent that is the apex of more angles than a frame holds
+//! ([`Integrity::max_angles`], 4) sends several frames, each with its own sequence
+//! number and the velocity.
 //!
 //! Receivers reject, with a typed [`FrameError`] counted in [`crate::FrameStats`], every
-//! frame whose length, CRC, version, integrity or estimator mode, sender, sequence number
-//! or values (non-finite, `|σ| > 1`, `ρ ≤ 0`, an estimate below the receiver's `r_min`)
-//! are wrong, and in `auth` mode every frame whose tag does not verify or whose counter
-//! is not newer than the sender's last accepted one; a rejected frame changes nothing
-//! but the counters.
+//! frame whose length, CRC, version, integrity or estimator mode, item count, sender,
+//! sequence number or values (non-finite, `|σ| > 1`, `ρ ≤ 0`, an estimate below the
+//! receiver's `r_min`) are wrong, and in `auth` mode every frame whose tag does not
+//! verify or whose counter is not newer than the sender's last accepted one; a rejected
+//! frame changes nothing but the counters.
 
 pub mod auth;
 mod checked;
 mod cobs;
+mod frame;
 pub mod quant;
 mod reader;
 mod writer;
@@ -59,7 +90,8 @@ mod writer;
 pub use auth::SwarmKey;
 pub use checked::CrcCheck;
 pub use cobs::{cobs_decode, cobs_encode, CobsAccumulator, MAX_COBS_LEN};
-pub use reader::{check_frame, decode_frame, AngleItem, Frame, FrameView};
+pub use frame::{AngleItem, CounterExt, Frame, F16};
+pub use reader::{check_frame, decode_frame, FrameView};
 pub(crate) use reader::{check_mode, RawAngle};
 pub use writer::FrameWriter;
 
@@ -69,8 +101,13 @@ use serde::{Deserialize, Serialize};
 
 /// Largest frame, in bytes (Crazyflie P2P payload limit).
 pub const MAX_FRAME_LEN: usize = 60;
-/// The wire-format version this crate writes and accepts (bits 7–4 of the mode byte).
-pub const WIRE_VERSION: u8 = 3;
+/// The wire-format version this crate writes and accepts. Versions up to 3 carried their
+/// number in bits 7–4 of the mode byte; version 4 carries `8 +` the item count there
+/// ([`COUNT_NIBBLE_BASE`]).
+pub const WIRE_VERSION: u8 = 4;
+/// Bits 7–4 of a version-4 mode byte are this plus the number of angle items (0–4):
+/// nibbles 8–12. Any other nibble is refused as [`FrameError::UnknownVersion`].
+pub const COUNT_NIBBLE_BASE: u8 = 8;
 
 /// Byte offsets of the frame fields.
 pub mod offset {
@@ -178,16 +215,36 @@ pub const fn estimator_code(mode: EstimatorMode) -> u8 {
     }
 }
 
-/// The mode byte of a frame written with `integrity` by an agent in `estimator` mode.
+/// The mode byte of a frame without angle items written with `integrity` by an agent in
+/// `estimator` mode; a frame with `k` items carries [`mode_with_items`]`(mode, k)`.
+/// [`FrameHeader::mode`] and [`crate::Agent`] use this form (the count is the items').
 pub const fn mode_byte(integrity: Integrity, estimator: EstimatorMode) -> u8 {
-    (WIRE_VERSION << 4) | (integrity.code() << 2) | estimator_code(estimator)
+    (COUNT_NIBBLE_BASE << 4) | (integrity.code() << 2) | estimator_code(estimator)
+}
+
+/// The mode byte on the air of a frame with `items` angle items whose modes are those of
+/// `mode` (bits 3–0; bits 7–4 become `8 + items`).
+pub const fn mode_with_items(mode: u8, items: usize) -> u8 {
+    ((COUNT_NIBBLE_BASE + items as u8) << 4) | (mode & 0x0F)
+}
+
+/// The number of angle items a mode byte announces, or `None` if its bits 7–4 are not a
+/// version-4 nibble (8–12).
+pub const fn items_of_mode(mode: u8) -> Option<usize> {
+    let k = (mode >> 4).wrapping_sub(COUNT_NIBBLE_BASE) as usize;
+    if k <= MAX_ANGLES_PER_FRAME {
+        Some(k)
+    } else {
+        None
+    }
 }
 
 /// The fixed header of every frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FrameHeader {
-    /// The mode byte (version, integrity, estimator mode).
+    /// The sender's mode byte without the item count, as [`mode_byte`] gives it (bits 7–4
+    /// are 8; on the air they are `8 +` the number of items, see [`mode_with_items`]).
     pub mode: u8,
     /// The sending agent.
     pub sender: AgentId,
@@ -205,13 +262,15 @@ pub enum FrameError {
     TooLong,
     /// CRC mismatch.
     BadCrc,
-    /// The mode byte's version is not [`WIRE_VERSION`].
+    /// The mode byte's bits 7–4 (carried) are not those of a version-4 frame (8 + an item
+    /// count of 0–4): another wire version.
     UnknownVersion(u8),
     /// The frame's integrity or estimator mode differs from the receiver's: the swarm is
     /// misconfigured. Carries the received mode byte.
     ModeMismatch(u8),
-    /// The length does not leave a whole number of angle items, or an item names the
-    /// same far vertex twice.
+    /// The length is not that of the item count the mode byte announces (with `auth`:
+    /// and the counter extension when there is room for it), or an item names the same
+    /// far vertex twice.
     Malformed,
     /// The sender is not one of this agent's neighbours.
     UnknownSender(AgentId),
@@ -251,7 +310,10 @@ impl core::fmt::Display for FrameError {
             Self::TooShort => write!(f, "frame shorter than header, velocity and trailer"),
             Self::TooLong => write!(f, "frame longer than {MAX_FRAME_LEN} bytes"),
             Self::BadCrc => write!(f, "CRC mismatch"),
-            Self::UnknownVersion(v) => write!(f, "unknown wire version {v}"),
+            Self::UnknownVersion(v) => write!(
+                f,
+                "unknown wire version (mode byte bits 7-4 = {v}, version 4 uses 8-12)"
+            ),
             Self::ModeMismatch(m) => write!(
                 f,
                 "integrity or estimator mode differs from this agent's (mode byte {m:#04x})"

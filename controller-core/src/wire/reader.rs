@@ -1,26 +1,13 @@
 //! Checking and reading frames in place (layout in [`super`]).
 
 use super::auth::{self, Counter, SwarmKey, TAG_LEN};
+use super::frame::{AngleItem, CounterExt, Frame, F16};
 use super::{
-    mode_byte, offset, quant, FrameError, FrameHeader, Integrity, ANGLE_ITEM_LEN, FIXED_LEN,
-    MAX_ANGLES_PER_FRAME, MAX_FRAME_LEN, WIRE_VERSION,
+    items_of_mode, mode_byte, mode_with_items, offset, FrameError, FrameHeader, Integrity,
+    ANGLE_ITEM_LEN, FIXED_LEN, MAX_ANGLES_PER_FRAME, MAX_FRAME_LEN,
 };
 use crate::config::EstimatorMode;
 use crate::{crc16, AgentId};
-
-/// One angle item, decoded (fields: see [`super`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct AngleItem {
-    /// The far vertices `v`, `w` of the angle `(sender; v, w)`.
-    pub far: [AgentId; 2],
-    /// `γ_α` (S7).
-    pub gamma: f32,
-    /// `σ_α = s_nv × s_nw`.
-    pub sigma: f32,
-    /// `[ρ_v, ρ_w]`: the distances the apex used.
-    pub rho: [f32; 2],
-}
 
 /// One angle item's bytes: far vertices and the binary16 codes of `[γ, σ, ρ_v, ρ_w]`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -161,17 +148,15 @@ impl<'a> FrameView<'a> {
         }
     }
 
-    /// The decoded angle items (invalid codes read as NaN; call [`FrameView::validate`]
-    /// first).
+    /// The angle items (their values unchecked until [`FrameView::validate`]).
     pub fn angles(&self) -> impl Iterator<Item = AngleItem> + 'a {
         self.raw_items().map(|it| {
-            let v = |c| quant::decode(c).unwrap_or(f32::NAN);
             let [g, s, r0, r1] = it.codes;
             AngleItem {
                 far: it.far,
-                gamma: v(g),
-                sigma: v(s),
-                rho: [v(r0), v(r1)],
+                gamma: F16(g),
+                sigma: F16(s),
+                rho: [F16(r0), F16(r1)],
             }
         })
     }
@@ -225,21 +210,30 @@ pub(crate) fn check_mode(
     let [mode, sender, q0, q1, ref velocity @ ..] = *head;
     let [ref vx @ .., _, _, _, _] = *velocity;
     let [_, _, _, _, ref vy @ ..] = *velocity;
-    if mode >> 4 != WIRE_VERSION {
-        return Err(FrameError::UnknownVersion(mode >> 4));
-    }
-    if mode != expected_mode {
-        return Err(FrameError::ModeMismatch(mode));
+    // Bits 7–4: 8 + the item count (version 4); bits 3–0: the modes. With the expected
+    // mode byte's nibble 8, `mode − expected` is `0x10 · count` exactly when the modes
+    // agree and the nibble is 8..=12: one subtraction, one rotation, one comparison.
+    let count = mode.wrapping_sub(expected_mode).rotate_right(4);
+    if usize::from(count) > MAX_ANGLES_PER_FRAME {
+        return Err(mode_error(mode));
     }
     let seq = u16::from_le_bytes([q0, q1]);
     let (items, rest) = items.as_chunks::<ANGLE_ITEM_LEN>();
+    if items.len() != usize::from(count) {
+        return Err(FrameError::Malformed);
+    }
+    // `auth`: the counter extension exactly when there is room for it (at most 3 items).
     let signed = match (integrity, rest, trailer.first_chunk::<TAG_LEN>()) {
-        (Integrity::Auth(_), [], Some(tag)) => Some(Signed {
-            bytes: body,
-            tag,
-            counter: None,
-        }),
-        (Integrity::Auth(_), [e0, e1, e2, e3, h0, h1], Some(tag)) => {
+        (Integrity::Auth(_), [], Some(tag)) if usize::from(count) == MAX_ANGLES_PER_FRAME => {
+            Some(Signed {
+                bytes: body,
+                tag,
+                counter: None,
+            })
+        }
+        (Integrity::Auth(_), [e0, e1, e2, e3, h0, h1], Some(tag))
+            if usize::from(count) < MAX_ANGLES_PER_FRAME =>
+        {
             let epoch = u32::from_le_bytes([*e0, *e1, *e2, *e3]);
             let high = u32::from(u16::from_le_bytes([*h0, *h1]));
             Some(Signed {
@@ -248,30 +242,33 @@ pub(crate) fn check_mode(
                 counter: Some(auth::counter(epoch, (high << 16) | u32::from(seq))),
             })
         }
-        (_, [], _) => None,
+        (Integrity::Crc16 | Integrity::Link, [], _) => None,
         _ => return Err(FrameError::Malformed),
     };
     Ok(FrameView {
-        header: FrameHeader { mode, sender, seq },
+        header: FrameHeader {
+            mode: mode_with_items(mode, 0),
+            sender,
+            seq,
+        },
         velocity: [f32::from_le_bytes(*vx), f32::from_le_bytes(*vy)],
         items,
         signed,
     })
 }
 
-/// A frame decoded completely (for tools and tests; agents read frames in place).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Frame {
-    /// The header.
-    pub header: FrameHeader,
-    /// The sender's velocity.
-    pub velocity: [f32; 2],
-    /// The angle items.
-    pub angles: heapless::Vec<AngleItem, MAX_ANGLES_PER_FRAME>,
+/// Why a mode byte is not the receiver's (cold): another version, or other modes.
+#[cold]
+fn mode_error(mode: u8) -> FrameError {
+    match items_of_mode(mode) {
+        None => FrameError::UnknownVersion(mode >> 4),
+        Some(_) => FrameError::ModeMismatch(mode),
+    }
 }
 
 /// Checks a frame ([`check_frame`] and [`FrameView::validate`] with any positive
-/// distance) and decodes it. Never panics.
+/// distance) and decodes it: the fast path's decoder, equal to the postcard decoder
+/// [`Frame::decode`] on every input (`tests/wire_postcard.rs`). Never panics.
 ///
 /// In `auth` mode it also verifies the tag with the counter the frame carries
 /// ([`FrameError::Unsynced`] for a frame without the counter extension); it keeps no
@@ -294,5 +291,6 @@ pub fn decode_frame(
         velocity: view.velocity,
         // At most MAX_ANGLES_PER_FRAME items fit in MAX_FRAME_LEN bytes.
         angles: view.angles().take(MAX_ANGLES_PER_FRAME).collect(),
+        counter_ext: view.carried_counter().map(CounterExt::of_counter),
     })
 }

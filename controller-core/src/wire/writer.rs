@@ -1,7 +1,7 @@
 //! Building frames (layout in [`super`]).
 
 use super::auth::{self, Counter, StoredCounter, COUNTER_EXT_LEN, TAG_LEN};
-use super::{offset, Integrity, ANGLE_ITEM_LEN, FIXED_LEN, MAX_FRAME_LEN};
+use super::{mode_with_items, offset, Integrity, ANGLE_ITEM_LEN, FIXED_LEN, MAX_FRAME_LEN};
 use crate::{crc16, AgentId};
 
 // The byte arrays below are built in the documented field order.
@@ -19,8 +19,11 @@ const _: () = assert!(
 );
 
 /// Builds one frame at a time: [`FrameWriter::start`] (header and velocity), then
-/// [`FrameWriter::push_angle`] while it fits, then [`FrameWriter::finish`] (trailer).
-/// The buffer is reused from frame to frame (no zeroing).
+/// [`FrameWriter::push_angle`] while it fits, then [`FrameWriter::finish`] (the item
+/// count in the mode byte, the trailer). The buffer is reused from frame to frame (no
+/// zeroing). The fast path's encoder: its bytes are `postcard::to_slice` of the
+/// [`super::Frame`] it holds and the trailer, as [`super::Frame::encode`] writes them
+/// (`tests/wire_postcard.rs`).
 #[derive(Clone, Debug)]
 pub struct FrameWriter {
     buf: [u8; MAX_FRAME_LEN],
@@ -42,7 +45,9 @@ impl FrameWriter {
         }
     }
 
-    /// Starts a frame: the mode byte, sender, sequence number and velocity. In `auth`
+    /// Starts a frame: the mode byte (its modes, bits 3–0: [`super::mode_byte`]; bits 7–4
+    /// are the item count's, written by [`FrameWriter::finish`]), sender, sequence number
+    /// and velocity. In `auth`
     /// mode the frame's full counter is `seq` (epoch 0): use
     /// [`FrameWriter::start_counted`].
     #[inline]
@@ -104,10 +109,15 @@ impl FrameWriter {
         (self.len.saturating_sub(FIXED_LEN)) / ANGLE_ITEM_LEN
     }
 
-    /// Appends the integrity trailer and returns the finished frame. In `auth` mode: the
-    /// counter extension if it fits (at most 3 items), then the tag.
+    /// Writes the item count into the mode byte, appends the integrity trailer and returns
+    /// the finished frame. In `auth` mode: the counter extension if it fits (at most 3
+    /// items), then the tag.
     #[inline]
     pub fn finish(&mut self) -> &[u8] {
+        let items = self.angles();
+        if let Some(mode) = self.buf.first_mut() {
+            *mode = mode_with_items(*mode, items);
+        }
         let mut body = self.len;
         match &self.integrity {
             Integrity::Crc16 => {
