@@ -6,6 +6,7 @@ mod design;
 mod export;
 mod run;
 mod sweep;
+mod view;
 
 pub use design::{DesignArgs, Shape};
 
@@ -58,6 +59,15 @@ pub enum Command {
     Sweep(sweep::SweepArgs),
     /// Write one agent's configuration as the C API's checked blob (docs/c-api.md).
     Export(ExportArgs),
+    /// Print the path of a run's replay.html (writing it if missing) and open it in a
+    /// browser when there is one ($BROWSER, else xdg-open with a display).
+    View {
+        /// The run's output directory.
+        dir: PathBuf,
+        /// Only print the path.
+        #[arg(long)]
+        no_open: bool,
+    },
 }
 
 /// Arguments of `host-sim export`.
@@ -177,6 +187,7 @@ pub fn execute(cli: Cli) -> u8 {
             exit_code::CONVERGED
         }
         Some(Command::Sweep(args)) => sweep::command(&args, quiet),
+        Some(Command::View { dir, no_open }) => view::view_command(&dir, no_open),
         Some(Command::Plot { dir }) => match crate::report::plot_run(&dir) {
             Ok(files) => {
                 if !quiet {

@@ -44,6 +44,7 @@ mod trajectories;
 mod xy;
 
 pub use error::PlotError;
+pub(crate) use thinning::spread;
 pub use xy::{plot_xy, XyChart, XyLine, XyPanel, XyPoint};
 
 use input::{load_run, Run};
