@@ -44,6 +44,10 @@ pub enum Command {
         /// Override a field before validation, e.g. `--set radio.loss=0.2`.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
+        /// Also draw the formation (labelled agents, triangles, desired angles, leader
+        /// edge, initial and target positions) into FILE (.png or .svg).
+        #[arg(long, value_name = "FILE")]
+        plot: Option<PathBuf>,
     },
     /// List the built-in scenarios.
     List,
@@ -178,7 +182,11 @@ pub fn execute(cli: Cli) -> u8 {
         ),
         Some(Command::Run(args)) => run_command(&args, quiet),
         Some(Command::Export(args)) => export::export_command(&args, quiet),
-        Some(Command::Validate { scenario, set }) => validate_command(&scenario, &set, quiet),
+        Some(Command::Validate {
+            scenario,
+            set,
+            plot,
+        }) => validate_command(&scenario, &set, plot.as_deref(), quiet),
         Some(Command::Design(args)) => design_command(&args, quiet),
         Some(Command::List) => {
             for b in BUILTINS {
@@ -228,9 +236,26 @@ pub(crate) fn load(scenario: &str, set: &[String]) -> Result<crate::model::Model
     crate::api::load_toml(&text, "<stdin>", set)
 }
 
-fn validate_command(scenario: &str, set: &[String], quiet: bool) -> u8 {
+/// Draws the formation of the scenario `text` into `file`.
+fn plot_formation_of(text: &str, name: &str, file: &std::path::Path) -> Result<(), String> {
+    let m = crate::api::load_toml(text, name, &[]).map_err(|e| e.to_string())?;
+    crate::report::plot::plot_formation(&m, file).map_err(|e| e.to_string())
+}
+
+fn validate_command(
+    scenario: &str,
+    set: &[String],
+    plot: Option<&std::path::Path>,
+    quiet: bool,
+) -> u8 {
     match load(scenario, set) {
         Ok(m) => {
+            if let Some(file) = plot {
+                if let Err(e) = crate::report::plot::plot_formation(&m, file) {
+                    eprintln!("error: {e}");
+                    return exit_code::IO;
+                }
+            }
             if !quiet {
                 println!(
                     "ok: {} ({}): {} agents, {} triangles, {} edges, mode {}, estimator {}, {} s",

@@ -30,6 +30,7 @@ mod angle_errors;
 mod energy;
 mod error;
 mod estimates;
+mod formation;
 mod input;
 mod legend;
 mod maneuvers;
@@ -44,6 +45,7 @@ mod trajectories;
 mod xy;
 
 pub use error::PlotError;
+pub use formation::{plot_formation, MAX_LABELLED_AGENTS};
 pub(crate) use thinning::spread;
 pub use xy::{plot_xy, XyChart, XyLine, XyPanel, XyPoint};
 

@@ -1,6 +1,6 @@
 //! `replay.html`: one self-contained page that replays a run in a browser, offline from
 //! `file://` (`docs/outputs.md`). The data is read from the run directory's
-//! `timeseries.csv` and `summary.json` ([`data`]), thinned in time and space to a bounded
+//! `timeseries.csv` and `summary.json` ([`ReplayData`]), thinned in time and space to a bounded
 //! size, and written as JSON into the page template (`replay.html`, next to this file:
 //! canvas drawing, controls and the test hook `window.phReplay`).
 //!
