@@ -77,3 +77,21 @@ fn design_plot_draws_the_designed_formation_and_a_bad_file_is_an_error() {
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("/nonexistent/dir/g.png"));
 }
+
+#[test]
+fn trajectory_and_shape_plots_label_the_agents() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let out = tmp.path().join("p");
+    let o = bin()
+        .args(["-q", "run", "paper", "--duration", "2", "--out"])
+        .arg(&out)
+        .output()
+        .expect("spawn");
+    assert_eq!(o.status.code(), Some(10), "{o:?}");
+    for figure in ["trajectories.svg", "shape.svg"] {
+        let labels = texts(&std::fs::read_to_string(out.join(figure)).expect("svg"));
+        for id in ["1", "2", "3", "4"] {
+            assert!(labels.iter().any(|l| l == id), "{figure}: agent {id}");
+        }
+    }
+}

@@ -6,7 +6,7 @@
 
 use super::legend::{entry, with_legend, Key};
 use super::ranges::{lin_range, sane};
-use super::style::{colour, plan_view, LEADER};
+use super::style::{agent_ids, colour, plan_view, LEADER};
 use super::text::{drawable, fit_text};
 use super::{ensure_font, DrawResult, PlotError, FONT, IMAGE_SIZE};
 use crate::model::Model;
@@ -16,8 +16,9 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
-/// Agents are labelled up to this many; beyond, the triangles and angle marks too are
-/// left out (they would cover each other).
+/// Plan views (trajectories, shape, formation) label agents with their ids up to this many;
+/// beyond, the formation picture also leaves out the triangles and angle marks (they
+/// would cover each other).
 pub const MAX_LABELLED_AGENTS: usize = 50;
 /// Grey of the initial positions.
 const INITIAL: RGBColor = RGBColor(130, 130, 130);
@@ -209,19 +210,7 @@ where
                 label.clone().pos(centre),
             )))?;
         }
-        // Agent ids, up and right of each agent.
-        let id_font = TextStyle::from((FONT, 17).into_font()).color(&BLACK);
-        chart.draw_series((0..n).filter_map(|i| {
-            let p = at(i)?;
-            Some(
-                EmptyElement::at(p)
-                    + Text::new(
-                        drawable(&m.agents[i].name, bitmap),
-                        (7, -20),
-                        id_font.clone(),
-                    ),
-            )
-        }))?;
     }
-    Ok(())
+    let ids: Vec<String> = m.agents.iter().map(|a| a.name.clone()).collect();
+    agent_ids(&mut chart, &tgt, &ids, bitmap)
 }
