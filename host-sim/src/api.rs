@@ -36,7 +36,7 @@ pub fn load(scenario: &str, overrides: &[String]) -> Result<Model, ScenarioError
 pub fn load_toml(text: &str, name: &str, overrides: &[String]) -> Result<Model, ScenarioErrors> {
     let source = Source::from_text(name, text);
     let file = source.parse(overrides)?;
-    scenario::validate(&file, &source.label, &source.default_name)
+    scenario::validate_text(&file, &source.label, &source.default_name, &source.text)
 }
 
 /// What stopped a library call: an invalid scenario, a run that could not finish, or an
