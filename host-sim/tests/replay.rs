@@ -349,4 +349,22 @@ fn replay_in_headless_chromium() {
         shots.push(pixels);
     }
     assert_ne!(shots[0], shots[1], "first and last frames look the same");
+
+    // The optional fields a later run may write (headings, field of view, dropped links)
+    // are drawn without error.
+    let mut d = page_data(&std::fs::read_to_string(&page).expect("page"));
+    let cells = d["x"].as_array().expect("x").len();
+    let edge_cells = d["edge_err"].as_array().expect("edge_err").len();
+    d["heading"] = serde_json::json!(vec![0.7; cells]);
+    d["fov"] = serde_json::json!(0.6);
+    d["edge_dropped"] = serde_json::json!((0..edge_cells).map(|k| k % 3 == 0).collect::<Vec<_>>());
+    let optional = tmp.path().join("optional.html");
+    std::fs::write(&optional, host_sim::report::replay::page(&d.to_string())).expect("write");
+    let dom = browse(&profile, &optional, "probe=last", &["--dump-dom"]);
+    assert_eq!(
+        pre(&dom, "ph-errors"),
+        "[]",
+        "page errors with the optional fields"
+    );
+    assert!(pre(&dom, "ph-probe").contains("\"frame\""));
 }

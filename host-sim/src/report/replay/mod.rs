@@ -7,7 +7,7 @@
 //! Bounds: at most [`MAX_AGENTS`] agents are drawn (an evenly spaced subset, leaders
 //! included), at most [`MAX_FRAMES`] frames and at most [`MAX_CELLS`] per-frame numbers
 //! (4 per drawn agent, 1 per drawn edge) are kept, and the charts keep at most
-//! [`MAX_CHART_POINTS`] points. Every number is written in at most 16 characters, so the
+//! [`MAX_CHART_POINTS`] points. Every number is written in at most 17 characters, so the
 //! page stays below [`MAX_BYTES`].
 
 mod data;
@@ -27,9 +27,11 @@ pub const MAX_FRAMES: usize = 2_000;
 pub const MAX_CELLS: usize = 500_000;
 /// At most this many points of V(t) and of the largest angle error are kept.
 pub const MAX_CHART_POINTS: usize = 2_000;
-/// An upper bound of the size of `replay.html` in bytes: 17 bytes per kept number (16
-/// characters and a comma) plus the ids, edges and page (at most 1 MB).
-pub const MAX_BYTES: usize = 17 * (MAX_CELLS + 2 * MAX_FRAMES + 2 * MAX_CHART_POINTS) + 1_000_000;
+/// An upper bound of the size of `replay.html` in bytes: 18 bytes per kept number (at
+/// most 17 characters, `-1.234567890e-100`, and a comma: the per-frame numbers, the frame
+/// times and the three chart series) plus the ids, edges, summary texts and page (taken
+/// as at most 1 MB).
+pub const MAX_BYTES: usize = 18 * (MAX_CELLS + MAX_FRAMES + 3 * MAX_CHART_POINTS) + 1_000_000;
 
 /// The page template; the data replaces [`DATA_MARKER`].
 const TEMPLATE: &str = include_str!("replay.html");
