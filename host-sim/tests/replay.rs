@@ -200,6 +200,55 @@ fn a_large_run_is_thinned_to_the_budget_with_its_leaders() {
     assert!(size <= MAX_BYTES, "{size} bytes");
 }
 
+/// A sweep directory: `points.csv` over two axes, one point with a collision.
+fn sweep_dir(root: &Path) -> PathBuf {
+    let dir = root.join("sweep");
+    std::fs::create_dir_all(&dir).expect("mkdir");
+    let mut text = String::from(
+        "point,radio.loss,controller.estimator,runs,errors,converged,converged_lo,converged_hi,collision,collision_lo,collision_hi,settled,settle_p10,settle_p50,settle_p90\n",
+    );
+    for (k, (loss, est, conv)) in [
+        (0.0, "shared", 1.0),
+        (0.2, "shared", 0.75),
+        (0.0, "measured", 1.0),
+    ]
+    .iter()
+    .enumerate()
+    {
+        text.push_str(&format!(
+            "{k},{loss},{est},4,0,{conv},0.5,1.0,{},0.0,0.5,4,40.0,41.0,42.0\n",
+            1.0 - conv
+        ));
+    }
+    std::fs::write(dir.join("points.csv"), text).expect("points.csv");
+    dir
+}
+
+#[test]
+fn view_writes_a_sweep_page_over_the_axes() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let dir = sweep_dir(tmp.path());
+    let o = run(&["view", "--no-open", dir.to_str().expect("utf-8")]);
+    assert_eq!(o.status.code(), Some(0), "{o:?}");
+    let page = dir.join("sweep.html");
+    assert_eq!(
+        String::from_utf8_lossy(&o.stdout).trim(),
+        page.to_str().unwrap()
+    );
+    let html = std::fs::read_to_string(&page).expect("sweep.html");
+    for bad in ["http://", "https://", "src=", "href=", "fetch("] {
+        assert!(!html.contains(bad), "sweep.html contains {bad}");
+    }
+    let d = page_data(&html);
+    assert_eq!(
+        d["axes"],
+        serde_json::json!(["radio.loss", "controller.estimator"])
+    );
+    assert_eq!(d["outcomes"], serde_json::json!(["converged", "collision"]));
+    assert_eq!(d["rows"][1][5], serde_json::json!(0.75));
+    assert_eq!(d["rows"][2][2], serde_json::json!("measured"));
+}
+
 // ---------------------------------------------------------------------------------------
 // In a real browser
 
@@ -367,4 +416,12 @@ fn replay_in_headless_chromium() {
         "page errors with the optional fields"
     );
     assert!(pre(&dom, "ph-probe").contains("\"frame\""));
+
+    // A sweep's page draws without error.
+    let sweep = sweep_dir(tmp.path());
+    let o = run(&["view", "--no-open", sweep.to_str().expect("utf-8")]);
+    assert_eq!(o.status.code(), Some(0), "{o:?}");
+    let dom = browse(&profile, &sweep.join("sweep.html"), "", &["--dump-dom"]);
+    assert_eq!(pre(&dom, "ph-errors"), "[]", "sweep page errors");
+    assert!(dom.contains("data-ready=\"1\""));
 }

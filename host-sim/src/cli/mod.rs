@@ -63,10 +63,11 @@ pub enum Command {
     Sweep(sweep::SweepArgs),
     /// Write one agent's configuration as the C API's checked blob (docs/c-api.md).
     Export(ExportArgs),
-    /// Print the path of a run's replay.html (writing it if missing) and open it in a
-    /// browser when there is one ($BROWSER, else xdg-open with a display).
+    /// Print the path of a run's replay.html (writing it if missing), or of a sweep's
+    /// sweep.html, and open it in a browser when there is one ($BROWSER, else xdg-open
+    /// with a display).
     View {
-        /// The run's output directory.
+        /// The run's (or the sweep's) output directory.
         dir: PathBuf,
         /// Only print the path.
         #[arg(long)]

@@ -1,5 +1,6 @@
 //! `host-sim view OUT_DIR`: the path of the run's `replay.html` (written first when the
-//! directory has a time series but no page yet), opened in a browser when one is there.
+//! directory has a time series but no page yet), or of a sweep's `sweep.html`, opened in a
+//! browser when one is there.
 
 use crate::exit_code;
 use std::path::{Path, PathBuf};
@@ -19,8 +20,13 @@ fn browser() -> Option<String> {
     (display && xdg).then(|| "xdg-open".to_owned())
 }
 
-/// The page of `dir`, written from its `timeseries.csv` and `summary.json` if missing.
+/// The page of `dir`, written from its `timeseries.csv` and `summary.json` if missing; for
+/// a sweep's directory (`points.csv`, no `timeseries.csv`), `sweep.html`, written afresh.
 fn page(dir: &Path) -> Result<PathBuf, String> {
+    if dir.join("points.csv").is_file() && !dir.join("timeseries.csv").is_file() {
+        return crate::report::replay::write_sweep_page(dir)
+            .map_err(|e| format!("cannot write {}: {e}", dir.join("sweep.html").display()));
+    }
     let path = dir.join("replay.html");
     if path.is_file() {
         return Ok(path);

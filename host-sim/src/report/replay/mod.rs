@@ -2,7 +2,8 @@
 //! `file://` (`docs/outputs.md`). The data is read from the run directory's
 //! `timeseries.csv` and `summary.json` ([`ReplayData`]), thinned in time and space to a bounded
 //! size, and written as JSON into the page template (`replay.html`, next to this file:
-//! canvas drawing, controls and the test hook `window.phReplay`).
+//! canvas drawing, controls and the test hook `window.phReplay`). A sweep's `points.csv`
+//! gets the same treatment: `sweep.html` ([`write_sweep_page`]).
 //!
 //! Bounds: at most [`MAX_AGENTS`] agents are drawn (an evenly spaced subset, leaders
 //! included), at most [`MAX_FRAMES`] frames and at most [`MAX_CELLS`] per-frame numbers
@@ -11,11 +12,13 @@
 //! page stays below [`MAX_BYTES`].
 
 mod data;
+mod sweep;
 
 use super::PlotError;
 use std::path::{Path, PathBuf};
 
 pub use data::ReplayData;
+pub use sweep::write_sweep_page;
 
 /// At most this many agents are drawn (an evenly spaced subset, leaders included).
 pub const MAX_AGENTS: usize = 1_000;
