@@ -36,7 +36,7 @@ pub fn load(scenario: &str, overrides: &[String]) -> Result<Model, ScenarioError
 pub fn load_toml(text: &str, name: &str, overrides: &[String]) -> Result<Model, ScenarioErrors> {
     let source = Source::from_text(name, text);
     let file = source.parse(overrides)?;
-    scenario::validate(&file, &source.label, &source.default_name)
+    scenario::validate_text(&file, &source.label, &source.default_name, &source.text)
 }
 
 /// What stopped a library call: an invalid scenario, a run that could not finish, or an
@@ -157,7 +157,7 @@ impl<'a> Simulation<'a> {
     }
 
     /// Also write `timeseries.csv` and `summary.json` into `dir` (created if needed), and
-    /// the figures if `plots`, as `host-sim run --out DIR` does.
+    /// the figures and `replay.html` if `plots`, as `host-sim run --out DIR` does.
     pub fn write_to(mut self, dir: impl Into<PathBuf>, plots: bool) -> Self {
         self.out = Some((dir.into(), plots));
         self
@@ -226,6 +226,7 @@ impl<'a> Simulation<'a> {
             estimates,
             files: Vec::new(),
             plot_error: None,
+            replay_error: None,
         };
         if let Some((dir, plots)) = &self.out {
             run.write_outputs(model, dir, csv_path, *plots)?;
@@ -244,10 +245,13 @@ pub struct Run {
     /// Every logged row (when kept, see [`Simulation::keep_series`]).
     pub series: Option<TimeSeries>,
     /// The files written (see [`Simulation::write_to`]): `timeseries.csv`,
-    /// `summary.json`, then the figures.
+    /// `summary.json`, then the figures and `replay.html`.
     pub files: Vec<PathBuf>,
     /// Why the figures were not drawn (a failed plot does not fail the run).
     pub plot_error: Option<PlotError>,
+    /// Why `replay.html` was not written (written with the figures; its failure does not
+    /// fail the run).
+    pub replay_error: Option<PlotError>,
 }
 
 impl Run {
@@ -283,6 +287,10 @@ impl Run {
             match report::plot_run(dir) {
                 Ok(p) => self.files.extend(p),
                 Err(e) => self.plot_error = Some(e),
+            }
+            match report::write_replay(dir) {
+                Ok(p) => self.files.push(p),
+                Err(e) => self.replay_error = Some(e),
             }
         }
         Ok(())

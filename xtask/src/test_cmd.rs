@@ -140,6 +140,10 @@ fn phases(
         "Slurm job array (cargo xtask cluster-test)",
         &mut crate::cluster::run,
     )?;
+    phase("replay.html in headless Chromium (host-sim)", &mut || {
+        // The ignored browser test of tests/replay.rs (Chromium from scripts/browser-deps.sh).
+        tools::run(cargo().args(["test", "--test", "replay", "--", "--ignored"]))
+    })?;
     phase("host-in-the-loop (host-sim QEMU tests)", &mut || {
         // No `-p host-sim`: the default members' feature set, as `cargo test` built it.
         tools::run(cargo().args(["test", "--test", "hil", "--", "--include-ignored"]))

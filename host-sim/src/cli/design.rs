@@ -96,6 +96,10 @@ pub struct DesignArgs {
     /// Write the scenario here instead of stdout.
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
+    /// Also draw the designed formation (labelled agents, triangles, desired angles,
+    /// leader edge, initial and target positions) into FILE (.png or .svg).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
 }
 
 /// Parses `A,B`.
@@ -142,7 +146,7 @@ pub fn design_command(args: &DesignArgs, quiet: bool) -> u8 {
                 eprint!("{figures}");
             }
             let written = match &args.output {
-                Some(path) => std::fs::write(path, text)
+                Some(path) => std::fs::write(path, &text)
                     .map_err(|e| format!("cannot write {}: {e}", path.display())),
                 None => {
                     use std::io::Write;
@@ -151,6 +155,10 @@ pub fn design_command(args: &DesignArgs, quiet: bool) -> u8 {
                         .map_err(|e| format!("cannot write to stdout: {e}"))
                 }
             };
+            let written = written.and_then(|()| match &args.plot {
+                Some(file) => super::plot_formation_of(&text, "design", file),
+                None => Ok(()),
+            });
             match written {
                 Ok(()) => exit_code::CONVERGED,
                 Err(e) => {

@@ -7,6 +7,7 @@ mod export;
 mod run;
 mod sweep;
 mod vehicle;
+mod view;
 
 pub use design::{DesignArgs, Shape};
 
@@ -44,6 +45,10 @@ pub enum Command {
         /// Override a field before validation, e.g. `--set radio.loss=0.2`.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
+        /// Also draw the formation (labelled agents, triangles, desired angles, leader
+        /// edge, initial and target positions) into FILE (.png or .svg).
+        #[arg(long, value_name = "FILE")]
+        plot: Option<PathBuf>,
     },
     /// List the built-in scenarios.
     List,
@@ -59,6 +64,16 @@ pub enum Command {
     Sweep(sweep::SweepArgs),
     /// Write agents' configurations as the C API's checked blobs (docs/c-api.md).
     Export(ExportArgs),
+    /// Print the path of a run's replay.html (writing it if missing), or of a sweep's
+    /// sweep.html, and open it in a browser when there is one ($BROWSER, else xdg-open
+    /// with a display).
+    View {
+        /// The run's (or the sweep's) output directory.
+        dir: PathBuf,
+        /// Only print the path.
+        #[arg(long)]
+        no_open: bool,
+    },
 }
 
 /// Arguments of `host-sim export`.
@@ -181,7 +196,11 @@ pub fn execute(cli: Cli) -> u8 {
         ),
         Some(Command::Run(args)) => run_command(&args, quiet),
         Some(Command::Export(args)) => export::export_command(&args, quiet),
-        Some(Command::Validate { scenario, set }) => validate_command(&scenario, &set, quiet),
+        Some(Command::Validate {
+            scenario,
+            set,
+            plot,
+        }) => validate_command(&scenario, &set, plot.as_deref(), quiet),
         Some(Command::Design(args)) => design_command(&args, quiet),
         Some(Command::List) => {
             for b in BUILTINS {
@@ -190,6 +209,7 @@ pub fn execute(cli: Cli) -> u8 {
             exit_code::CONVERGED
         }
         Some(Command::Sweep(args)) => sweep::command(&args, quiet),
+        Some(Command::View { dir, no_open }) => view::view_command(&dir, no_open),
         Some(Command::Plot { dir }) => match crate::report::plot_run(&dir) {
             Ok(files) => {
                 if !quiet {
@@ -230,9 +250,26 @@ pub(crate) fn load(scenario: &str, set: &[String]) -> Result<crate::model::Model
     crate::api::load_toml(&text, "<stdin>", set)
 }
 
-fn validate_command(scenario: &str, set: &[String], quiet: bool) -> u8 {
+/// Draws the formation of the scenario `text` into `file`.
+fn plot_formation_of(text: &str, name: &str, file: &std::path::Path) -> Result<(), String> {
+    let m = crate::api::load_toml(text, name, &[]).map_err(|e| e.to_string())?;
+    crate::report::plot::plot_formation(&m, file).map_err(|e| e.to_string())
+}
+
+fn validate_command(
+    scenario: &str,
+    set: &[String],
+    plot: Option<&std::path::Path>,
+    quiet: bool,
+) -> u8 {
     match load(scenario, set) {
         Ok(m) => {
+            if let Some(file) = plot {
+                if let Err(e) = crate::report::plot::plot_formation(&m, file) {
+                    eprintln!("error: {e}");
+                    return exit_code::IO;
+                }
+            }
             if !quiet {
                 println!(
                     "ok: {} ({}): {} agents, {} triangles, {} edges, mode {}, estimator {}, {} s",

@@ -106,6 +106,9 @@ pub(super) fn run_command(args: &RunArgs, quiet: bool) -> u8 {
             if let Some(e) = &run.plot_error {
                 eprintln!("warning: plots not drawn: {e}");
             }
+            if let Some(e) = &run.replay_error {
+                eprintln!("warning: replay.html not written: {e}");
+            }
             let r = &run.result;
             for w in &r.warnings {
                 eprintln!("warning: {w}");

@@ -1,5 +1,6 @@
 //! Reports of a run: the time series (`timeseries.csv`, or in memory), `summary.json`,
-//! the summary table and the figures (one file per figure under [`plot`]). They read
+//! the summary table, the figures (one file per figure under [`plot`]) and the replay page
+//! ([`replay`]). They read
 //! what the engine produced and never drive a run (`docs/architecture.md`).
 
 mod attack;
@@ -7,6 +8,7 @@ mod channel;
 mod columns;
 mod csv;
 pub mod plot;
+pub mod replay;
 mod series;
 mod summary;
 mod table;
@@ -14,6 +16,7 @@ mod table;
 pub use columns::{for_each_cell, header, Cell, BASE_COLUMNS};
 pub use csv::CsvRecorder;
 pub use plot::{plot_run, PlotError};
+pub use replay::write_replay;
 pub use series::TimeSeries;
 pub use summary::{summary_json, write_summary};
 pub use table::summary_table;

@@ -23,7 +23,7 @@ pub use schema::{
 pub use settings::{ChannelSpec, ControllerSpec, Integration, RadioSpec, SensorSpec};
 pub use source::Source;
 pub use strip::strip_model;
-pub use validate::validate;
+pub use validate::{validate, validate_text};
 
 use crate::model::Model;
 
@@ -32,5 +32,5 @@ use crate::model::Model;
 pub fn load(arg: &str, overrides: &[String]) -> Result<Model, ScenarioErrors> {
     let source = Source::resolve(arg)?;
     let file = source.parse(overrides)?;
-    validate(&file, &source.label, &source.default_name)
+    validate_text(&file, &source.label, &source.default_name, &source.text)
 }

@@ -66,6 +66,8 @@ impl ScheduleSpec {
 }
 
 /// `[gains]`: default gains of every controlled angle (each angle may override them).
+/// A gain given neither here nor by the angle is that of the built-in `formation-only`
+/// ([`GainsSpec::DEFAULT_STIFFNESS`], …; docs/scenarios.md).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct GainsSpec {
@@ -75,6 +77,15 @@ pub struct GainsSpec {
     pub damping: Option<f64>,
     /// `c_e`.
     pub estimator_gain: Option<f64>,
+}
+
+impl GainsSpec {
+    /// `c_α` when neither `[gains]` nor the angle gives it: `formation-only`'s.
+    pub const DEFAULT_STIFFNESS: f64 = 10.0;
+    /// `d_α` when neither `[gains]` nor the angle gives it: `formation-only`'s.
+    pub const DEFAULT_DAMPING: f64 = 1.0;
+    /// `c_e` when neither `[gains]` nor the angle gives it: `formation-only`'s.
+    pub const DEFAULT_ESTIMATOR_GAIN: f64 = 10.0;
 }
 
 /// `[agent_defaults]`: values used by agents that do not give their own.

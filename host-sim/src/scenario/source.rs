@@ -4,7 +4,9 @@
 use super::builtin::{builtin, Builtin, BUILTINS};
 use super::error::{ErrorKind, ScenarioError};
 use super::schema::ScenarioFile;
-use super::toml_text::{field_at, line_col, one_line, parse_override_value, set_path};
+use super::toml_text::{
+    did_you_mean, field_at, line_col, one_line, parse_override_value, set_path,
+};
 use std::path::Path;
 
 /// A scenario's TOML text and where it came from.
@@ -109,7 +111,11 @@ impl Source {
                     ErrorKind::Syntax,
                     &self.label,
                     key,
-                    format!("--set {ov}: {}", one_line(&e.to_string())),
+                    format!(
+                        "--set {ov}: {}{}",
+                        one_line(&e.to_string()),
+                        suggestion(e.message())
+                    ),
                 )
             })?;
         }
@@ -131,7 +137,16 @@ impl Source {
             ErrorKind::Syntax,
             &self.label,
             &field,
-            format!("{}{location}", one_line(e.message())),
+            format!(
+                "{}{location}{}",
+                one_line(e.message()),
+                suggestion(e.message())
+            ),
         )
     }
+}
+
+/// `"; did you mean `loss`?"` for an unknown field near a known one, else empty.
+fn suggestion(message: &str) -> String {
+    did_you_mean(message).map_or_else(String::new, |c| format!("; did you mean `{c}`?"))
 }

@@ -120,3 +120,61 @@ pub fn field_at(text: &str, pos: usize) -> String {
         (false, false) => format!("{section}.{key}"),
     }
 }
+
+/// For serde's "unknown field `x`, expected one of `a`, `b`, …" (or "expected `a` or
+/// `b`"): the expected name most like `x` (Jaro–Winkler similarity above 0.7, as clap's
+/// suggestions), if there is one.
+pub fn did_you_mean(message: &str) -> Option<String> {
+    let rest = &message[message.find("unknown field `")? + "unknown field `".len()..];
+    let name = &rest[..rest.find('`')?];
+    let expected = &rest[rest.find("expected")?..];
+    expected
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .map(|c| (strsim::jaro_winkler(name, c), c))
+        .filter(|(score, _)| *score > 0.7)
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, c)| c.to_owned())
+}
+
+/// 1-based line of the header of the `k`-th (0-based) `[[table]]` entry in `text`, when
+/// the array is written as headers (not inline).
+pub fn array_entry_line(text: &str, table: &str, k: usize) -> Option<usize> {
+    let header = format!("[[{table}]]");
+    text.lines()
+        .enumerate()
+        .filter(|(_, l)| {
+            let l = l.trim_start();
+            l.starts_with(&header)
+        })
+        .nth(k)
+        .map(|(i, _)| i + 1)
+}
+
+#[cfg(test)]
+mod suggestion_tests {
+    use super::*;
+
+    #[test]
+    fn the_nearest_expected_field_is_suggested() {
+        let m = "unknown field `los`, expected one of `loss`, `latency`, `jitter`";
+        assert_eq!(did_you_mean(m).as_deref(), Some("loss"));
+        let m =
+            "unknown field `stifness`, expected one of `stiffness`, `damping`, `estimator_gain`";
+        assert_eq!(did_you_mean(m).as_deref(), Some("stiffness"));
+        assert_eq!(
+            did_you_mean("unknown field `zzzz`, expected `loss` or `mass`"),
+            None
+        );
+        assert_eq!(did_you_mean("invalid type: string"), None);
+    }
+
+    #[test]
+    fn array_entries_are_found_by_their_headers() {
+        let t = "a = 1\n[[agents]]\nid = 1\n  [[agents]]\nid = 2\n[[triangles]]\n";
+        assert_eq!(array_entry_line(t, "agents", 1), Some(4));
+        assert_eq!(array_entry_line(t, "triangles", 0), Some(6));
+        assert_eq!(array_entry_line(t, "triangles", 1), None);
+    }
+}

@@ -1,5 +1,6 @@
 //! `angle_errors`: |angle error| of every controlled angle (at most `MAX_ANGLES`) and
-//! their maximum vs time, log scale, with the threshold line.
+//! their maximum vs time, log scale, with the threshold line. Beyond ten angles the
+//! `WORST_NAMED` largest at the end are drawn in colour and named, the others grey.
 
 use super::input::Run;
 use super::legend::{entry, with_legend, Key};
@@ -10,6 +11,9 @@ use super::{DrawResult, ANGLE_FLOOR, ANGLE_THRESHOLD};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+/// The angles that are not named (beyond ten angles).
+const OTHERS: RGBColor = RGBColor(185, 185, 185);
+
 /// Draws the figure on `root`.
 pub(super) fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
@@ -19,11 +23,22 @@ pub(super) fn draw<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let note = if run.angles.len() < run.n_angles {
-        format!("{} of {} angles shown", run.angles.len(), run.n_angles)
-    } else {
-        String::new()
-    };
+    let many = run.angles.len() > 10;
+    let mut notes = Vec::new();
+    if run.angles.len() < run.n_angles {
+        notes.push(format!(
+            "{} of {} angles shown",
+            run.angles.len(),
+            run.n_angles
+        ));
+    }
+    if many {
+        notes.push(format!(
+            "the {} largest at the end named",
+            run.worst_angles.len()
+        ));
+    }
+    let note = notes.join("; ");
     let area = frame(root, run, "angle errors", &note, bitmap)?;
 
     let series: Vec<Vec<(f64, f64)>> = run
@@ -39,9 +54,15 @@ where
             entries.push(entry(a.label.clone(), Key::Line(colour(i), 2)));
         }
     } else {
+        for (k, &i) in run.worst_angles.iter().enumerate() {
+            entries.push(entry(
+                format!("{} (worst #{})", run.angles[i].label, k + 1),
+                Key::Line(colour(k), 2),
+            ));
+        }
         entries.push(entry(
-            format!("{} individual angles", run.angles.len()),
-            Key::Line(colour(0), 1),
+            format!("{} other angles", run.angles.len() - run.worst_angles.len()),
+            Key::Line(OTHERS, 1),
         ));
     }
     if run.n_angles == 0 {
@@ -71,9 +92,27 @@ where
         .y_label_formatter(&log_label)
         .draw()?;
 
-    let width = if run.angles.len() > 10 { 1 } else { 2 };
-    for (i, pts) in series.into_iter().enumerate() {
-        stroke(chart.plotting_area(), &pts, colour(i), width, false, bitmap)?;
+    if many {
+        // The others thin and grey, then the worst on top in colour.
+        for (i, pts) in series.iter().enumerate() {
+            if !run.worst_angles.contains(&i) {
+                stroke(chart.plotting_area(), pts, OTHERS, 1, false, bitmap)?;
+            }
+        }
+        for (k, &i) in run.worst_angles.iter().enumerate() {
+            stroke(
+                chart.plotting_area(),
+                &series[i],
+                colour(k),
+                2,
+                false,
+                bitmap,
+            )?;
+        }
+    } else {
+        for (i, pts) in series.iter().enumerate() {
+            stroke(chart.plotting_area(), pts, colour(i), 2, false, bitmap)?;
+        }
     }
     let area = chart.plotting_area();
     stroke(area, &max_series, DARK, 3, false, bitmap)?;

@@ -1,5 +1,6 @@
 //! `estimates`: each distance estimate r̂ (solid) against its true distance r
-//! (dashed), at most `MAX_ESTIMATES`.
+//! (dashed), at most `MAX_ESTIMATES` (beyond, the ones farthest from their true
+//! distance at the end, worst first).
 
 use super::input::Run;
 use super::legend::{entry, with_legend, Key};
@@ -21,7 +22,7 @@ where
 {
     let note = if run.n_estimates > run.estimates.len() {
         format!(
-            "first {} of {} estimates shown",
+            "the {} of {} estimates farthest from their true distance at the end",
             run.estimates.len(),
             run.n_estimates
         )

@@ -3,7 +3,7 @@
 //! rows, then keep an evenly spaced subset).
 
 use super::thinning::{spread, Thinning};
-use super::{PlotError, MAX_AGENT_PATHS, MAX_ANGLES, MAX_ESTIMATES, REQUIRED};
+use super::{PlotError, MAX_AGENT_PATHS, MAX_ANGLES, MAX_ESTIMATES, REQUIRED, WORST_NAMED};
 use serde::Deserialize;
 use std::collections::HashMap;
 use std::fs::File;
@@ -109,6 +109,9 @@ pub(super) struct Run {
     pub(super) snapshots: Vec<Snapshot>,
     pub(super) angles: Vec<Named>,
     pub(super) n_angles: usize,
+    /// Indices into `angles` of the [`WORST_NAMED`] largest |angle errors| at the end,
+    /// largest first.
+    pub(super) worst_angles: Vec<usize>,
     pub(super) estimates: Vec<Estimate>,
     pub(super) n_estimates: usize,
 }
@@ -287,9 +290,38 @@ pub(super) fn load_run(dir: &Path) -> Result<Run, PlotError> {
         .map(|&a| (a, cols.add(agent_xy[a].0), cols.add(agent_xy[a].1)))
         .collect();
 
+    // Pass 1: count the rows with a finite t, and keep the last one (swapped, not copied).
+    let mut rec = csv::ByteRecord::new();
+    let mut last = csv::ByteRecord::new();
+    let mut valid = 0usize;
+    while reader.read_byte_record(&mut rec).map_err(csv_err)? {
+        if field(&rec, t_col, &header)?.is_finite() {
+            valid += 1;
+            std::mem::swap(&mut rec, &mut last);
+        }
+    }
+    // |value| at the end, for ranking (non-finite ranks first: the worst).
+    let at_end = |c: usize| field(&last, c, &header).map_or(f64::INFINITY, |x| x.abs());
+
+    // Angles: an evenly spaced subset and the WORST_NAMED largest at the end (named in
+    // the legend).
     let angle_cols = header.with_prefix("angle_err_");
     let n_angles = angle_cols.len();
-    let angle_slots: Vec<(String, usize)> = spread(n_angles, MAX_ANGLES)
+    let mut by_end: Vec<usize> = (0..n_angles).collect();
+    by_end.sort_by(|&a, &b| {
+        let (ea, eb) = (at_end(angle_cols[a].0), at_end(angle_cols[b].0));
+        eb.total_cmp(&ea).then(a.cmp(&b))
+    });
+    let worst: Vec<usize> = by_end.iter().copied().take(WORST_NAMED).collect();
+    let mut shown = spread(n_angles, MAX_ANGLES);
+    shown.extend(&worst);
+    shown.sort_unstable();
+    shown.dedup();
+    let worst_angles: Vec<usize> = worst
+        .iter()
+        .filter_map(|w| shown.iter().position(|k| k == w))
+        .collect();
+    let angle_slots: Vec<(String, usize)> = shown
         .into_iter()
         .map(|k| {
             let (c, suffix) = &angle_cols[k];
@@ -297,22 +329,25 @@ pub(super) fn load_run(dir: &Path) -> Result<Run, PlotError> {
         })
         .collect();
 
+    // Estimates: the MAX_ESTIMATES farthest from their true distance at the end, worst
+    // first (all of them, in column order, when there are no more).
     let est_cols = header.with_prefix("rhat_");
     let n_estimates = est_cols.len();
-    let mut est_slots = Vec::new();
-    for (c, suffix) in est_cols.iter().take(MAX_ESTIMATES) {
+    let mut pairs = Vec::with_capacity(n_estimates);
+    for (c, suffix) in &est_cols {
         let r = header.require(&format!("r_{suffix}"))?;
-        est_slots.push((estimate_label(suffix), cols.add(*c), cols.add(r)));
+        let gap = field(&last, *c, &header).and_then(|h| Ok((h - field(&last, r, &header)?).abs()));
+        let gap = gap.ok().filter(|g| !g.is_nan()).unwrap_or(f64::INFINITY);
+        pairs.push((gap, *c, r, suffix.as_str()));
     }
-
-    // Pass 1: count the rows with a finite t.
-    let mut rec = csv::ByteRecord::new();
-    let mut valid = 0usize;
-    while reader.read_byte_record(&mut rec).map_err(csv_err)? {
-        if field(&rec, t_col, &header)?.is_finite() {
-            valid += 1;
-        }
+    if n_estimates > MAX_ESTIMATES {
+        pairs.sort_by(|a, b| b.0.total_cmp(&a.0));
     }
+    let est_slots: Vec<(String, usize, usize)> = pairs
+        .iter()
+        .take(MAX_ESTIMATES)
+        .map(|&(_, c, r, suffix)| (estimate_label(suffix), cols.add(c), cols.add(r)))
+        .collect();
     if valid == 0 {
         return Err(PlotError::Empty {
             path: csv_path.clone(),
@@ -403,6 +438,7 @@ pub(super) fn load_run(dir: &Path) -> Result<Run, PlotError> {
         snapshots,
         angles,
         n_angles,
+        worst_angles,
         estimates,
         n_estimates,
     })

@@ -6,9 +6,9 @@
 //! | file | content |
 //! | --- | --- |
 //! | `trajectories` | x–y path of every agent (at most [`MAX_AGENT_PATHS`]), formation snapshots (graph edges between agent positions) at five times from start to end, leaders marked; equal aspect ratio |
-//! | `angle_errors` | \|angle error\| of every controlled angle (at most [`MAX_ANGLES`]) and their maximum vs time, log scale, with the [`ANGLE_THRESHOLD`] line |
+//! | `angle_errors` | \|angle error\| of every controlled angle (at most [`MAX_ANGLES`], the [`WORST_NAMED`] worst at the end always, named) and their maximum vs time, log scale, with the [`ANGLE_THRESHOLD`] line |
 //! | `energy` | V and its terms V_kin, V_ang, V_lead, V_est vs time, log scale |
-//! | `estimates` | each distance estimate r̂ (solid) against its true distance r (dashed), at most [`MAX_ESTIMATES`] |
+//! | `estimates` | each distance estimate r̂ (solid) against its true distance r (dashed), at most [`MAX_ESTIMATES`] (the worst at the end) |
 //! | `maneuvers` | leader displacement and velocity errors, and the minimum inter-agent distance vs time |
 //! | `shape` | the final formation, fitted onto its target shape (translation, rotation, scale, mirror), over the target; folded triangles marked |
 //!
@@ -30,6 +30,7 @@ mod angle_errors;
 mod energy;
 mod error;
 mod estimates;
+mod formation;
 mod input;
 mod legend;
 mod maneuvers;
@@ -44,6 +45,8 @@ mod trajectories;
 mod xy;
 
 pub use error::PlotError;
+pub use formation::{plot_formation, MAX_LABELLED_AGENTS};
+pub(crate) use thinning::spread;
 pub use xy::{plot_xy, XyChart, XyLine, XyPanel, XyPoint};
 
 use input::{load_run, Run};
@@ -65,7 +68,12 @@ pub const MAX_AGENT_PATHS: usize = 50;
 /// Runs with more controlled angles than this draw an evenly spaced subset of
 /// this many angle errors (the maximum over all angles is always drawn).
 pub const MAX_ANGLES: usize = 50;
-/// At most this many estimates (the first ones in column order) are drawn.
+/// Runs with more than this many angles (or estimates) name only the worst ones at the
+/// end of the run in the legend: the largest |angle error|, the estimates farthest from
+/// their true distance.
+pub const WORST_NAMED: usize = 5;
+/// At most this many estimates are drawn: all when there are no more, else the ones
+/// farthest from their true distance at the end of the run.
 pub const MAX_ESTIMATES: usize = 12;
 /// |angle error| values below this (including exact zeros) are drawn at it.
 pub const ANGLE_FLOOR: f64 = 1e-9;

@@ -135,5 +135,5 @@ where
                 .map(|p| Circle::new(p, radius, c.filled())),
         )?;
     }
-    Ok(())
+    agent_ids(&mut chart, &fitted, &run.agent_ids, bitmap)
 }

@@ -191,3 +191,30 @@ pub(super) fn label_style() -> TextStyle<'static> {
 pub(super) fn desc_style() -> TextStyle<'static> {
     (FONT, 18).into_font().color(&BLACK)
 }
+
+/// Writes each agent's id up and right of its point, when there are at most
+/// [`super::MAX_LABELLED_AGENTS`] agents (points that are not finite are skipped).
+pub(super) fn agent_ids<DB: DrawingBackend>(
+    chart: &mut PlanView<'_, DB>,
+    pts: &[(f64, f64)],
+    ids: &[String],
+    bitmap: bool,
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    if ids.len() > super::MAX_LABELLED_AGENTS {
+        return Ok(());
+    }
+    let font = TextStyle::from((FONT, 17).into_font()).color(&BLACK);
+    chart.draw_series(
+        pts.iter()
+            .zip(ids)
+            .filter(|(p, _)| p.0.is_finite() && p.1.is_finite())
+            .map(|(p, id)| {
+                EmptyElement::at(*p)
+                    + Text::new(super::text::drawable(id, bitmap), (7, -20), font.clone())
+            }),
+    )?;
+    Ok(())
+}

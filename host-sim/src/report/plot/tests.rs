@@ -194,15 +194,40 @@ fn a_large_run_is_thinned_and_says_so() {
     assert_eq!(run.leaders, [0, 1]);
     assert!(run.paths.len() <= MAX_AGENT_PATHS + 2);
     assert!(run.paths.iter().all(|p| p.x.len() == run.t.len()));
-    assert_eq!((run.angles.len(), run.n_angles), (MAX_ANGLES, 130));
+    assert!(run.angles.len() >= MAX_ANGLES && run.angles.len() <= MAX_ANGLES + WORST_NAMED);
+    assert_eq!(run.n_angles, 130);
     assert_eq!((run.estimates.len(), run.n_estimates), (MAX_ESTIMATES, 20));
+    // The worst angles at the end (t = 43.2 s: angle k is 0.2 e^(-t/2) cos(t + k)), named
+    // in order, whether or not the evenly spaced subset has them.
+    let t_end = 0.01 * 4320.0;
+    let mut ks: Vec<usize> = (1..130).collect(); // angle 0 is 0 from t = 2 s
+    ks.sort_by(|&a, &b| {
+        let f = |k: usize| (t_end + k as f64).cos().abs();
+        f(b).total_cmp(&f(a))
+    });
+    let names: Vec<&str> = run
+        .worst_angles
+        .iter()
+        .map(|&i| run.angles[i].label.as_str())
+        .collect();
+    let expected: Vec<String> = ks[..WORST_NAMED]
+        .iter()
+        .map(|&k| {
+            let (u, v, w) = (1 + k % 120, 1 + (k + 1) % 120, 1 + (k + 2) % 120);
+            format!("∠{v}-{u}-{w}")
+        })
+        .collect();
+    assert_eq!(names, expected);
 
     plot_run(dir.path()).unwrap();
     let read = |f: &str| std::fs::read_to_string(dir.path().join(f)).unwrap();
     let n = run.paths.len();
     assert!(read("trajectories.svg").contains(&format!("paths of {n} of 120 agents shown")));
-    assert!(read("angle_errors.svg").contains("50 of 130 angles shown"));
-    assert!(read("estimates.svg").contains("first 12 of 20 estimates shown"));
+    let shown = format!("{} of 130 angles shown", run.angles.len());
+    assert!(read("angle_errors.svg").contains(&shown));
+    assert!(read("angle_errors.svg").contains(&format!("{} (worst #1)", expected[0])));
+    assert!(read("estimates.svg")
+        .contains("the 12 of 20 estimates farthest from their true distance at the end"));
 }
 
 #[test]

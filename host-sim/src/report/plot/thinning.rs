@@ -45,7 +45,7 @@ impl Thinning {
 
 /// Indices `0..n` thinned to at most `max`, evenly spaced, first and last
 /// included.
-pub(super) fn spread(n: usize, max: usize) -> Vec<usize> {
+pub(crate) fn spread(n: usize, max: usize) -> Vec<usize> {
     if n <= max {
         return (0..n).collect();
     }

@@ -130,6 +130,10 @@ where
                 .map(|p| TriangleMarker::new(p, radius + 5, LEADER.filled())),
         )?;
     }
+    // Ids at the last snapshot.
+    if let Some(s) = run.snapshots.last() {
+        agent_ids(&mut chart, &s.pos, &run.agent_ids, bitmap)?;
+    }
     Ok(())
 }
 

@@ -7,10 +7,19 @@ use controller_core::{Schedule, ScheduleStep, MAX_SCHEDULE_STEPS};
 /// Collects errors while checking.
 pub(super) struct Checker<'a> {
     pub(super) file: &'a str,
+    /// The file's TOML text, when known: errors then name lines.
+    pub(super) text: Option<&'a str>,
     pub(super) errors: Vec<ScenarioError>,
 }
 
 impl Checker<'_> {
+    /// `" (line L)"`: where the `k`-th `[[table]]` entry starts in the file, or empty.
+    pub(super) fn line_of(&self, table: &str, k: usize) -> String {
+        self.text
+            .and_then(|t| crate::scenario::toml_text::array_entry_line(t, table, k))
+            .map_or_else(String::new, |l| format!(" (line {l})"))
+    }
+
     pub(super) fn err(&mut self, kind: ErrorKind, field: &str, reason: impl Into<String>) {
         self.errors
             .push(ScenarioError::new(kind, self.file, field, reason));

@@ -44,17 +44,7 @@ pub(super) fn check(
                         agents.saturating_sub(2)
                     ),
                     ),
-                    LamanError::Unattached(rest) => {
-                        let first = rest.first().copied().unwrap_or(0);
-                        (
-                        format!("triangles[{first}]"),
-                        format!(
-                            "triangle {} does not join exactly one new agent to an edge of the triangles before it (triangles {:?} cannot be attached)",
-                            s.triangles.get(first).map_or_else(String::new, |t| list(&t.vertices)),
-                            rest
-                        ),
-                    )
-                    }
+                    LamanError::Unattached(rest) => unattached(c, s, &tri_idx, &rest, &id_of),
                 };
                 c.err(ErrorKind::NotLaman, &field, reason);
             }
@@ -89,6 +79,73 @@ pub(super) fn check(
         }
     }
     order
+}
+
+/// The field and reason of triangles that cannot be attached (`rest`, list positions):
+/// the first in the file, by its agent ids, line and why, then all of them.
+fn unattached(
+    c: &Checker<'_>,
+    s: &ScenarioFile,
+    tri_idx: &[[usize; 3]],
+    rest: &[usize],
+    id_of: &dyn Fn(usize) -> String,
+) -> (String, String) {
+    let mut rest = rest.to_vec();
+    rest.sort_unstable();
+    let first = rest.first().copied().unwrap_or(0);
+    let ids = |k: usize| {
+        s.triangles
+            .get(k)
+            .map_or_else(String::new, |t| list(&t.vertices))
+    };
+    // What the attached triangles built: their agents and edges.
+    let mut placed = std::collections::HashSet::new();
+    let mut edges = std::collections::HashSet::new();
+    for (k, t) in tri_idx.iter().enumerate() {
+        if rest.binary_search(&k).is_err() {
+            placed.extend(t.iter().copied());
+            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[0], t[2])] {
+                edges.insert((a.min(b), a.max(b)));
+            }
+        }
+    }
+    let t = tri_idx.get(first).copied().unwrap_or_default();
+    let on_built_edge = [(t[0], t[1]), (t[1], t[2]), (t[0], t[2])]
+        .iter()
+        .any(|&(a, b)| edges.contains(&(a.min(b), a.max(b))));
+    let why = if t.iter().all(|v| placed.contains(v)) {
+        "its three agents are already joined by the triangles that attach, so it adds no new agent (too many triangles on them)".to_owned()
+    } else if on_built_edge {
+        "it would join more than one new agent".to_owned()
+    } else {
+        let known: Vec<String> = t
+            .iter()
+            .filter(|v| placed.contains(v))
+            .map(|&v| id_of(v))
+            .collect();
+        format!(
+            "it shares no edge with the triangles that attach (agents of it already joined: {})",
+            if known.is_empty() {
+                "none".to_owned()
+            } else {
+                known.join(", ")
+            }
+        )
+    };
+    let all: Vec<String> = rest
+        .iter()
+        .map(|&k| format!("{}{}", ids(k), c.line_of("triangles", k)))
+        .collect();
+    (
+        format!("triangles[{first}]"),
+        format!(
+            "triangle {}{} cannot be attached: {why}; each triangle after the first must join exactly one new agent to an edge of the triangles before it (SPEC §3); {} cannot be attached: {}",
+            ids(first),
+            c.line_of("triangles", first),
+            if all.len() == 1 { "1 triangle".to_owned() } else { format!("{} triangles", all.len()) },
+            all.join(", ")
+        ),
+    )
 }
 
 /// Checks every agent's triangles and radio neighbours against the controller's

@@ -22,8 +22,29 @@ use controller_core::{BearingFilter, Limits, TrackerConfig};
 /// Validates a parsed scenario file. `file` labels errors; `default_name` is used when the
 /// file has no `name`.
 pub fn validate(s: &ScenarioFile, file: &str, default_name: &str) -> Result<Model, ScenarioErrors> {
+    check(s, file, default_name, None)
+}
+
+/// [`validate`], with the file's TOML `text`, so that errors about `[[agents]]` or
+/// `[[triangles]]` entries also name their line.
+pub fn validate_text(
+    s: &ScenarioFile,
+    file: &str,
+    default_name: &str,
+    text: &str,
+) -> Result<Model, ScenarioErrors> {
+    check(s, file, default_name, Some(text))
+}
+
+fn check(
+    s: &ScenarioFile,
+    file: &str,
+    default_name: &str,
+    text: Option<&str>,
+) -> Result<Model, ScenarioErrors> {
     let mut c = Checker {
         file,
+        text,
         errors: Vec::new(),
     };
     let settings::Timing {

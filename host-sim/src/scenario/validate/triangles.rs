@@ -5,7 +5,7 @@ use super::agents::{list, lookup};
 use super::checker::Checker;
 use crate::model::{AngleModel, TriangleModel};
 use crate::scenario::error::ErrorKind::{self, InvalidValue, NonPositiveGain};
-use crate::scenario::ScenarioFile;
+use crate::scenario::{GainsSpec, ScenarioFile};
 use std::collections::HashMap;
 use std::f64::consts::PI;
 
@@ -107,39 +107,39 @@ pub(super) fn check(
                     desired.push(x);
                 }
             }
-            let mut gain =
-                |name: &str, own: Option<f64>, dflt: Option<f64>, zero_ok: bool| -> f64 {
-                    match own.or(dflt) {
-                        Some(x) => {
-                            let good = x.is_finite() && (x > 0.0 || (zero_ok && x == 0.0));
-                            if !good {
-                                let need = if zero_ok { "≥ 0" } else { "> 0" };
-                                let field = if own.is_some() {
-                                    format!("{af}.{name}")
-                                } else {
-                                    format!("gains.{name}")
-                                };
-                                c.err(
-                                    NonPositiveGain,
-                                    &field,
-                                    format!("gain must be finite and {need}, got {x}"),
-                                );
-                            }
-                            x
-                        }
-                        None => {
-                            c.err(
-                                InvalidValue,
-                                &format!("{af}.{name}"),
-                                format!("no {name}: give it here or in [gains]"),
-                            );
-                            f64::NAN
-                        }
-                    }
-                };
-            let stiffness = gain("stiffness", a.stiffness, g.stiffness, false);
-            let damping = gain("damping", a.damping, g.damping, true);
-            let estimator_gain = gain("estimator_gain", a.estimator_gain, g.estimator_gain, false);
+            // A gain of the angle, else of [gains], else formation-only's (schema.rs).
+            let mut gain = |name: &str, own: Option<f64>, dflt: Option<f64>, builtin: f64| -> f64 {
+                let x = own.or(dflt).unwrap_or(builtin);
+                let zero_ok = name == "damping";
+                let good = x.is_finite() && (x > 0.0 || (zero_ok && x == 0.0));
+                if !good {
+                    let need = if zero_ok { "≥ 0" } else { "> 0" };
+                    let field = if own.is_some() {
+                        format!("{af}.{name}")
+                    } else {
+                        format!("gains.{name}")
+                    };
+                    c.err(
+                        NonPositiveGain,
+                        &field,
+                        format!("gain must be finite and {need}, got {x}"),
+                    );
+                }
+                x
+            };
+            let stiffness = gain(
+                "stiffness",
+                a.stiffness,
+                g.stiffness,
+                GainsSpec::DEFAULT_STIFFNESS,
+            );
+            let damping = gain("damping", a.damping, g.damping, GainsSpec::DEFAULT_DAMPING);
+            let estimator_gain = gain(
+                "estimator_gain",
+                a.estimator_gain,
+                g.estimator_gain,
+                GainsSpec::DEFAULT_ESTIMATOR_GAIN,
+            );
             if let Some(u) = apex {
                 let mut far = [0usize; 2];
                 let mut k = 0;
