@@ -10,7 +10,9 @@
 //! And the two decoders agree on every frame, incoming and outgoing, for every agent:
 //! the fast path (`check_frame`, `decode_frame`) and postcard's deserializer
 //! (`postcard::take_from_bytes::<Frame>`, `Frame::decode`) accept and reject alike and
-//! give the same frame.
+//! give the same frame. The `crc16` and `auth` agents run the bearing tracker (SPEC §11,
+//! the default), the `link` agent the finite difference: arbitrary bearings, velocities
+//! and time steps reach both, and the force stays finite and bounded.
 #![no_main]
 
 use controller_core::wire::{
@@ -31,6 +33,9 @@ fn agent(integrity: Integrity) -> Agent<f32, 2, 4> {
         estimator_gain: 10.0,
     };
     let mut c = AgentConfig::<f32, 2>::new(3);
+    if matches!(integrity, Integrity::Link) {
+        c.bearing_filter = controller_core::BearingFilter::FiniteDifference;
+    }
     c.integrity = integrity;
     let _ = c.triangles.push(TriangleConfig {
         vertices: [1, 2, 3],
