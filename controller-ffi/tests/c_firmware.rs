@@ -231,7 +231,7 @@ fn c_firmware_figures() {
         elf,
         &[
             "-plugin".into(),
-            format!("{plugin},marker={marker},out={}", counts.display()),
+            format!("{plugin},marker={marker},regions=32,out={}", counts.display()),
         ],
     );
     assert_eq!(code, Some(0), "{log}");
@@ -278,7 +278,7 @@ fn c_firmware_figures() {
         &[
             "-plugin".into(),
             format!(
-                "{plugin},marker={marker},out={},profile=3",
+                "{plugin},marker={marker},regions=32,out={},profile=3",
                 profile.display()
             ),
         ],
