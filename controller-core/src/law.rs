@@ -119,25 +119,41 @@ pub fn estimator_rate<T: Real>(range_rate: T, gamma: T, t: T, gain: T, r_hat: T)
     range_rate - gamma * t / (gain * r_hat)
 }
 
-/// S10, continuous form: the projected flow (0 instead of a negative flow at `r_min`).
+/// S10: whether an estimate is on the floor `r_min` (at or below it, or NaN): the one
+/// test behind [`estimate_floor`] and [`projected_rate`].
+#[inline]
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(r̂ > r_min)`: a NaN estimate is on the floor.
+pub fn at_floor<T: Real>(r_hat: T, r_min: T) -> bool {
+    !(r_hat > r_min)
+}
+
+/// S10's floor `max(r_min, r̂)`, a NaN estimate read as `r_min`: the one implementation
+/// of the floor (the sampled step [`estimator_step`], [`crate::Agent::set_estimate`] and
+/// host-sim's continuous integration use it).
+#[inline]
+pub fn estimate_floor<T: Real>(r_hat: T, r_min: T) -> T {
+    if at_floor(r_hat, r_min) {
+        r_min
+    } else {
+        r_hat
+    }
+}
+
+/// S10, continuous form: the projected flow (0 instead of a negative flow at `r_min`,
+/// [`at_floor`]).
 #[inline]
 pub fn projected_rate<T: Real>(r_hat: T, rate: T, r_min: T) -> T {
-    if r_hat <= r_min && rate < T::zero() {
+    if at_floor(r_hat, r_min) && rate < T::zero() {
         T::zero()
     } else {
         rate
     }
 }
 
-/// S10, sampled form: `r̂ ← max(r_min, r̂ + Δt·S9)`.
+/// S10, sampled form: `r̂ ← max(r_min, r̂ + Δt·S9)` ([`estimate_floor`]).
 #[inline]
 pub fn estimator_step<T: Real>(r_hat: T, rate: T, dt: T, r_min: T) -> T {
-    let next = r_hat + dt * rate;
-    if next > r_min {
-        next
-    } else {
-        r_min
-    }
+    estimate_floor(r_hat + dt * rate, r_min)
 }
 
 /// `PerAgent` share (SPEC §6): `f^n_{α,e} = ±g_{α,e}ᵀ v_n / r̂^n_{α,e}`, `+` for the far

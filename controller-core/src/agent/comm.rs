@@ -3,26 +3,11 @@
 //! layout is [`crate::wire`]'s.
 
 use super::state::{AngleState, Remote, Side};
-use super::Agent;
+use super::{pick, Agent};
 use crate::config::AgentId;
 use crate::wire::auth::{self, Counter};
 use crate::wire::{check_mode, quant, CrcCheck, FrameError, Integrity, RawAngle};
 use crate::{law, Real, Vec2};
-
-/// A broadcast item at full precision (the wire rounds the angle's values to binary16).
-#[derive(Clone, Copy, Debug)]
-enum Item<T: Real> {
-    /// The sender's velocity.
-    Velocity(Vec2<T>),
-    /// An angle `(sender; far[0], far[1])`: `γ`, `σ` and the distances `ρ` (see
-    /// [`crate::wire`]).
-    Angle {
-        far: [AgentId; 2],
-        gamma: T,
-        sigma: T,
-        rho: [T; 2],
-    },
-}
 
 /// `auth`: an agent whose broadcasts fill every frame (no room for the counter
 /// extension) adds a sync frame (velocity and counter extension, no items) to the first
@@ -245,10 +230,8 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             // finite.
             let v = |c: u16| T::of_f32(quant::from_code(c));
             let [g, s, r0, r1] = codes;
-            if far[0] == me {
-                self.apply_angle(slot, far[1], v(g), v(s), v(r0));
-            } else if far[1] == me {
-                self.apply_angle(slot, far[0], v(g), v(s), v(r1));
+            if let Some((k, other)) = far_role(far, me) {
+                self.apply_angle(slot, other, v(g), v(s), v(pick(&[r0, r1], k)));
             }
         }
         Ok(())
@@ -261,49 +244,18 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         let slot = self.slot(sender).ok_or(FrameError::UnknownSender(sender))?;
         if let Some(n) = self.neighbours.get_mut(slot) {
             n.age = T::zero();
+            n.velocity = from.velocity;
         }
         self.oldest = None;
-        self.apply(slot, Item::Velocity(from.velocity));
+        let me = self.config.id;
         for a in from.angles.iter().flatten() {
-            if let Some((gamma, sigma, rho)) = sent_angle(a) {
-                let far = a.far;
-                self.apply(
-                    slot,
-                    Item::Angle {
-                        far,
-                        gamma,
-                        sigma,
-                        rho,
-                    },
-                );
+            if let (Some((gamma, sigma, rho)), Some((k, other))) =
+                (sent_angle(a), far_role(a.far, me))
+            {
+                self.apply_angle(slot, other, gamma, sigma, pick(&rho, k));
             }
         }
         Ok(())
-    }
-
-    /// Stores one item from the neighbour in `slot`: its velocity, or the effort of an
-    /// angle `(sender; far[0], far[1])` of which this agent is a far vertex.
-    fn apply(&mut self, slot: usize, item: Item<T>) {
-        match item {
-            Item::Velocity(v) => {
-                if let Some(n) = self.neighbours.get_mut(slot) {
-                    n.velocity = v;
-                }
-            }
-            Item::Angle {
-                far,
-                gamma,
-                sigma,
-                rho,
-            } => {
-                let me = self.config.id;
-                if far[0] == me {
-                    self.apply_angle(slot, far[1], gamma, sigma, rho[0]);
-                } else if far[1] == me {
-                    self.apply_angle(slot, far[0], gamma, sigma, rho[1]);
-                }
-            }
-        }
     }
 
     /// Stores what the apex in neighbour `slot` sent of its angle `(apex; me, other)`:
@@ -337,6 +289,20 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 *age = T::zero();
             }
         }
+    }
+}
+
+/// Which far vertex of an angle `(sender; far[0], far[1])` the agent `me` is, and the
+/// other one: `(k, far[1 − k])`; `None` if it is neither. The one place where a received
+/// angle is matched to its receiver, for [`Agent::receive`] and [`Agent::receive_direct`].
+#[inline]
+fn far_role(far: [AgentId; 2], me: AgentId) -> Option<(usize, AgentId)> {
+    if far[0] == me {
+        Some((0, far[1]))
+    } else if far[1] == me {
+        Some((1, far[0]))
+    } else {
+        None
     }
 }
 

@@ -238,12 +238,10 @@ impl Engine for ContinuousSim<'_> {
         for (i, yi) in self.y.iter_mut().enumerate() {
             *yi += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
         }
-        // S10: the projection keeps every estimate at or above r_min.
+        // S10: the projection keeps every estimate at or above r_min (the core's floor).
         let n4 = 4 * self.q.len();
         for r in self.y.iter_mut().skip(n4) {
-            if *r < model.min_estimate {
-                *r = model.min_estimate;
-            }
+            *r = law::estimate_floor(*r, model.min_estimate);
         }
         self.unpack();
     }

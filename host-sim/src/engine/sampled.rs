@@ -11,6 +11,7 @@
 //! the result does not depend on the number of threads.
 
 mod parallel;
+mod tick;
 
 use super::attack::{AttackCounts, Attacks};
 use super::channel::ChannelStats;
@@ -26,7 +27,8 @@ use super::slot_order::SlotOrder;
 use super::stats::{add_frame_stats, ControlStats, FrameCounts};
 use crate::model::graph::Adjacency;
 use crate::model::{resolve_estimates, BearingRate, EstimateInfo, Estimator, Model};
-use controller_core::{BearingMeasurement, FrameStats, Measurements, StepOutput, Vec2};
+use controller_core::{BearingMeasurement, FrameStats, StepOutput, Vec2, MAX_NEIGHBOURS};
+use tick::{AgentSlots, Walk};
 
 /// Runs of at least this many agents compute ticks and plant steps on every thread of the
 /// current rayon pool (below it the fork-join costs more than it saves).
@@ -70,7 +72,6 @@ pub struct SampledSim<'m> {
     outputs: Vec<Option<StepOutput<f64>>>,
     error: Option<HilError>,
     forces: Vec<Vec2<f64>>,
-    bearings: Vec<BearingMeasurement<f64>>,
     /// Each agent's bearings go to its core in slot order ([`SlotOrder`]).
     slot_order: SlotOrder,
     estimates: Vec<f64>,
@@ -118,6 +119,13 @@ impl<'m> SampledSim<'m> {
         let n = model.n();
         if controllers.len() != n {
             return Err(format!("{} controllers for {n} agents", controllers.len()));
+        }
+        // An agent's tick holds one bearing per triangle neighbour ([`Walk::start`]).
+        let degree = model.graph.triangle.max_degree();
+        if degree > MAX_NEIGHBOURS {
+            return Err(format!(
+                "an agent has {degree} triangle neighbours, more than a controller holds ({MAX_NEIGHBOURS})"
+            ));
         }
         let mut info = Vec::new();
         let mut est_start = Vec::with_capacity(n + 1);
@@ -175,7 +183,6 @@ impl<'m> SampledSim<'m> {
             outputs: vec![None; n],
             error: None,
             forces: vec![Vec2::zeros(); n],
-            bearings: Vec::with_capacity(model.graph.triangle.max_degree()),
             slot_order,
             estimates: vec![model.initial_estimate; info.len()],
             est_start,
@@ -277,34 +284,40 @@ impl SampledSim<'_> {
         }
     }
 
-    /// Every agent measured and its tick started, in agent order.
+    /// Every agent's tick started ([`Walk::start`]), in agent order.
     fn tick_sequential(&mut self, t: f64, dt: f64, tick: u64) -> Result<(), HilError> {
         let mut delivered = 0;
         let model = self.model;
-        // Field by field: the scene reads the state while the loop writes the mailboxes.
-        let scene = Scene::of(model, &self.plant, &self.senses, tick);
-        for i in 0..model.n() {
-            prefetch_agent(&self.footprints, &self.sent, i + prefetch::AHEAD);
-            self.bearings.clear();
-            let (velocity, partner_offset) = scene.measure(i, |b| self.bearings.push(b));
-            self.slot_order.apply(i, &mut self.bearings);
-            let m = Measurements {
-                time: t,
-                dt,
-                velocity,
-                bearings: &self.bearings,
-                partner_offset,
+        // Field by field: the walk reads the state while the loop writes the agents' parts.
+        let walk = Walk {
+            t,
+            dt,
+            scene: Scene::of(model, &self.plant, &self.senses, tick),
+            radio: &model.graph.radio,
+            slot_order: &self.slot_order,
+            sent: &self.sent,
+            footprints: &self.footprints,
+            copy_estimates: self.viewed,
+        };
+        let each = self
+            .controllers
+            .iter_mut()
+            .zip(&mut self.inboxes)
+            .zip(&mut self.outboxes)
+            .zip(&mut self.forces)
+            .zip(&mut self.outputs);
+        for (i, ((((controller, inbox), outbox), force), output)) in each.enumerate() {
+            let (a, b) = (self.est_start[i], self.est_start[i + 1]);
+            let mut slots = AgentSlots {
+                controller,
+                inbox,
+                outbox,
+                force,
+                estimates: &mut self.estimates[a..b],
             };
-            self.outboxes[i].clear();
-            let inbox = Self::inbox(&self.inboxes[i], &self.sent, &model.graph.radio, i);
-            delivered += inbox.len() as u64;
-            self.outputs[i] = self.controllers[i].start_tick(inbox, &m, &mut self.outboxes[i])?;
-            if self.viewed && self.outputs[i].is_some() {
-                // Done: its estimates while its state is in cache.
-                let c = &*self.controllers[i];
-                Self::read_estimates_of(c, &mut self.estimates, &self.est_start, i);
-            }
-            self.inboxes[i].clear();
+            let (out, frames) = walk.start(i, &mut slots)?;
+            delivered += frames;
+            *output = out;
         }
         self.count_direct(delivered);
         Ok(())

@@ -12,6 +12,7 @@ mod criteria;
 mod devices;
 pub mod estimates;
 mod formation;
+pub mod geometry;
 pub mod graph;
 mod options;
 pub mod shape;

@@ -23,12 +23,7 @@ pub struct Shape {
 
 /// The interior angle at `p` of the triangle `p, a, b` (degrees).
 fn angle_deg(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let u = [a[0] - p[0], a[1] - p[1]];
-    let w = [b[0] - p[0], b[1] - p[1]];
-    (u[0] * w[1] - u[1] * w[0])
-        .abs()
-        .atan2(u[0] * w[0] + u[1] * w[1])
-        .to_degrees()
+    crate::model::geometry::interior_angle(p, a, b).to_degrees()
 }
 
 /// Perturbed initial positions for `model` (its triangles, angle margin and collision
