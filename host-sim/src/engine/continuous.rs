@@ -14,7 +14,7 @@ use super::stats::{ControlStats, FrameCounts};
 use crate::model::{
     resolve_estimates, BearingRate, CoreAgent, EstimateInfo, Estimator, Model, SensorModel,
 };
-use controller_core::{law, BearingMeasurement, Fault, Measurements, Status, Vec2};
+use controller_core::{law, BearingMeasurement, Fault, Measurements, StepOutput, Vec2};
 
 /// `(&mut v[i], &v[j])` for `i ≠ j`.
 fn pair_mut<T>(v: &mut [T], i: usize, j: usize) -> Option<(&mut T, &T)> {
@@ -92,49 +92,58 @@ impl Rhs {
                 }
             }
         }
-        let limit = model.limits.max_force;
         for i in 0..n {
             let vi = vel(i);
             let a = &model.agents[i];
-            let result = match self.sense_fault[i] {
-                Some(f) => Err(f),
-                None => self.agents[i].evaluate(),
-            };
-            let (force, status, saturated, degenerate) = match result {
-                Ok(ev) => {
-                    for e in self.est_start[i]..self.est_start[i + 1] {
-                        let info = &self.info[e];
-                        dy[4 * n + e] = ev
-                            .estimate_rates
-                            .get(info.local_triangle)
-                            .map_or(0.0, |r| r[info.angle][info.edge]);
-                    }
-                    let (f, sat) = law::saturate(&ev.force, limit);
-                    (f, Status::Nominal, sat, ev.degenerate)
-                }
-                Err(fault) => {
-                    for e in self.est_start[i]..self.est_start[i + 1] {
-                        dy[4 * n + e] = 0.0;
-                    }
-                    let (f, sat) = law::saturate(&(vi * -model.limits.safe_damping), limit);
-                    (f, Status::Safe(fault), sat, false)
-                }
-            };
+            let rates = &mut dy[4 * n + self.est_start[i]..4 * n + self.est_start[i + 1]];
+            let out = self.output(i, &vi, rates);
             // Counted per stage evaluation; t > 0 makes every safe output count.
             self.stats.record(
                 t.max(f64::MIN_POSITIVE),
                 i,
-                status,
-                saturated,
-                degenerate,
-                force.norm(),
+                out.status,
+                out.saturated,
+                out.degenerate,
+                out.force.norm(),
             );
+            let force = out.force;
             let acc = acceleration(&vi, &force, a.mass, &a.friction);
             dy[4 * i] = vi.x;
             dy[4 * i + 1] = vi.y;
             dy[4 * i + 2] = acc.x;
             dy[4 * i + 3] = acc.y;
         }
+    }
+}
+
+impl Rhs {
+    /// Agent `i`'s output at this stage, from its sensing and `evaluate`, through the
+    /// core's own [`Agent::output`](controller_core::Agent::output) (saturation, and on a
+    /// fault the safe command, zero for a non-finite velocity `v`), and the rates of its
+    /// owned estimates into `rates` (zero on a fault: the estimates hold still).
+    fn output(&mut self, i: usize, v: &Vec2<f64>, rates: &mut [f64]) -> StepOutput<f64> {
+        let result = match self.sense_fault[i] {
+            Some(f) => Err(f),
+            None => self.agents[i].evaluate(),
+        };
+        let first = self.est_start[i];
+        let law = match result {
+            Ok(ev) => {
+                for (k, rate) in rates.iter_mut().enumerate() {
+                    let info = &self.info[first + k];
+                    *rate = ev
+                        .estimate_rates
+                        .get(info.local_triangle)
+                        .map_or(0.0, |r| r[info.angle][info.edge]);
+                }
+                Ok((ev.force, ev.degenerate))
+            }
+            Err(fault) => {
+                rates.fill(0.0);
+                Err(fault)
+            }
+        };
+        self.agents[i].output(law, v)
     }
 }
 
@@ -202,6 +211,21 @@ impl<'m> ContinuousSim<'m> {
         };
         sim.unpack();
         Ok(sim)
+    }
+
+    /// Agent `i`'s output at time `t` on the current state, as the first RK4 stage
+    /// computes it (every agent sensed and exchanged; counted in the control statistics
+    /// like a stage): `None` beyond the last agent. For tests and diagnostics.
+    pub fn output_of(&mut self, t: f64, i: usize) -> Option<StepOutput<f64>> {
+        let n = self.q.len();
+        if i >= n {
+            return None;
+        }
+        let [k1, ..] = &mut self.k;
+        self.rhs.eval(self.model, t, &self.y, k1);
+        let v = Vec2::new(self.y[4 * i + 2], self.y[4 * i + 3]);
+        let mut rates = vec![0.0; self.rhs.est_start[i + 1] - self.rhs.est_start[i]];
+        Some(self.rhs.output(i, &v, &mut rates))
     }
 
     fn unpack(&mut self) {
