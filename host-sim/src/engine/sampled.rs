@@ -37,19 +37,12 @@ pub const PARALLEL_MIN_AGENTS: usize = 2048;
 const CHUNK: usize = 256;
 
 /// Whether every frame of a tick arrives, unchanged and in sender order, at the next tick:
-/// no loss, duplication, corruption, reordering, jitter, bandwidth limit or shared channel,
-/// a latency under half a control period, and no attacker.
+/// nothing in the radio alters frames ([`RadioModel::departures`](crate::model::RadioModel::departures),
+/// the one classification of its fields), a latency under half a control period, and no
+/// attacker.
 pub fn direct_radio(model: &Model) -> bool {
-    let r = &model.radio;
-    r.loss == 0.0
-        && r.duplication == 0.0
-        && r.corruption == 0.0
-        && (r.reordering == 0.0 || r.reorder_delay == 0.0)
-        && r.jitter == 0.0
-        && r.bandwidth == 0.0
-        && r.channel.is_none()
-        && r.latency < 0.5 * model.control_period()
-        && model.attacks.is_empty()
+    let d = model.radio.departures();
+    !d.alters_frames && d.latency < 0.5 * model.control_period() && model.attacks.is_empty()
 }
 
 /// The sampled-data simulator.

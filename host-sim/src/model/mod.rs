@@ -23,7 +23,7 @@ pub use attack::{AttackKind, AttackModel};
 pub use channel::{Access, ChannelModel, IntegrityMode};
 pub use core_config::{CoreAgent, MT, NB};
 pub use criteria::Criteria;
-pub use devices::{RadioModel, SensorModel};
+pub use devices::{RadioDepartures, RadioModel, SensorDepartures, SensorModel};
 pub use estimates::{estimate_layout, resolve_estimates, EstimateInfo};
 pub use formation::{AgentModel, AngleModel, LeaderModel, TriangleModel};
 pub use graph::Graph;
