@@ -18,23 +18,17 @@ use super::channel::ChannelStats;
 use super::controller::{local_core, AgentController, Inbox};
 use super::driver::Engine;
 use super::hil::{HilError, LinkStats};
-use super::huge_pages::Regions;
 use super::plant::Plant;
-use super::prefetch::{self, Footprint};
 use super::radio::{Radio, RadioFrame};
 use super::sensors::{offset_with, quiet_bearing, velocity_with, Sensors, Sight};
 use super::slot_order::SlotOrder;
+use super::speed::prefetch::{self, Footprint};
+use super::speed::{CHUNK, PARALLEL_MIN_AGENTS};
 use super::stats::{add_frame_stats, ControlStats, FrameCounts};
 use crate::model::graph::Adjacency;
 use crate::model::{resolve_estimates, BearingRate, EstimateInfo, Estimator, Model};
 use controller_core::{BearingMeasurement, FrameStats, StepOutput, Vec2, MAX_NEIGHBOURS};
 use tick::{AgentSlots, Walk};
-
-/// Runs of at least this many agents compute ticks and plant steps on every thread of the
-/// current rayon pool (below it the fork-join costs more than it saves).
-pub const PARALLEL_MIN_AGENTS: usize = 2048;
-/// Agents per parallel work item.
-const CHUNK: usize = 256;
 
 /// Whether every frame of a tick arrives, unchanged and in sender order, at the next tick:
 /// nothing in the radio alters frames ([`RadioModel::departures`](crate::model::RadioModel::departures),
@@ -158,7 +152,7 @@ impl<'m> SampledSim<'m> {
         let slot_order = SlotOrder::for_model(model, |i| controllers[i].neighbour_order());
         let mut radio = Radio::new(&model.radio, n, model.seed, capacity);
         radio.attach_channel(&model.graph.radio, period);
-        let sim = Self {
+        Ok(Self {
             model,
             footprints: controllers.iter().map(|c| Footprint::of(&**c)).collect(),
             controllers,
@@ -187,23 +181,7 @@ impl<'m> SampledSim<'m> {
             stats: ControlStats::default(),
             direct,
             local: false,
-        };
-        sim.huge_pages();
-        Ok(sim)
-    }
-
-    /// Backs the per-agent memory every tick walks (controllers, frame buffers) with huge
-    /// pages where the system allows it ([`huge_pages`](super::huge_pages)): a hint, no
-    /// value changes.
-    fn huge_pages(&self) {
-        let mut regions = Regions::new();
-        for c in &self.controllers {
-            regions.add(&**c);
-        }
-        for b in self.outboxes.iter().chain(&self.sent).chain(&self.inboxes) {
-            regions.add_buffer(b);
-        }
-        regions.collapse();
+        })
     }
 
     /// Runs `ticks` control periods (control, then `steps_per_tick` RK4 steps) without

@@ -7,9 +7,10 @@
 //! 100,000 agents' states costs a second walk through memory).
 
 use super::tick::{AgentSlots, Walk};
-use super::{SampledSim, Scene, CHUNK};
+use super::{SampledSim, Scene};
 use crate::engine::controller::AgentController;
 use crate::engine::radio::RadioFrame;
+use crate::engine::speed::CHUNK;
 use crate::engine::stats::ControlStats;
 use controller_core::Vec2;
 

@@ -6,9 +6,9 @@
 use super::{prefetch_agent, SampledSim, Scene};
 use crate::engine::controller::AgentController;
 use crate::engine::hil::HilError;
-use crate::engine::prefetch::{self, Footprint};
 use crate::engine::radio::RadioFrame;
 use crate::engine::slot_order::SlotOrder;
+use crate::engine::speed::prefetch::{self, Footprint};
 use crate::model::graph::Adjacency;
 use controller_core::{BearingMeasurement, Measurements, StepOutput, Vec2, MAX_NEIGHBOURS};
 
