@@ -136,6 +136,19 @@ fn phases(
             )
         },
     )?;
+    phase("bench-counts (host-sim under callgrind)", &mut || {
+        // The dev build `cargo test` made: only the example links (docs/performance.md).
+        let o = crate::bench_counts::Options {
+            profile: "dev".into(),
+            budgets: crate::bench_counts::default_budgets(),
+            no_check: false,
+            all: false,
+        };
+        match crate::bench_counts::run(&o)? {
+            true => Ok(()),
+            false => Err("regressions (listed above)".into()),
+        }
+    })?;
     phase("host-in-the-loop (host-sim QEMU tests)", &mut || {
         // No `-p host-sim`: the default members' feature set, as `cargo test` built it.
         tools::run(cargo().args(["test", "--test", "hil", "--", "--include-ignored"]))
