@@ -60,23 +60,44 @@ pub fn apex_angle<T: Real>(
 /// `γ_k = γ_α + c_α Δy + d_α Δẏ` (S7): the far vertex's own stiffness and damping act on
 /// fresh measurements. Returns `(γ_k, g_k, U_k)` with `U_k = −(γ_k / r_k) g_k` (S8).
 #[inline]
-#[allow(clippy::too_many_arguments)]
-pub fn far_angle<T: Real>(
-    gamma: T,
-    sigma_k: T,
-    r_k: T,
-    s_to_apex: &Vec2<T>,
-    stiffness: T,
-    damping: T,
-    delta: &Vec2<T>,
-    dv: &Vec2<T>,
-) -> (T, Vec2<T>, Vec2<T>) {
+pub fn far_angle<T: Real>(input: &FarAngle<T>) -> (T, Vec2<T>, Vec2<T>) {
+    let FarAngle {
+        gamma,
+        sigma_k,
+        r_k,
+        s_to_apex,
+        stiffness,
+        damping,
+        delta,
+        dv,
+    } = *input;
     // n_k = J s_uk = −J s_ku, so g_k = −σ_k J s_ku and g_kᵀ x = −σ_k (s_ku × x).
     let x = delta * stiffness + dv * damping;
-    let gamma_k = gamma - sigma_k * geometry::cross(s_to_apex, &x) / r_k;
+    let gamma_k = gamma - sigma_k * geometry::cross(&s_to_apex, &x) / r_k;
     // U_k = −(γ_k / r_k) g_k = (σ_k γ_k / r_k) J s_ku.
-    let j_s = geometry::perp(s_to_apex);
+    let j_s = geometry::perp(&s_to_apex);
     (gamma_k, j_s * -sigma_k, j_s * (sigma_k * gamma_k / r_k))
+}
+
+/// What [`far_angle`] reads: what the apex sent and the far vertex's own measurements.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FarAngle<T: Real> {
+    /// S7: the apex's `γ_α`.
+    pub gamma: T,
+    /// `σ_k = ±σ` ([`far_sigma`]).
+    pub sigma_k: T,
+    /// The distance `r_k` to the apex (estimate or range).
+    pub r_k: T,
+    /// The far vertex's fresh bearing to the apex `s_ku`.
+    pub s_to_apex: Vec2<T>,
+    /// The far vertex's own stiffness `c_α`.
+    pub stiffness: T,
+    /// The far vertex's own damping `d_α`.
+    pub damping: T,
+    /// Its displacement relative to the apex since the apex measured, `δ`.
+    pub delta: Vec2<T>,
+    /// The change of its own velocity since then, `Δv`.
+    pub dv: Vec2<T>,
 }
 
 /// S6: the sign of far vertex `k`'s direction, `g_{α,v} = σ J s_uv` and
@@ -94,15 +115,6 @@ pub fn far_sigma<T: Real>(sigma: T, k: usize) -> T {
 #[inline]
 pub fn port_effort<T: Real>(stiffness: T, damping: T, y_tilde: T, y_dot: T) -> T {
     stiffness * y_tilde + damping * y_dot
-}
-
-/// S8: the forces of one angle on `[u, v, w]` (apex first), given `γ_α`, the directions
-/// `g = [g_{α,v}, g_{α,w}]` and the distances `r = [r̂_{α,uv}, r̂_{α,uw}]`. They sum to zero.
-#[inline]
-pub fn angle_forces<T: Real>(gamma: T, g: &[Vec2<T>; 2], r: [T; 2]) -> [Vec2<T>; 3] {
-    let fv = g[0] * (-gamma / r[0]);
-    let fw = g[1] * (-gamma / r[1]);
-    [-(fv + fw), fv, fw]
 }
 
 /// S8: force of one angle on its apex.

@@ -46,8 +46,8 @@ pub mod stats;
 pub mod wire;
 
 pub use agent::{
-    Agent, BearingMeasurement, Evaluation, Fault, MeasurementError, Measurements, OwnedEstimate,
-    Status, StepOutput,
+    Agent, BearingMeasurement, Evaluation, Fault, LawOutput, MeasurementError, Measurements,
+    OwnedEstimate, Status, StepOutput,
 };
 pub use config::{
     AgentConfig, AgentId, AngleConfig, ConfigError, EstimatorMode, Integrity, LeaderConfig,

@@ -3,8 +3,8 @@
 //! layout is [`crate::wire`]'s.
 
 use super::state::{AngleState, Remote, Side};
-use super::{pick, Agent};
-use crate::config::AgentId;
+use super::{finite_vec, pick, Agent};
+use crate::config::{AgentId, EstimatorMode};
 use crate::wire::auth::{self, Counter};
 use crate::wire::{check_mode, quant, CrcCheck, FrameError, Integrity, RawAngle};
 use crate::{law, Real, Vec2};
@@ -238,10 +238,17 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     }
 
     /// Takes a neighbour's broadcast directly, without the wire (no rounding, no sequence
-    /// numbers): for in-process simulation and tests.
+    /// numbers): for in-process simulation and tests. The broadcast passes the checks
+    /// [`Agent::receive`] applies to a frame's values before anything is applied: a
+    /// finite velocity, and for every angle sent, distinct far vertices
+    /// ([`FrameError::Malformed`]), a finite `γ` and `σ` and distances that are finite,
+    /// positive and (with estimators) at least `r_min` ([`FrameError::InvalidValue`]).
+    /// (`|σ| ≤ 1` is not checked: the wire rounds `σ` into it, a direct value may exceed
+    /// it by a rounding.)
     pub fn receive_direct(&mut self, from: &Self) -> Result<(), FrameError> {
         let sender = from.id();
         let slot = self.slot(sender).ok_or(FrameError::UnknownSender(sender))?;
+        self.check_direct(from)?;
         if let Some(n) = self.neighbours.get_mut(slot) {
             n.age = T::zero();
             n.velocity = from.velocity;
@@ -253,6 +260,30 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 (sent_angle(a), far_role(a.far, me))
             {
                 self.apply_angle(slot, other, gamma, sigma, pick(&rho, k));
+            }
+        }
+        Ok(())
+    }
+
+    /// The value checks of [`Agent::receive_direct`] (those of `FrameView::validate` on
+    /// full-precision values).
+    fn check_direct(&self, from: &Self) -> Result<(), FrameError> {
+        if !finite_vec(&from.velocity) {
+            return Err(FrameError::InvalidValue);
+        }
+        let r_min = match self.config.estimator {
+            EstimatorMode::Measured => T::zero(),
+            EstimatorMode::Shared | EstimatorMode::PerAgent => self.config.min_estimate,
+        };
+        let distance = |r: T| r.finite() && r > T::zero() && r >= r_min;
+        for a in from.angles.iter().flatten() {
+            if let Some((gamma, sigma, rho)) = sent_angle(a) {
+                if a.far[0] == a.far[1] {
+                    return Err(FrameError::Malformed);
+                }
+                if !(gamma.finite() && sigma.finite() && distance(rho[0]) && distance(rho[1])) {
+                    return Err(FrameError::InvalidValue);
+                }
             }
         }
         Ok(())
@@ -336,8 +367,23 @@ mod tests {
     use super::unit_code;
     use crate::agent::test_support::one_triangle;
     use crate::wire::auth::{self, Counter};
-    use crate::wire::{Integrity, SwarmKey};
-    use crate::Agent;
+    use crate::wire::{FrameError, Integrity, SwarmKey};
+    use crate::{Agent, Vec2};
+
+    /// `receive_direct` refuses what `receive` refuses, before applying anything: a
+    /// non-finite velocity (it took any broadcast as it was).
+    #[test]
+    fn receive_direct_applies_the_value_checks_of_receive() {
+        let mut me = Agent::<f64, 1, 2>::new(one_triangle(2, [1, 2], 0.5)).unwrap();
+        let mut from = Agent::<f64, 1, 2>::new(one_triangle(1, [1, 2], 0.5)).unwrap();
+        from.velocity = Vec2::new(1.0, 2.0);
+        assert_eq!(me.receive_direct(&from), Ok(()));
+        let slot = me.slot(1).unwrap();
+        assert_eq!(me.neighbours[slot].velocity, Vec2::new(1.0, 2.0));
+        from.velocity = Vec2::new(f64::NAN, 0.0);
+        assert_eq!(me.receive_direct(&from), Err(FrameError::InvalidValue));
+        assert_eq!(me.neighbours[slot].velocity, Vec2::new(1.0, 2.0));
+    }
 
     /// An `auth` agent `id` in the triangle (1, 2, 3).
     fn auth_agent(id: u8) -> Agent<f32, 1, 2> {

@@ -52,11 +52,19 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         n
     }
 
-    /// Overwrites an owned estimate (for simulators integrating S9 in continuous time; call
-    /// it before [`Agent::sense`], which computes the apex kernels with the estimates).
-    /// Values are clamped to `r_min`; returns `false` for an estimate this agent does not
-    /// own or a non-finite value.
-    pub fn set_estimate(&mut self, triangle: usize, angle: usize, edge: usize, value: T) -> bool {
+    /// Overwrites an owned estimate with `e.value` (for simulators integrating S9 in
+    /// continuous time; call it before [`Agent::sense`], which computes the apex kernels
+    /// with the estimates). `e` names the estimate as [`Agent::owned_estimates`] does
+    /// (its `apex` and `far` are not read). Values are clamped to `r_min`; returns `false`
+    /// for an estimate this agent does not own or a non-finite value.
+    pub fn set_estimate(&mut self, e: &OwnedEstimate<T>) -> bool {
+        let OwnedEstimate {
+            triangle,
+            angle,
+            edge,
+            value,
+            ..
+        } = *e;
         let owned = match self.angles.get(triangle).and_then(|t| t.get(angle)) {
             Some(a) => self.owns(a, edge),
             None => false,
@@ -93,7 +101,7 @@ pub(super) fn owns<T: Real>(mode: EstimatorMode, a: &AngleState<T>, edge: usize)
 mod tests {
     use super::super::test_support::one_triangle;
     use crate::law::{at_floor, estimate_floor, estimator_step, projected_rate};
-    use crate::Agent;
+    use crate::{Agent, OwnedEstimate};
 
     /// S10 in its three uses agrees with the one floor: the sampled step, the projected
     /// flow and `Agent::set_estimate` (which clamped with its own comparison before).
@@ -120,7 +128,7 @@ mod tests {
         let mut a = Agent::<f64, 1, 2>::new(c).unwrap();
         let e = a.owned_estimates().next().unwrap();
         for r in [below, r_min, above, 2.0] {
-            assert!(a.set_estimate(e.triangle, e.angle, e.edge, r));
+            assert!(a.set_estimate(&OwnedEstimate { value: r, ..e }));
             let got = a.owned_estimates().next().unwrap().value;
             assert_eq!(got.to_bits(), estimate_floor(r, r_min).to_bits(), "{r}");
         }

@@ -14,7 +14,9 @@ use super::stats::{ControlStats, FrameCounts};
 use crate::model::{
     resolve_estimates, BearingRate, CoreAgent, EstimateInfo, Estimator, Model, SensorModel,
 };
-use controller_core::{law, BearingMeasurement, Fault, Measurements, StepOutput, Vec2};
+use controller_core::{
+    law, BearingMeasurement, Fault, LawOutput, Measurements, OwnedEstimate, StepOutput, Vec2,
+};
 
 /// `(&mut v[i], &v[j])` for `i ≠ j`.
 fn pair_mut<T>(v: &mut [T], i: usize, j: usize) -> Option<(&mut T, &T)> {
@@ -55,7 +57,14 @@ impl Rhs {
         let vel = |i: usize| Vec2::new(y[4 * i + 2], y[4 * i + 3]);
         for (e, info) in self.info.iter().enumerate() {
             if let Some(a) = self.agents.get_mut(info.owner) {
-                a.set_estimate(info.local_triangle, info.angle, info.edge, y[4 * n + e]);
+                a.set_estimate(&OwnedEstimate {
+                    triangle: info.local_triangle,
+                    angle: info.angle,
+                    edge: info.edge,
+                    apex: 0,
+                    far: 0,
+                    value: y[4 * n + e],
+                });
             }
         }
         let ranged = model.estimator == Estimator::Measured;
@@ -136,7 +145,10 @@ impl Rhs {
                         .get(info.local_triangle)
                         .map_or(0.0, |r| r[info.angle][info.edge]);
                 }
-                Ok((ev.force, ev.degenerate))
+                Ok(LawOutput {
+                    force: ev.force,
+                    degenerate: ev.degenerate,
+                })
             }
             Err(fault) => {
                 rates.fill(0.0);
