@@ -33,4 +33,4 @@ pub use record::{NullRecorder, Recorder, Row};
 pub use result::RunResult;
 pub use sampled::{direct_radio, SampledSim};
 pub use speed::PARALLEL_MIN_AGENTS;
-pub use stats::{ControlStats, FrameCounts};
+pub use stats::{ControlStats, FrameCounts, FrameReasons};

@@ -24,10 +24,10 @@ use super::sensors::{offset_with, quiet_bearing, velocity_with, Sensors, Sight};
 use super::slot_order::SlotOrder;
 use super::speed::prefetch::{self, Footprint};
 use super::speed::{CHUNK, PARALLEL_MIN_AGENTS};
-use super::stats::{add_frame_stats, ControlStats, FrameCounts};
+use super::stats::{ControlStats, FrameCounts, FrameReasons};
 use crate::model::graph::Adjacency;
 use crate::model::{resolve_estimates, BearingRate, EstimateInfo, Estimator, Model};
-use controller_core::{BearingMeasurement, FrameStats, StepOutput, Vec2, MAX_NEIGHBOURS};
+use controller_core::{BearingMeasurement, StepOutput, Vec2, MAX_NEIGHBOURS};
 use tick::{AgentSlots, Walk};
 
 /// Whether every frame of a tick arrives, unchanged and in sender order, at the next tick:
@@ -452,13 +452,13 @@ impl Engine for SampledSim<'_> {
             delivered: r.delivered,
             accepted: 0,
             rejected: 0,
-            by_reason: FrameStats::default(),
+            by_reason: FrameReasons::default(),
         };
         for ctl in &self.controllers {
             let s = ctl.frame_stats();
             c.accepted += u64::from(s.accepted);
             c.rejected += u64::from(s.rejected());
-            add_frame_stats(&mut c.by_reason, &s);
+            c.by_reason.add(&s);
         }
         c
     }
