@@ -82,7 +82,12 @@ pub(super) fn run_command(args: &RunArgs, quiet: bool) -> u8 {
     let mut progress = Progress::new(quiet, model.duration);
     let mut sim = Simulation::new(&model)
         .keep_series(false)
-        .write_to(&out, !args.no_plots)
+        .write_to(
+            &out,
+            crate::WriteOptions {
+                plots: !args.no_plots,
+            },
+        )
         .csv(!args.summary_only)
         .progress(&mut progress);
     if let Some(n) = args.jobs {
