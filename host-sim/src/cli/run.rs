@@ -129,6 +129,7 @@ pub(super) fn run_command(args: &RunArgs, quiet: bool) -> u8 {
 
 /// Checks the `--hil` arguments (agent ids, timeout, firmware ELF, QEMU) before anything
 /// is written.
+#[allow(irrefutable_let_patterns)] // QEMU is the only launcher without `fake-target`.
 fn hil_options(args: &RunArgs, model: &Model, out: &Path) -> Result<HilOptions, hil::HilError> {
     hil::agent_indices(model, &args.hil)?;
     let opts = HilOptions::qemu(

@@ -16,6 +16,8 @@
 mod config;
 pub mod controller;
 mod error;
+#[cfg(feature = "fake-target")]
+#[doc(hidden)]
 pub mod fake;
 mod options;
 mod stats;
@@ -94,6 +96,7 @@ fn launch(
             })?;
             (s, TargetHandle::Qemu(p))
         }
+        #[cfg(feature = "fake-target")]
         Launcher::Fake(b) => {
             let h = fake::spawn(port, *b);
             let s = qemu::accept_until(&listener, deadline, || Ok(()))
@@ -150,6 +153,7 @@ pub fn controllers(
         Launcher::Qemu {
             program, firmware, ..
         } => Some(preflight(program, firmware)?),
+        #[cfg(feature = "fake-target")]
         Launcher::Fake(_) => None,
     };
     let startup = opts.timeout.max(Duration::from_secs_f64(STARTUP_TIMEOUT_S));
