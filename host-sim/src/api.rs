@@ -187,7 +187,7 @@ impl<'a> Simulation<'a> {
             })?;
         }
         // The estimate layout (for the columns) comes from the agents' own configurations.
-        let estimates = estimate_layout(model).map_err(RunError::Failed)?;
+        let estimates = estimate_layout(model).map_err(RunError::from)?;
         let csv_path = self
             .out
             .as_ref()

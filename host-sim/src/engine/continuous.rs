@@ -7,6 +7,7 @@
 //! `receive_direct`, then `evaluate` every agent for its force and estimate rates.
 
 use super::driver::Engine;
+use super::error::SetupError;
 use super::plant::acceleration;
 use super::sensors::{quiet_bearing, Sight};
 use super::slot_order::SlotOrder;
@@ -173,7 +174,7 @@ pub struct ContinuousSim<'m> {
 
 impl<'m> ContinuousSim<'m> {
     /// Builds the cores and the initial ODE state.
-    pub fn new(model: &'m Model) -> Result<Self, String> {
+    pub fn new(model: &'m Model) -> Result<Self, SetupError> {
         let n = model.n();
         let mut agents = Vec::with_capacity(n);
         let mut info = Vec::new();

@@ -150,15 +150,13 @@ pub fn drive(
             diag.evaluate(model, t, q, v, est);
             let stop = monitor.observe(model, &diag, est);
             if (log || stop) && rows {
-                recorder
-                    .record(&Row {
-                        snap: &diag.snap,
-                        q,
-                        v,
-                        estimates: est,
-                        frames,
-                    })
-                    .map_err(|e| format!("cannot write the time series: {e}"))?;
+                recorder.record(&Row {
+                    snap: &diag.snap,
+                    q,
+                    v,
+                    estimates: est,
+                    frames,
+                })?;
             }
             if stop {
                 break;
@@ -178,9 +176,7 @@ pub fn drive(
         }
         k = next;
     }
-    recorder
-        .finish()
-        .map_err(|e| format!("cannot write the time series: {e}"))?;
+    recorder.finish()?;
     progress(diag.snap.t);
     let (q, v, est) = engine.view();
     let (outcome, reason) = monitor.verdict(model, &diag.snap, q);

@@ -28,7 +28,7 @@ mod stats;
 pub use continuous::ContinuousSim;
 pub use controller::{local_core, AgentController, LocalCore, LOCAL_CAPACITIES};
 pub use driver::{drive, run, Engine};
-pub use error::RunError;
+pub use error::{RunError, SetupError};
 pub use record::{NullRecorder, Recorder, Row};
 pub use result::RunResult;
 pub use sampled::{direct_radio, SampledSim};

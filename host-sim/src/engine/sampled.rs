@@ -17,6 +17,7 @@ use super::attack::{AttackCounts, Attacks};
 use super::channel::ChannelStats;
 use super::controller::{local_core, AgentController, Inbox};
 use super::driver::Engine;
+use super::error::SetupError;
 use super::hil::{HilError, LinkStats};
 use super::plant::Plant;
 use super::radio::{Radio, RadioFrame};
@@ -88,7 +89,7 @@ const FRAMES_PER_TICK: usize = controller_core::StandardAgent::<f64>::MAX_FRAMES
 impl<'m> SampledSim<'m> {
     /// A sampled simulation with a [`LocalCore`](super::LocalCore) for every agent, each
     /// in the smallest capacity that holds it ([`local_core`]).
-    pub fn new(model: &'m Model) -> Result<Self, String> {
+    pub fn new(model: &'m Model) -> Result<Self, SetupError> {
         let mut controllers: Vec<Box<dyn AgentController>> = Vec::with_capacity(model.n());
         for i in 0..model.n() {
             controllers.push(local_core(model, i)?);
@@ -102,27 +103,31 @@ impl<'m> SampledSim<'m> {
     pub fn with_controllers(
         model: &'m Model,
         controllers: Vec<Box<dyn AgentController>>,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, SetupError> {
         let n = model.n();
         if controllers.len() != n {
-            return Err(format!("{} controllers for {n} agents", controllers.len()));
+            return Err(SetupError::ControllerCount {
+                controllers: controllers.len(),
+                agents: n,
+            });
         }
         // An agent's tick holds one bearing per triangle neighbour ([`Walk::start`]).
         let degree = model.graph.triangle.max_degree();
         if degree > MAX_NEIGHBOURS {
-            return Err(format!(
-                "an agent has {degree} triangle neighbours, more than a controller holds ({MAX_NEIGHBOURS})"
-            ));
+            return Err(SetupError::TooManyNeighbours {
+                degree,
+                max: MAX_NEIGHBOURS,
+            });
         }
         let mut info = Vec::new();
         let mut est_start = Vec::with_capacity(n + 1);
         for (i, c) in controllers.iter().enumerate() {
             if c.id() != model.agents[i].id {
-                return Err(format!(
-                    "controller {i} has id {}, expected {}",
-                    c.id(),
-                    model.agents[i].id
-                ));
+                return Err(SetupError::ControllerId {
+                    index: i,
+                    id: c.id(),
+                    expected: model.agents[i].id,
+                });
             }
             est_start.push(info.len());
             info.extend(resolve_estimates(model, i, &c.estimate_layout())?);

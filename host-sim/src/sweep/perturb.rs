@@ -5,7 +5,8 @@
 
 use super::plan::Perturb;
 use crate::design::{
-    initial_positions, Construction, ControlledAngle, DesignTriangle, Figures, Perturbation, Scale,
+    initial_positions, Construction, ControlledAngle, DesignError, DesignTriangle, Figures,
+    Perturbation, Scale,
 };
 use crate::model::Model;
 
@@ -28,7 +29,12 @@ fn angle_deg(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
 
 /// Perturbed initial positions for `model` (its triangles, angle margin and collision
 /// distance), at `fraction` of the reference's size, from `seed`.
-pub fn positions(model: &Model, p: &Perturb, fraction: f64, seed: u64) -> Result<Shape, String> {
+pub fn positions(
+    model: &Model,
+    p: &Perturb,
+    fraction: f64,
+    seed: u64,
+) -> Result<Shape, DesignError> {
     let reference: Vec<[f64; 2]> = match &p.shape {
         Some(s) => s.clone(),
         None => model.agents.iter().map(|a| a.position).collect(),
@@ -82,8 +88,7 @@ pub fn positions(model: &Model, p: &Perturb, fraction: f64, seed: u64) -> Result
         },
         margin_deg,
         model.criteria.collision_distance,
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     Ok(Shape {
         positions: init.positions,
         rotation: init.rotation,

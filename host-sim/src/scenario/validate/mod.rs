@@ -121,7 +121,7 @@ pub fn validate(s: &ScenarioFile, file: &str, default_name: &str) -> Result<Mode
                 InvalidValue,
                 file,
                 &format!("agents[{i}]"),
-                e,
+                e.to_string(),
             ));
         }
     }
