@@ -84,7 +84,7 @@ pub(super) fn run_command(args: &RunArgs, quiet: bool) -> u8 {
         .keep_series(false)
         .write_to(
             &out,
-            crate::WriteOptions {
+            crate::api::WriteOptions {
                 plots: !args.no_plots,
             },
         )
