@@ -16,6 +16,7 @@ rustup target add thumbv7em-none-eabihf >/dev/null
 rustup component add rustfmt clippy llvm-tools >/dev/null
 bash scripts/firmware-deps.sh
 bash scripts/browser-deps.sh
+bash scripts/bench-deps.sh    # valgrind, for cargo xtask bench-counts
 
 XTASK_TEST_INSTALLED=$(date +%s.%N)
 export XTASK_TEST_INSTALLED

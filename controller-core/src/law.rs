@@ -60,23 +60,44 @@ pub fn apex_angle<T: Real>(
 /// `γ_k = γ_α + c_α Δy + d_α Δẏ` (S7): the far vertex's own stiffness and damping act on
 /// fresh measurements. Returns `(γ_k, g_k, U_k)` with `U_k = −(γ_k / r_k) g_k` (S8).
 #[inline]
-#[allow(clippy::too_many_arguments)]
-pub fn far_angle<T: Real>(
-    gamma: T,
-    sigma_k: T,
-    r_k: T,
-    s_to_apex: &Vec2<T>,
-    stiffness: T,
-    damping: T,
-    delta: &Vec2<T>,
-    dv: &Vec2<T>,
-) -> (T, Vec2<T>, Vec2<T>) {
+pub fn far_angle<T: Real>(input: &FarAngle<T>) -> (T, Vec2<T>, Vec2<T>) {
+    let FarAngle {
+        gamma,
+        sigma_k,
+        r_k,
+        s_to_apex,
+        stiffness,
+        damping,
+        delta,
+        dv,
+    } = *input;
     // n_k = J s_uk = −J s_ku, so g_k = −σ_k J s_ku and g_kᵀ x = −σ_k (s_ku × x).
     let x = delta * stiffness + dv * damping;
-    let gamma_k = gamma - sigma_k * geometry::cross(s_to_apex, &x) / r_k;
+    let gamma_k = gamma - sigma_k * geometry::cross(&s_to_apex, &x) / r_k;
     // U_k = −(γ_k / r_k) g_k = (σ_k γ_k / r_k) J s_ku.
-    let j_s = geometry::perp(s_to_apex);
+    let j_s = geometry::perp(&s_to_apex);
     (gamma_k, j_s * -sigma_k, j_s * (sigma_k * gamma_k / r_k))
+}
+
+/// What [`far_angle`] reads: what the apex sent and the far vertex's own measurements.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FarAngle<T: Real> {
+    /// S7: the apex's `γ_α`.
+    pub gamma: T,
+    /// `σ_k = ±σ` ([`far_sigma`]).
+    pub sigma_k: T,
+    /// The distance `r_k` to the apex (estimate or range).
+    pub r_k: T,
+    /// The far vertex's fresh bearing to the apex `s_ku`.
+    pub s_to_apex: Vec2<T>,
+    /// The far vertex's own stiffness `c_α`.
+    pub stiffness: T,
+    /// The far vertex's own damping `d_α`.
+    pub damping: T,
+    /// Its displacement relative to the apex since the apex measured, `δ`.
+    pub delta: Vec2<T>,
+    /// The change of its own velocity since then, `Δv`.
+    pub dv: Vec2<T>,
 }
 
 /// S6: the sign of far vertex `k`'s direction, `g_{α,v} = σ J s_uv` and
@@ -96,15 +117,6 @@ pub fn port_effort<T: Real>(stiffness: T, damping: T, y_tilde: T, y_dot: T) -> T
     stiffness * y_tilde + damping * y_dot
 }
 
-/// S8: the forces of one angle on `[u, v, w]` (apex first), given `γ_α`, the directions
-/// `g = [g_{α,v}, g_{α,w}]` and the distances `r = [r̂_{α,uv}, r̂_{α,uw}]`. They sum to zero.
-#[inline]
-pub fn angle_forces<T: Real>(gamma: T, g: &[Vec2<T>; 2], r: [T; 2]) -> [Vec2<T>; 3] {
-    let fv = g[0] * (-gamma / r[0]);
-    let fw = g[1] * (-gamma / r[1]);
-    [-(fv + fw), fv, fw]
-}
-
 /// S8: force of one angle on its apex.
 #[inline]
 pub fn apex_force<T: Real>(gamma: T, g: &[Vec2<T>; 2], r: [T; 2]) -> Vec2<T> {
@@ -119,25 +131,41 @@ pub fn estimator_rate<T: Real>(range_rate: T, gamma: T, t: T, gain: T, r_hat: T)
     range_rate - gamma * t / (gain * r_hat)
 }
 
-/// S10, continuous form: the projected flow (0 instead of a negative flow at `r_min`).
+/// S10: whether an estimate is on the floor `r_min` (at or below it, or NaN): the one
+/// test behind [`estimate_floor`] and [`projected_rate`].
+#[inline]
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(r̂ > r_min)`: a NaN estimate is on the floor.
+pub fn at_floor<T: Real>(r_hat: T, r_min: T) -> bool {
+    !(r_hat > r_min)
+}
+
+/// S10's floor `max(r_min, r̂)`, a NaN estimate read as `r_min`: the one implementation
+/// of the floor (the sampled step [`estimator_step`], [`crate::Agent::set_estimate`] and
+/// host-sim's continuous integration use it).
+#[inline]
+pub fn estimate_floor<T: Real>(r_hat: T, r_min: T) -> T {
+    if at_floor(r_hat, r_min) {
+        r_min
+    } else {
+        r_hat
+    }
+}
+
+/// S10, continuous form: the projected flow (0 instead of a negative flow at `r_min`,
+/// [`at_floor`]).
 #[inline]
 pub fn projected_rate<T: Real>(r_hat: T, rate: T, r_min: T) -> T {
-    if r_hat <= r_min && rate < T::zero() {
+    if at_floor(r_hat, r_min) && rate < T::zero() {
         T::zero()
     } else {
         rate
     }
 }
 
-/// S10, sampled form: `r̂ ← max(r_min, r̂ + Δt·S9)`.
+/// S10, sampled form: `r̂ ← max(r_min, r̂ + Δt·S9)` ([`estimate_floor`]).
 #[inline]
 pub fn estimator_step<T: Real>(r_hat: T, rate: T, dt: T, r_min: T) -> T {
-    let next = r_hat + dt * rate;
-    if next > r_min {
-        next
-    } else {
-        r_min
-    }
+    estimate_floor(r_hat + dt * rate, r_min)
 }
 
 /// `PerAgent` share (SPEC §6): `f^n_{α,e} = ±g_{α,e}ᵀ v_n / r̂^n_{α,e}`, `+` for the far

@@ -15,8 +15,9 @@
 //! 1. [`Agent::receive`] every frame heard since the last tick;
 //! 2. [`Agent::step`] with [`Measurements`] (bearings, optional rates, own velocity, `Δt`,
 //!    the leader's partner offset) → [`StepOutput`] (force, status);
-//! 3. [`Agent::frames`] → one frame of at most 60 bytes to broadcast (two for the apex
-//!    of more than 7 angles; none on the ticks [`AgentConfig::comm_every`] skips).
+//! 3. [`Agent::frames`] → one frame of at most 60 bytes to broadcast (more for the apex
+//!    of more angles than a frame holds, [`wire::Integrity::max_angles`]: 4 with every
+//!    integrity mode; none on the ticks [`AgentConfig::comm_every`] skips).
 #![no_std]
 #![deny(
     clippy::unwrap_used,
@@ -47,8 +48,8 @@ pub mod tracker;
 pub mod wire;
 
 pub use agent::{
-    Agent, BearingMeasurement, Evaluation, Fault, MeasurementError, Measurements, OwnedEstimate,
-    Status, StepOutput,
+    Agent, BearingMeasurement, Evaluation, Fault, LawOutput, MeasurementError, Measurements,
+    OwnedEstimate, Status, StepOutput,
 };
 pub use config::{
     AgentConfig, AgentId, AngleConfig, BearingFilter, ConfigError, EstimatorMode, Integrity, LeaderConfig,

@@ -190,7 +190,10 @@ fn copy_estimates_is_owned_estimates_values() {
         for mut a in f.agents::<f64>() {
             let owned: Vec<_> = a.owned_estimates().collect();
             for e in &owned {
-                assert!(a.set_estimate(e.triangle, e.angle, e.edge, r.random_range(0.3..3.0)));
+                assert!(a.set_estimate(&controller_core::OwnedEstimate {
+                    value: r.random_range(0.3..3.0),
+                    ..*e
+                }));
             }
             let values: Vec<f64> = a.owned_estimates().map(|e| e.value).collect();
             let mut out = vec![f64::NAN; values.len() + 2];

@@ -25,7 +25,10 @@ fn check(f: &Formation, s: &State, seed: u64) -> Check {
     for a in agents.iter_mut() {
         let owned: Vec<_> = a.owned_estimates().collect();
         for e in owned {
-            assert!(a.set_estimate(e.triangle, e.angle, e.edge, r.random_range(0.3..3.0)));
+            assert!(a.set_estimate(&controller_core::OwnedEstimate {
+                value: r.random_range(0.3..3.0),
+                ..e
+            }));
         }
     }
     sense_and_exchange(f, s, &mut agents, 0.0, 0.0);

@@ -17,7 +17,10 @@ fn forces<T: controller_core::Real>(
         let owned: Vec<_> = a.owned_estimates().collect();
         for e in owned {
             let key = usize::from(e.apex) * 1000 + usize::from(e.far) * 10 + e.triangle;
-            assert!(a.set_estimate(e.triangle, e.angle, e.edge, T::lit(estimates(key))));
+            assert!(a.set_estimate(&controller_core::OwnedEstimate {
+                value: T::lit(estimates(key)),
+                ..e
+            }));
         }
     }
     sense_and_exchange(f, s, &mut agents, 0.0, 0.0);

@@ -59,7 +59,7 @@ proptest! {
         let s_to_apex = (q[0] - q[far]) / r;
         // Nothing moved: exactly S8 on the far vertex, and the apex's γ.
         let (gamma_k, g, f) =
-            law::far_angle(a.gamma, law::far_sigma(a.sigma, k), r, &s_to_apex, c, d, &Vec2::zeros(), &Vec2::zeros());
+            law::far_angle(&far_input(a.gamma, law::far_sigma(a.sigma, k), r, s_to_apex, c, d, Vec2::zeros(), Vec2::zeros()));
         let s8 = a.g[k] * (-a.gamma / r);
         prop_assert!((f - s8).norm() <= 1e-9 * (1.0 + s8.norm()), "{:?} vs {:?}", f, s8);
         prop_assert!((g - a.g[k]).norm() <= 1e-12);
@@ -69,7 +69,7 @@ proptest! {
         vel1[far] += dv;
         let exact = apex(&q, &vel1, cos_d, c, d).gamma;
         let (approx, ..) =
-            law::far_angle(a.gamma, law::far_sigma(a.sigma, k), r, &s_to_apex, c, d, &Vec2::zeros(), &dv);
+            law::far_angle(&far_input(a.gamma, law::far_sigma(a.sigma, k), r, s_to_apex, c, d, Vec2::zeros(), dv));
         prop_assert!((approx - exact).abs() <= 1e-9 * (1.0 + exact.abs()), "{} vs {}", approx, exact);
         // The far vertex moved by ε·dir (everybody moving together): second order.
         let same = [vu; 3];
@@ -78,10 +78,10 @@ proptest! {
             let mut q1 = q;
             q1[far] += dir * (0.01 * eps);
             let exact = apex(&q1, &same, cos_d, c, d).gamma;
-            let (approx, ..) = law::far_angle(
-                a.gamma, law::far_sigma(a.sigma, k), r, &s_to_apex, c, d,
-                &(dir * (0.01 * eps)), &Vec2::zeros(),
-            );
+            let (approx, ..) = law::far_angle(&far_input(
+                a.gamma, law::far_sigma(a.sigma, k), r, s_to_apex, c, d,
+                dir * (0.01 * eps), Vec2::zeros(),
+            ));
             ((approx - exact).abs(), (a.gamma - exact).abs())
         };
         // Second order: within the Taylor remainder ½·max|∂²y/∂q²|·c|δ|², with
@@ -93,5 +93,29 @@ proptest! {
             let bound = 2.1 * c * (delta / r).powi(2) + 1e-13;
             prop_assert!(e <= bound, "ε = {}: error {} > {} (uncorrected {})", eps, e, bound, u);
         }
+    }
+}
+
+/// `law::FarAngle` from its fields in their order (gamma, σ_k, r_k, s_ku, c, d, δ, Δv).
+#[allow(clippy::too_many_arguments)]
+fn far_input(
+    gamma: f64,
+    sigma_k: f64,
+    r_k: f64,
+    s_to_apex: Vec2<f64>,
+    stiffness: f64,
+    damping: f64,
+    delta: Vec2<f64>,
+    dv: Vec2<f64>,
+) -> law::FarAngle<f64> {
+    law::FarAngle {
+        gamma,
+        sigma_k,
+        r_k,
+        s_to_apex,
+        stiffness,
+        damping,
+        delta,
+        dv,
     }
 }

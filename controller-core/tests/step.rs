@@ -63,7 +63,7 @@ fn compare<T: Real>(f: &Formation, q0: &[Vec2<f64>], seed: u64) -> (usize, usize
         let owned: Vec<_> = a.owned_estimates().collect();
         for e in owned {
             let value = T::lit(r.random_range(0.05..3.0));
-            assert!(a.set_estimate(e.triangle, e.angle, e.edge, value));
+            assert!(a.set_estimate(&controller_core::OwnedEstimate { value, ..e }));
         }
     }
     let s0 = random_state(q0, &mut r);
@@ -144,7 +144,8 @@ fn compare<T: Real>(f: &Formation, q0: &[Vec2<f64>], seed: u64) -> (usize, usize
                         a.value,
                         want
                     );
-                    assert!(reference.set_estimate(e.triangle, e.angle, e.edge, want));
+                    assert!(reference
+                        .set_estimate(&controller_core::OwnedEstimate { value: want, ..*e }));
                 }
             }
             Err(fault) => {

@@ -157,9 +157,9 @@ impl<'a> Simulation<'a> {
     }
 
     /// Also write `timeseries.csv` and `summary.json` into `dir` (created if needed), and
-    /// the figures and `replay.html` if `plots`, as `host-sim run --out DIR` does.
-    pub fn write_to(mut self, dir: impl Into<PathBuf>, plots: bool) -> Self {
-        self.out = Some((dir.into(), plots));
+    /// what `options` asks for (the figures and `replay.html` with `plots`), as `host-sim run --out DIR` does.
+    pub fn write_to(mut self, dir: impl Into<PathBuf>, options: WriteOptions) -> Self {
+        self.out = Some((dir.into(), options.plots));
         self
     }
 
@@ -187,7 +187,7 @@ impl<'a> Simulation<'a> {
             })?;
         }
         // The estimate layout (for the columns) comes from the agents' own configurations.
-        let estimates = estimate_layout(model).map_err(RunError::Failed)?;
+        let estimates = estimate_layout(model).map_err(RunError::from)?;
         let csv_path = self
             .out
             .as_ref()
@@ -232,6 +232,27 @@ impl<'a> Simulation<'a> {
             run.write_outputs(model, dir, csv_path, *plots)?;
         }
         Ok(run)
+    }
+}
+
+/// What [`Simulation::write_to`] writes besides `summary.json` and `timeseries.csv`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WriteOptions {
+    /// The figures, one PNG each (`docs/outputs.md`), drawn from `timeseries.csv`.
+    pub plots: bool,
+}
+
+impl Default for WriteOptions {
+    /// Everything `host-sim run --out DIR` writes: the figures too.
+    fn default() -> Self {
+        Self { plots: true }
+    }
+}
+
+impl WriteOptions {
+    /// `summary.json` and `timeseries.csv` only (`host-sim run --no-plots`).
+    pub fn without_plots() -> Self {
+        Self { plots: false }
     }
 }
 

@@ -31,7 +31,7 @@
 #![recursion_limit = "256"]
 
 pub use analysis::Outcome;
-pub use api::{load, load_toml, Error, Progress, Run, Simulation};
+pub use api::{load, load_toml, Error, Progress, Run, Simulation, WriteOptions};
 pub use engine::{RunError, RunResult};
 pub use model::Model;
 pub use report::TimeSeries;

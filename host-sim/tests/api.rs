@@ -17,7 +17,7 @@ fn the_series_in_memory_is_the_csv_that_is_written() {
     let m = load("paper", &["duration=2".to_owned()]).expect("paper");
     let dir = tempfile::tempdir().expect("tempdir");
     let run = Simulation::new(&m)
-        .write_to(dir.path(), false)
+        .write_to(dir.path(), host_sim::WriteOptions::without_plots())
         .run()
         .expect("run");
     let series = run.series.as_ref().expect("kept by default");
@@ -81,7 +81,7 @@ fn a_failed_run_is_an_outcome_and_an_unwritable_directory_an_error() {
     let file = dir.path().join("a-file");
     std::fs::write(&file, "").expect("write");
     let e = Simulation::new(&m)
-        .write_to(file.join("sub"), false)
+        .write_to(file.join("sub"), host_sim::WriteOptions::without_plots())
         .run()
         .expect_err("not a directory");
     assert!(matches!(e, Error::Output(_)), "{e:?}");

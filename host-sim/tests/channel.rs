@@ -278,7 +278,7 @@ fn a_channel_run_is_reproducible_bit_for_bit() {
         let out = dir.path().join(format!("run{k}"));
         let r = Simulation::new(&m)
             .keep_series(false)
-            .write_to(&out, false)
+            .write_to(&out, host_sim::WriteOptions::without_plots())
             .run()
             .expect("run");
         assert!(r.result.channel.expect("channel").collided > 0);

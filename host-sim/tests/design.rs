@@ -247,6 +247,7 @@ fn refusals_say_which_points_and_why() {
 }
 
 #[test]
+#[ignore = "slow lane: `cargo xtask test` runs it (phase \"slow tests\")"]
 fn a_hundred_thousand_points() {
     let p = Generator::RandomDisc {
         n: 100_000,
@@ -269,6 +270,7 @@ fn a_hundred_thousand_points() {
 }
 
 #[test]
+#[ignore = "slow lane: `cargo xtask test` runs it (phase \"slow tests\")"]
 fn wire_ids_on_large_lattices_and_strips() {
     let n = 100_000;
     let lattice = Generator::TriangularLattice { n, spacing: 1.0 }

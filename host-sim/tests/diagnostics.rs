@@ -35,6 +35,12 @@ fn reused_equals_fresh(model: &Model) {
 #[test]
 fn a_reused_diagnostics_sums_only_what_it_was_given() {
     reused_equals_fresh(&load("paper", &[]).expect("paper"));
+}
+
+/// The same for a 3,000-agent strip on two threads (its terms are computed on both).
+#[test]
+#[ignore = "slow lane: `cargo xtask test` runs it (phase \"slow tests\")"]
+fn a_reused_diagnostics_sums_only_what_it_was_given_on_two_threads() {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(2)
         .build()

@@ -165,7 +165,7 @@ fn stand_in_run_is_deterministic_and_lock_step() {
         let options = fake(&[2, 3], FakeBehaviour::default(), 10.0);
         let run = Simulation::new(&m)
             .keep_series(false)
-            .write_to(&out, false)
+            .write_to(&out, host_sim::WriteOptions::without_plots())
             .hil(&options)
             .run()
             .expect("run");
@@ -196,7 +196,7 @@ fn stand_in_run_is_deterministic_and_lock_step() {
     // A pure-host summary has no wall-clock figures (same seed, same summary).
     let out = dir.path().join("host");
     Simulation::new(&m)
-        .write_to(&out, false)
+        .write_to(&out, host_sim::WriteOptions::without_plots())
         .run()
         .expect("host run");
     let s: serde_json::Value =

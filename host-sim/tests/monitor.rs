@@ -75,6 +75,7 @@ fn an_estimate_held_at_r_min_for_the_collapse_time_collapses_from_when_it_reache
 /// The same sequence among the estimates of a 3,000-agent strip, on one and on two
 /// threads (the smallest estimate and whether any is held are then found on both).
 #[test]
+#[ignore = "slow lane: `cargo xtask test` runs it (phase \"slow tests\")"]
 fn the_collapse_rule_holds_for_a_large_formation_on_any_number_of_threads() {
     let model = strip_model(3000, 10.0);
     let n = SampledSim::new(&model).expect("sim").estimate_info().len();

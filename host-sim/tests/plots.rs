@@ -101,7 +101,7 @@ fn two_hundred_agents_get_a_colour_bar_not_a_legend_row_each() {
     let m = host_sim::load_toml(&text, "lattice", &[]).expect("load");
     let dir = tempfile::tempdir().expect("tempdir");
     let run = host_sim::Simulation::new(&m)
-        .write_to(dir.path(), true)
+        .write_to(dir.path(), host_sim::WriteOptions::default())
         .run()
         .expect("run");
     assert!(run.plot_error.is_none(), "{:?}", run.plot_error);

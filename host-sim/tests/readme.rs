@@ -49,7 +49,7 @@ fn the_readme_figures_of_the_paper_run_are_true() {
     let dir = tempfile::tempdir().expect("tempdir");
     let run = host_sim::Simulation::new(&model)
         .keep_series(false)
-        .write_to(dir.path(), true)
+        .write_to(dir.path(), host_sim::WriteOptions::default())
         .run()
         .expect("run");
     let r = &run.result;

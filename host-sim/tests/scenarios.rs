@@ -191,7 +191,7 @@ fn same_seed_same_csv_other_seed_other_csv() {
         let out = dir.path().join(format!("run{k}"));
         let run = Simulation::new(&m)
             .keep_series(false)
-            .write_to(&out, false)
+            .write_to(&out, host_sim::WriteOptions::without_plots())
             .run()
             .expect("run");
         let r = &run.result;

@@ -11,10 +11,13 @@
 //!   measured step go (by file and function).
 //! * `cargo xtask cluster-test`: a sweep as a Slurm job array on a one-node cluster
 //!   started here (installs slurm-wlm and munge if missing).
+//! * `cargo xtask bench-counts [--profile dev|release]`: host-sim's instructions and
+//!   last-level misses per agent-step (callgrind) against `host-sim/bench-counts.toml`.
 //! * `cargo xtask stack-frames <elf> [N]`: the largest stack frames of an ELF.
 //! * `cargo xtask qemu-run <elf> [qemu args…]`: the cargo runner of the firmware (QEMU +
 //!   live defmt log).
 
+mod bench_counts;
 mod budgets;
 mod check;
 mod cluster;
@@ -62,6 +65,24 @@ enum Task {
         /// Rows per table.
         #[arg(default_value_t = 25)]
         top: usize,
+    },
+    /// host-sim's instructions and last-level cache misses per agent-step, counted by
+    /// valgrind's callgrind (1,000- and 100,000-agent strips, the paper run), checked
+    /// against host-sim/bench-counts.toml with a 5 % guard; exits 1 on any regression.
+    BenchCounts {
+        /// Build profile of the measured binary: dev (what `cargo test` built; CI) or
+        /// release (the figures of docs/performance.md).
+        #[arg(long, default_value = "dev")]
+        profile: String,
+        /// Budget file.
+        #[arg(long)]
+        budgets: Option<PathBuf>,
+        /// Only measure and print.
+        #[arg(long)]
+        no_check: bool,
+        /// Every case, also the 100,000-agent strip (about 160 s in the dev build).
+        #[arg(long)]
+        all: bool,
     },
     /// The largest stack frames of a thumbv7em ELF (from the `sub sp, #N` of the
     /// function prologues; push/vpush not counted).
@@ -149,6 +170,24 @@ fn main() -> ExitCode {
             })
         }),
         Task::ClusterTest => cluster::run().map(|()| ExitCode::SUCCESS),
+        Task::BenchCounts {
+            profile,
+            budgets,
+            no_check,
+            all,
+        } => bench_counts::run(&bench_counts::Options {
+            profile,
+            budgets: budgets.unwrap_or_else(bench_counts::default_budgets),
+            no_check,
+            all,
+        })
+        .map(|ok| {
+            if ok {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::FAILURE
+            }
+        }),
         Task::Test(a) => a
             .options()
             .and_then(|o| test_cmd::run(&o))

@@ -136,6 +136,36 @@ fn phases(
             )
         },
     )?;
+    phase("slow tests (host-sim, ignored by cargo test)", &mut || {
+        // The 100,000-point design and load, the 3,000-agent runs, the 100 s paper run
+        // pinned to wire v3 (`#[ignore = "slow lane…"]`), out of the fast `cargo test`.
+        tools::run(
+            cargo()
+                .args(["test", "--test", "design", "--test", "design_cli"])
+                .args([
+                    "--test",
+                    "diagnostics",
+                    "--test",
+                    "monitor",
+                    "--test",
+                    "wire_v3",
+                ])
+                .args(["--", "--ignored"]),
+        )
+    })?;
+    phase("bench-counts (host-sim under callgrind)", &mut || {
+        // The dev build `cargo test` made: only the example links (docs/performance.md).
+        let o = crate::bench_counts::Options {
+            profile: "dev".into(),
+            budgets: crate::bench_counts::default_budgets(),
+            no_check: false,
+            all: false,
+        };
+        match crate::bench_counts::run(&o)? {
+            true => Ok(()),
+            false => Err("regressions (listed above)".into()),
+        }
+    })?;
     phase(
         "Slurm job array (cargo xtask cluster-test)",
         &mut crate::cluster::run,

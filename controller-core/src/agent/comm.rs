@@ -3,26 +3,11 @@
 //! layout is [`crate::wire`]'s.
 
 use super::state::{AngleState, Remote, Side};
-use super::Agent;
-use crate::config::AgentId;
+use super::{finite_vec, pick, Agent};
+use crate::config::{AgentId, EstimatorMode};
 use crate::wire::auth::{self, Counter};
 use crate::wire::{check_mode, quant, CrcCheck, FrameError, Integrity, RawAngle};
 use crate::{law, Real, Vec2};
-
-/// A broadcast item at full precision (the wire rounds the angle's values to binary16).
-#[derive(Clone, Copy, Debug)]
-enum Item<T: Real> {
-    /// The sender's velocity.
-    Velocity(Vec2<T>),
-    /// An angle `(sender; far[0], far[1])`: `γ`, `σ` and the distances `ρ` (see
-    /// [`crate::wire`]).
-    Angle {
-        far: [AgentId; 2],
-        gamma: T,
-        sigma: T,
-        rho: [T; 2],
-    },
-}
 
 /// `auth`: an agent whose broadcasts fill every frame (no room for the counter
 /// extension) adds a sync frame (velocity and counter extension, no items) to the first
@@ -245,65 +230,63 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             // finite.
             let v = |c: u16| T::of_f32(quant::from_code(c));
             let [g, s, r0, r1] = codes;
-            if far[0] == me {
-                self.apply_angle(slot, far[1], v(g), v(s), v(r0));
-            } else if far[1] == me {
-                self.apply_angle(slot, far[0], v(g), v(s), v(r1));
+            if let Some((k, other)) = far_role(far, me) {
+                self.apply_angle(slot, other, v(g), v(s), v(pick(&[r0, r1], k)));
             }
         }
         Ok(())
     }
 
     /// Takes a neighbour's broadcast directly, without the wire (no rounding, no sequence
-    /// numbers): for in-process simulation and tests.
+    /// numbers): for in-process simulation and tests. The broadcast passes the checks
+    /// [`Agent::receive`] applies to a frame's values before anything is applied: a
+    /// finite velocity, and for every angle sent, distinct far vertices
+    /// ([`FrameError::Malformed`]), a finite `γ` and `σ` and distances that are finite,
+    /// positive and (with estimators) at least `r_min` ([`FrameError::InvalidValue`]).
+    /// (`|σ| ≤ 1` is not checked: the wire rounds `σ` into it, a direct value may exceed
+    /// it by a rounding.)
     pub fn receive_direct(&mut self, from: &Self) -> Result<(), FrameError> {
         let sender = from.id();
         let slot = self.slot(sender).ok_or(FrameError::UnknownSender(sender))?;
+        self.check_direct(from)?;
         if let Some(n) = self.neighbours.get_mut(slot) {
             n.age = T::zero();
+            n.velocity = from.velocity;
         }
         self.oldest = None;
-        self.apply(slot, Item::Velocity(from.velocity));
+        let me = self.config.id;
         for a in from.angles.iter().flatten() {
-            if let Some((gamma, sigma, rho)) = sent_angle(a) {
-                let far = a.far;
-                self.apply(
-                    slot,
-                    Item::Angle {
-                        far,
-                        gamma,
-                        sigma,
-                        rho,
-                    },
-                );
+            if let (Some((gamma, sigma, rho)), Some((k, other))) =
+                (sent_angle(a), far_role(a.far, me))
+            {
+                self.apply_angle(slot, other, gamma, sigma, pick(&rho, k));
             }
         }
         Ok(())
     }
 
-    /// Stores one item from the neighbour in `slot`: its velocity, or the effort of an
-    /// angle `(sender; far[0], far[1])` of which this agent is a far vertex.
-    fn apply(&mut self, slot: usize, item: Item<T>) {
-        match item {
-            Item::Velocity(v) => {
-                if let Some(n) = self.neighbours.get_mut(slot) {
-                    n.velocity = v;
+    /// The value checks of [`Agent::receive_direct`] (those of `FrameView::validate` on
+    /// full-precision values).
+    fn check_direct(&self, from: &Self) -> Result<(), FrameError> {
+        if !finite_vec(&from.velocity) {
+            return Err(FrameError::InvalidValue);
+        }
+        let r_min = match self.config.estimator {
+            EstimatorMode::Measured => T::zero(),
+            EstimatorMode::Shared | EstimatorMode::PerAgent => self.config.min_estimate,
+        };
+        let distance = |r: T| r.finite() && r > T::zero() && r >= r_min;
+        for a in from.angles.iter().flatten() {
+            if let Some((gamma, sigma, rho)) = sent_angle(a) {
+                if a.far[0] == a.far[1] {
+                    return Err(FrameError::Malformed);
                 }
-            }
-            Item::Angle {
-                far,
-                gamma,
-                sigma,
-                rho,
-            } => {
-                let me = self.config.id;
-                if far[0] == me {
-                    self.apply_angle(slot, far[1], gamma, sigma, rho[0]);
-                } else if far[1] == me {
-                    self.apply_angle(slot, far[0], gamma, sigma, rho[1]);
+                if !(gamma.finite() && sigma.finite() && distance(rho[0]) && distance(rho[1])) {
+                    return Err(FrameError::InvalidValue);
                 }
             }
         }
+        Ok(())
     }
 
     /// Stores what the apex in neighbour `slot` sent of its angle `(apex; me, other)`:
@@ -340,6 +323,20 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     }
 }
 
+/// Which far vertex of an angle `(sender; far[0], far[1])` the agent `me` is, and the
+/// other one: `(k, far[1 − k])`; `None` if it is neither. The one place where a received
+/// angle is matched to its receiver, for [`Agent::receive`] and [`Agent::receive_direct`].
+#[inline]
+fn far_role(far: [AgentId; 2], me: AgentId) -> Option<(usize, AgentId)> {
+    if far[0] == me {
+        Some((0, far[1]))
+    } else if far[1] == me {
+        Some((1, far[0]))
+    } else {
+        None
+    }
+}
+
 /// The binary16 code `c` with its magnitude limited to 1: `σ = s_nv × s_nw` of
 /// bearings that are unit only within the tolerance can exceed 1 by a rounding, which
 /// receivers refuse (`|σ| ≤ 1`, see [`crate::wire`]). Found by the fuzz target.
@@ -370,8 +367,23 @@ mod tests {
     use super::unit_code;
     use crate::agent::test_support::one_triangle;
     use crate::wire::auth::{self, Counter};
-    use crate::wire::{Integrity, SwarmKey};
-    use crate::Agent;
+    use crate::wire::{FrameError, Integrity, SwarmKey};
+    use crate::{Agent, Vec2};
+
+    /// `receive_direct` refuses what `receive` refuses, before applying anything: a
+    /// non-finite velocity (it took any broadcast as it was).
+    #[test]
+    fn receive_direct_applies_the_value_checks_of_receive() {
+        let mut me = Agent::<f64, 1, 2>::new(one_triangle(2, [1, 2], 0.5)).unwrap();
+        let mut from = Agent::<f64, 1, 2>::new(one_triangle(1, [1, 2], 0.5)).unwrap();
+        from.velocity = Vec2::new(1.0, 2.0);
+        assert_eq!(me.receive_direct(&from), Ok(()));
+        let slot = me.slot(1).unwrap();
+        assert_eq!(me.neighbours[slot].velocity, Vec2::new(1.0, 2.0));
+        from.velocity = Vec2::new(f64::NAN, 0.0);
+        assert_eq!(me.receive_direct(&from), Err(FrameError::InvalidValue));
+        assert_eq!(me.neighbours[slot].velocity, Vec2::new(1.0, 2.0));
+    }
 
     /// An `auth` agent `id` in the triangle (1, 2, 3).
     fn auth_agent(id: u8) -> Agent<f32, 1, 2> {

@@ -6,7 +6,8 @@ use super::estimates::owns;
 use super::sensing::sense_angle;
 use super::state::{AngleState, ApexPart, Neighbour, Remote, Side};
 use super::{
-    finite_vec, pick, vec2, within, Agent, Evaluation, Fault, Measurements, Status, StepOutput,
+    finite_vec, pick, vec2, within, Agent, Evaluation, Fault, LawOutput, Measurements, Status,
+    StepOutput,
 };
 use crate::config::{EstimatorMode, LeaderRole};
 use crate::{geometry, law, Real, Vec2};
@@ -18,7 +19,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// that integrate the estimators themselves (continuous time) call [`Agent::sense`],
     /// exchange, then this.
     pub fn evaluate(&mut self) -> Result<Evaluation<T, MT>, Fault> {
-        let (force, degenerate) = self.law_pass()?;
+        let LawOutput { force, degenerate } = self.law_pass()?;
         let r_min = self.config.min_estimate;
         // S10, continuous form: no negative flow at r_min (zero for estimates not owned).
         let projected = |a: &AngleState<T>| {
@@ -71,10 +72,10 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// The output for a law result: the force saturated to `max_force`, or on a fault the
     /// safe command `U = −safe_damping · v` (zero if `v` is not finite), saturated too.
     /// (What [`Agent::step`] returns; for simulators that call [`Agent::evaluate`].)
-    pub fn output(&self, law: Result<(Vec2<T>, bool), Fault>, velocity: &Vec2<T>) -> StepOutput<T> {
+    pub fn output(&self, law: Result<LawOutput<T>, Fault>, velocity: &Vec2<T>) -> StepOutput<T> {
         let limits = &self.config.limits;
         let (force, status, degenerate) = match law {
-            Ok((force, degenerate)) => (force, Status::Nominal, degenerate),
+            Ok(LawOutput { force, degenerate }) => (force, Status::Nominal, degenerate),
             Err(fault) => {
                 let v = if finite_vec(velocity) {
                     *velocity
@@ -133,7 +134,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// unsaturated force and whether a current angle (of which this agent is the apex) is
     /// degenerate. The first fault in angle order wins (after staleness).
     #[inline]
-    fn law_pass(&mut self) -> Result<(Vec2<T>, bool), Fault> {
+    fn law_pass(&mut self) -> Result<LawOutput<T>, Fault> {
         self.check_fresh()?;
         let cx = self.law_context(None);
         let mut sum = LawSum::new(self.velocity_force());
@@ -152,7 +153,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// law finds, as `sense` then the law would. `done`: the angles whose estimates were
     /// integrated (to roll back after a fault).
     #[inline]
-    fn sense_and_law(&mut self, dt: T, done: &mut usize) -> Result<(Vec2<T>, bool), Fault> {
+    fn sense_and_law(&mut self, dt: T, done: &mut usize) -> Result<LawOutput<T>, Fault> {
         let mut fault = self.check_fresh().err();
         let cx = self.law_context(Some(dt));
         let mut sum = LawSum::new(self.velocity_force());
@@ -205,7 +206,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
 
     /// The end of the law after the angles: S11, the finiteness of the force, degeneracy.
     #[inline(always)]
-    fn finish_law(&self, sum: LawSum<T>) -> Result<(Vec2<T>, bool), Fault> {
+    fn finish_law(&self, sum: LawSum<T>) -> Result<LawOutput<T>, Fault> {
         let c = &self.config;
         let v = self.velocity;
         let mut force = sum.force;
@@ -227,7 +228,10 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         if !finite_vec(&force) {
             return Err(Fault::NonFinite);
         }
-        Ok((force, sum.y_max > c.limits.margin_cos))
+        Ok(LawOutput {
+            force,
+            degenerate: sum.y_max > c.limits.margin_cos,
+        })
     }
 }
 
@@ -347,16 +351,16 @@ fn far_law<T: Real, const MT: usize>(
     let delta = (v - v_apex) * age;
     let dv = v - remote.v_ref;
     // S6–S8 on this far vertex.
-    let (gamma_k, g_k, f) = law::far_angle(
-        remote.gamma,
-        remote.sigma,
-        r,
-        &s_ku,
-        a.stiffness,
-        a.damping,
-        &delta,
-        &dv,
-    );
+    let (gamma_k, g_k, f) = law::far_angle(&law::FarAngle {
+        gamma: remote.gamma,
+        sigma_k: remote.sigma,
+        r_k: r,
+        s_to_apex: s_ku,
+        stiffness: a.stiffness,
+        damping: a.damping,
+        delta,
+        dv,
+    });
     sum.force += f;
     if cx.mode == EstimatorMode::PerAgent {
         // S9 on the own copy r̂^k (SPEC §6): ṙ_uk = s_ukᵀ(v_k − v_u) with s_uk = −s_ku

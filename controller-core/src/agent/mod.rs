@@ -27,8 +27,8 @@ mod test_support;
 mod types;
 
 pub use types::{
-    BearingMeasurement, Evaluation, Fault, MeasurementError, Measurements, OwnedEstimate, Status,
-    StepOutput,
+    BearingMeasurement, Evaluation, Fault, LawOutput, MeasurementError, Measurements,
+    OwnedEstimate, Status, StepOutput,
 };
 
 use crate::config::{AgentConfig, AgentId};

@@ -153,6 +153,15 @@ impl<T: Real> defmt::Format for StepOutput<T> {
     }
 }
 
+/// What the control law gives before saturation ([`crate::Agent::output`]'s input).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LawOutput<T: Real> {
+    /// `U_n` before saturation.
+    pub force: Vec2<T>,
+    /// A current angle is within the configured margin of 0 or π.
+    pub degenerate: bool,
+}
+
 /// The control law evaluated without changing any state (see [`crate::Agent::evaluate`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Evaluation<T: Real, const MT: usize> {

@@ -3,6 +3,7 @@
 //! from what the agents measured.
 
 use super::min_distance::MinDistance;
+use crate::model::geometry::interior_angle;
 use crate::model::{EstimateInfo, Model, TriangleModel};
 use controller_core::{energy, Vec2};
 use rayon::prelude::*;
@@ -286,9 +287,9 @@ struct AngleTerms<'a> {
 }
 
 impl AngleTerms<'_> {
-    /// Each angle's error `α − α*` into `errs` and energy `½ c ỹ²` (S13) into `energies`,
-    /// model order. `parallel`: on every thread of the current rayon pool (the angles are
-    /// independent).
+    /// Each angle's error `α − α*` (the model's one [`interior_angle`]) into `errs` and
+    /// energy `½ c ỹ²` (S13) into `energies`, model order. `parallel`: on every thread of
+    /// the current rayon pool (the angles are independent).
     fn evaluate(&self, q: &[Vec2<f64>], errs: &mut [f64], energies: &mut [f64], parallel: bool) {
         type Out<'a> = (&'a mut [f64], (&'a mut [f64], &'a [f64]));
         let angles = |(tri, (err, (en, cos_desired))): (&TriangleModel, Out<'_>)| {
@@ -298,7 +299,8 @@ impl AngleTerms<'_> {
                 let sw = unit(q[a.far[1]] - q[a.apex]);
                 let y = su.dot(&sw);
                 *en = energy::angle(a.stiffness, y - cos_desired);
-                *err = y.clamp(-1.0, 1.0).acos() - a.desired;
+                let p = |v: usize| [q[v].x, q[v].y];
+                *err = interior_angle(p(a.apex), p(a.far[0]), p(a.far[1])) - a.desired;
             }
         };
         if parallel {

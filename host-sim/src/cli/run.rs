@@ -82,7 +82,12 @@ pub(super) fn run_command(args: &RunArgs, quiet: bool) -> u8 {
     let mut progress = Progress::new(quiet, model.duration);
     let mut sim = Simulation::new(&model)
         .keep_series(false)
-        .write_to(&out, !args.no_plots)
+        .write_to(
+            &out,
+            crate::api::WriteOptions {
+                plots: !args.no_plots,
+            },
+        )
         .csv(!args.summary_only)
         .progress(&mut progress);
     if let Some(n) = args.jobs {
@@ -127,6 +132,7 @@ pub(super) fn run_command(args: &RunArgs, quiet: bool) -> u8 {
 
 /// Checks the `--hil` arguments (agent ids, timeout, firmware ELF, QEMU) before anything
 /// is written.
+#[allow(irrefutable_let_patterns)] // QEMU is the only launcher without `fake-target`.
 fn hil_options(args: &RunArgs, model: &Model, out: &Path) -> Result<HilOptions, hil::HilError> {
     hil::agent_indices(model, &args.hil)?;
     let opts = HilOptions::qemu(

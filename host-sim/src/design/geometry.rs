@@ -1,38 +1,14 @@
-//! Plane geometry of the construction: interior angles, orientation, and the overlap tests
-//! of triangles (separating axes) and points.
+//! Plane geometry of the construction: interior angles, orientation (the model's one
+//! implementation of each, [`crate::model::geometry`]), and the overlap tests of
+//! triangles (separating axes) and points.
 
 use super::points::Point;
-
-/// `b − a`.
-#[inline]
-pub(crate) fn sub(b: Point, a: Point) -> Point {
-    [b[0] - a[0], b[1] - a[1]]
-}
+pub(crate) use crate::model::geometry::{cross, interior_angle as angle_at, sub};
 
 /// `|b − a|`.
 #[inline]
 pub(crate) fn dist(a: Point, b: Point) -> f64 {
     (b[0] - a[0]).hypot(b[1] - a[1])
-}
-
-/// Twice the signed area of `o, a, b` (> 0 counter-clockwise).
-#[inline]
-pub(crate) fn cross(o: Point, a: Point, b: Point) -> f64 {
-    let u = sub(a, o);
-    let w = sub(b, o);
-    u[0] * w[1] - u[1] * w[0]
-}
-
-/// The interior angle at `p` between the rays to `a` and `b` (rad, in `[0, π]`);
-/// `atan2(|u × w|, u · w)` keeps its precision near 0 and π. This is the angle whose
-/// cosine S4 controls.
-#[inline]
-pub(crate) fn angle_at(p: Point, a: Point, b: Point) -> f64 {
-    let u = sub(a, p);
-    let w = sub(b, p);
-    (u[0] * w[1] - u[1] * w[0])
-        .abs()
-        .atan2(u[0] * w[0] + u[1] * w[1])
 }
 
 /// The three interior angles of a triangle, at `t[0]`, `t[1]`, `t[2]`.

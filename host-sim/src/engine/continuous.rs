@@ -7,6 +7,7 @@
 //! `receive_direct`, then `evaluate` every agent for its force and estimate rates.
 
 use super::driver::Engine;
+use super::error::SetupError;
 use super::plant::acceleration;
 use super::sensors::{quiet_bearing, Sight};
 use super::slot_order::SlotOrder;
@@ -14,7 +15,9 @@ use super::stats::{ControlStats, FrameCounts};
 use crate::model::{
     resolve_estimates, BearingRate, CoreAgent, EstimateInfo, Estimator, Model, SensorModel,
 };
-use controller_core::{law, BearingMeasurement, Fault, Measurements, Status, Vec2};
+use controller_core::{
+    law, BearingMeasurement, Fault, LawOutput, Measurements, OwnedEstimate, StepOutput, Vec2,
+};
 
 /// `(&mut v[i], &v[j])` for `i ≠ j`.
 fn pair_mut<T>(v: &mut [T], i: usize, j: usize) -> Option<(&mut T, &T)> {
@@ -55,7 +58,14 @@ impl Rhs {
         let vel = |i: usize| Vec2::new(y[4 * i + 2], y[4 * i + 3]);
         for (e, info) in self.info.iter().enumerate() {
             if let Some(a) = self.agents.get_mut(info.owner) {
-                a.set_estimate(info.local_triangle, info.angle, info.edge, y[4 * n + e]);
+                a.set_estimate(&OwnedEstimate {
+                    triangle: info.local_triangle,
+                    angle: info.angle,
+                    edge: info.edge,
+                    apex: 0,
+                    far: 0,
+                    value: y[4 * n + e],
+                });
             }
         }
         let ranged = model.estimator == Estimator::Measured;
@@ -92,49 +102,61 @@ impl Rhs {
                 }
             }
         }
-        let limit = model.limits.max_force;
         for i in 0..n {
             let vi = vel(i);
             let a = &model.agents[i];
-            let result = match self.sense_fault[i] {
-                Some(f) => Err(f),
-                None => self.agents[i].evaluate(),
-            };
-            let (force, status, saturated, degenerate) = match result {
-                Ok(ev) => {
-                    for e in self.est_start[i]..self.est_start[i + 1] {
-                        let info = &self.info[e];
-                        dy[4 * n + e] = ev
-                            .estimate_rates
-                            .get(info.local_triangle)
-                            .map_or(0.0, |r| r[info.angle][info.edge]);
-                    }
-                    let (f, sat) = law::saturate(&ev.force, limit);
-                    (f, Status::Nominal, sat, ev.degenerate)
-                }
-                Err(fault) => {
-                    for e in self.est_start[i]..self.est_start[i + 1] {
-                        dy[4 * n + e] = 0.0;
-                    }
-                    let (f, sat) = law::saturate(&(vi * -model.limits.safe_damping), limit);
-                    (f, Status::Safe(fault), sat, false)
-                }
-            };
+            let rates = &mut dy[4 * n + self.est_start[i]..4 * n + self.est_start[i + 1]];
+            let out = self.output(i, &vi, rates);
             // Counted per stage evaluation; t > 0 makes every safe output count.
             self.stats.record(
                 t.max(f64::MIN_POSITIVE),
                 i,
-                status,
-                saturated,
-                degenerate,
-                force.norm(),
+                out.status,
+                out.saturated,
+                out.degenerate,
+                out.force.norm(),
             );
+            let force = out.force;
             let acc = acceleration(&vi, &force, a.mass, &a.friction);
             dy[4 * i] = vi.x;
             dy[4 * i + 1] = vi.y;
             dy[4 * i + 2] = acc.x;
             dy[4 * i + 3] = acc.y;
         }
+    }
+}
+
+impl Rhs {
+    /// Agent `i`'s output at this stage, from its sensing and `evaluate`, through the
+    /// core's own [`Agent::output`](controller_core::Agent::output) (saturation, and on a
+    /// fault the safe command, zero for a non-finite velocity `v`), and the rates of its
+    /// owned estimates into `rates` (zero on a fault: the estimates hold still).
+    fn output(&mut self, i: usize, v: &Vec2<f64>, rates: &mut [f64]) -> StepOutput<f64> {
+        let result = match self.sense_fault[i] {
+            Some(f) => Err(f),
+            None => self.agents[i].evaluate(),
+        };
+        let first = self.est_start[i];
+        let law = match result {
+            Ok(ev) => {
+                for (k, rate) in rates.iter_mut().enumerate() {
+                    let info = &self.info[first + k];
+                    *rate = ev
+                        .estimate_rates
+                        .get(info.local_triangle)
+                        .map_or(0.0, |r| r[info.angle][info.edge]);
+                }
+                Ok(LawOutput {
+                    force: ev.force,
+                    degenerate: ev.degenerate,
+                })
+            }
+            Err(fault) => {
+                rates.fill(0.0);
+                Err(fault)
+            }
+        };
+        self.agents[i].output(law, v)
     }
 }
 
@@ -152,7 +174,7 @@ pub struct ContinuousSim<'m> {
 
 impl<'m> ContinuousSim<'m> {
     /// Builds the cores and the initial ODE state.
-    pub fn new(model: &'m Model) -> Result<Self, String> {
+    pub fn new(model: &'m Model) -> Result<Self, SetupError> {
         let n = model.n();
         let mut agents = Vec::with_capacity(n);
         let mut info = Vec::new();
@@ -204,6 +226,21 @@ impl<'m> ContinuousSim<'m> {
         Ok(sim)
     }
 
+    /// Agent `i`'s output at time `t` on the current state, as the first RK4 stage
+    /// computes it (every agent sensed and exchanged; counted in the control statistics
+    /// like a stage): `None` beyond the last agent. For tests and diagnostics.
+    pub fn output_of(&mut self, t: f64, i: usize) -> Option<StepOutput<f64>> {
+        let n = self.q.len();
+        if i >= n {
+            return None;
+        }
+        let [k1, ..] = &mut self.k;
+        self.rhs.eval(self.model, t, &self.y, k1);
+        let v = Vec2::new(self.y[4 * i + 2], self.y[4 * i + 3]);
+        let mut rates = vec![0.0; self.rhs.est_start[i + 1] - self.rhs.est_start[i]];
+        Some(self.rhs.output(i, &v, &mut rates))
+    }
+
     fn unpack(&mut self) {
         let n = self.q.len();
         for i in 0..n {
@@ -238,12 +275,10 @@ impl Engine for ContinuousSim<'_> {
         for (i, yi) in self.y.iter_mut().enumerate() {
             *yi += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
         }
-        // S10: the projection keeps every estimate at or above r_min.
+        // S10: the projection keeps every estimate at or above r_min (the core's floor).
         let n4 = 4 * self.q.len();
         for r in self.y.iter_mut().skip(n4) {
-            if *r < model.min_estimate {
-                *r = model.min_estimate;
-            }
+            *r = law::estimate_floor(*r, model.min_estimate);
         }
         self.unpack();
     }

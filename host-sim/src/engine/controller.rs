@@ -9,7 +9,7 @@
 
 use crate::engine::hil::{HilError, LinkStats};
 use crate::engine::radio::RadioFrame;
-use crate::model::{Model, MT, NB};
+use crate::model::{Model, ModelError, MT, NB};
 use controller_core::{Agent, FrameStats, Measurements, OwnedEstimate, StepOutput};
 
 /// The frames an agent takes in at one tick, in arrival order: what the radio delivered
@@ -166,7 +166,7 @@ pub const LOCAL_CAPACITIES: [(usize, usize); 4] = [(2, 4), (3, 6), (6, 8), (MT, 
 /// Agent `i`'s in-process controller in the smallest of [`LOCAL_CAPACITIES`] that holds
 /// its triangles and neighbours. Every capacity runs the same code on the same data, so
 /// the choice never changes a result (`tests/scaling.rs`).
-pub fn local_core(model: &Model, i: usize) -> Result<Box<dyn AgentController>, String> {
+pub fn local_core(model: &Model, i: usize) -> Result<Box<dyn AgentController>, ModelError> {
     let triangles = model.triangles_of(i).count();
     // One arm per capacity (const generics need literal indices); a refusal (more
     // neighbours than the class holds) moves on to the next class.

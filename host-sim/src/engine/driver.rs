@@ -12,7 +12,7 @@ use super::result::RunResult;
 use super::sampled::SampledSim;
 use super::stats::{ControlStats, FrameCounts};
 use crate::analysis::{Diagnostics, Monitor};
-use crate::model::{EstimateInfo, Mode, Model};
+use crate::model::{geometry, EstimateInfo, Mode, Model};
 use controller_core::Vec2;
 use std::time::Instant;
 
@@ -62,10 +62,10 @@ fn next_instant(k: usize, spt: usize, log_every: usize, total: usize) -> usize {
     after(spt).min(after(log_every)).min(total)
 }
 
+/// Twice the signed area of triangle `t` in `q` ([`geometry::cross`]).
 fn signed_area(q: &[Vec2<f64>], t: [usize; 3]) -> f64 {
-    let a = q[t[1]] - q[t[0]];
-    let b = q[t[2]] - q[t[0]];
-    a.x * b.y - a.y * b.x
+    let p = |v: usize| [q[v].x, q[v].y];
+    geometry::cross(p(t[0]), p(t[1]), p(t[2]))
 }
 
 /// Runs `model` in its mode, logging rows to `recorder` and reporting the simulated time
@@ -150,15 +150,13 @@ pub fn drive(
             diag.evaluate(model, t, q, v, est);
             let stop = monitor.observe(model, &diag, est);
             if (log || stop) && rows {
-                recorder
-                    .record(&Row {
-                        snap: &diag.snap,
-                        q,
-                        v,
-                        estimates: est,
-                        frames,
-                    })
-                    .map_err(|e| format!("cannot write the time series: {e}"))?;
+                recorder.record(&Row {
+                    snap: &diag.snap,
+                    q,
+                    v,
+                    estimates: est,
+                    frames,
+                })?;
             }
             if stop {
                 break;
@@ -178,9 +176,7 @@ pub fn drive(
         }
         k = next;
     }
-    recorder
-        .finish()
-        .map_err(|e| format!("cannot write the time series: {e}"))?;
+    recorder.finish()?;
     progress(diag.snap.t);
     let (q, v, est) = engine.view();
     let (outcome, reason) = monitor.verdict(model, &diag.snap, q);

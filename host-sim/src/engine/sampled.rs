@@ -11,43 +11,33 @@
 //! the result does not depend on the number of threads.
 
 mod parallel;
+mod tick;
 
 use super::attack::{AttackCounts, Attacks};
 use super::channel::ChannelStats;
 use super::controller::{local_core, AgentController, Inbox};
 use super::driver::Engine;
+use super::error::SetupError;
 use super::hil::{HilError, LinkStats};
-use super::huge_pages::Regions;
 use super::plant::Plant;
-use super::prefetch::{self, Footprint};
 use super::radio::{Radio, RadioFrame};
 use super::sensors::{offset_with, quiet_bearing, velocity_with, Sensors, Sight};
 use super::slot_order::SlotOrder;
-use super::stats::{add_frame_stats, ControlStats, FrameCounts};
+use super::speed::prefetch::{self, Footprint};
+use super::speed::{CHUNK, PARALLEL_MIN_AGENTS};
+use super::stats::{ControlStats, FrameCounts, FrameReasons};
 use crate::model::graph::Adjacency;
 use crate::model::{resolve_estimates, BearingRate, EstimateInfo, Estimator, Model};
-use controller_core::{BearingMeasurement, FrameStats, Measurements, StepOutput, Vec2};
-
-/// Runs of at least this many agents compute ticks and plant steps on every thread of the
-/// current rayon pool (below it the fork-join costs more than it saves).
-pub const PARALLEL_MIN_AGENTS: usize = 2048;
-/// Agents per parallel work item.
-const CHUNK: usize = 256;
+use controller_core::{BearingMeasurement, StepOutput, Vec2, MAX_NEIGHBOURS};
+use tick::{AgentSlots, Walk};
 
 /// Whether every frame of a tick arrives, unchanged and in sender order, at the next tick:
-/// no loss, duplication, corruption, reordering, jitter, bandwidth limit or shared channel,
-/// a latency under half a control period, and no attacker.
+/// nothing in the radio alters frames ([`RadioModel::departures`](crate::model::RadioModel::departures),
+/// the one classification of its fields), a latency under half a control period, and no
+/// attacker.
 pub fn direct_radio(model: &Model) -> bool {
-    let r = &model.radio;
-    r.loss == 0.0
-        && r.duplication == 0.0
-        && r.corruption == 0.0
-        && (r.reordering == 0.0 || r.reorder_delay == 0.0)
-        && r.jitter == 0.0
-        && r.bandwidth == 0.0
-        && r.channel.is_none()
-        && r.latency < 0.5 * model.control_period()
-        && model.attacks.is_empty()
+    let d = model.radio.departures();
+    !d.alters_frames && d.latency < 0.5 * model.control_period() && model.attacks.is_empty()
 }
 
 /// The sampled-data simulator.
@@ -70,7 +60,6 @@ pub struct SampledSim<'m> {
     outputs: Vec<Option<StepOutput<f64>>>,
     error: Option<HilError>,
     forces: Vec<Vec2<f64>>,
-    bearings: Vec<BearingMeasurement<f64>>,
     /// Each agent's bearings go to its core in slot order ([`SlotOrder`]).
     slot_order: SlotOrder,
     estimates: Vec<f64>,
@@ -100,7 +89,7 @@ const FRAMES_PER_TICK: usize = controller_core::StandardAgent::<f64>::MAX_FRAMES
 impl<'m> SampledSim<'m> {
     /// A sampled simulation with a [`LocalCore`](super::LocalCore) for every agent, each
     /// in the smallest capacity that holds it ([`local_core`]).
-    pub fn new(model: &'m Model) -> Result<Self, String> {
+    pub fn new(model: &'m Model) -> Result<Self, SetupError> {
         let mut controllers: Vec<Box<dyn AgentController>> = Vec::with_capacity(model.n());
         for i in 0..model.n() {
             controllers.push(local_core(model, i)?);
@@ -114,20 +103,31 @@ impl<'m> SampledSim<'m> {
     pub fn with_controllers(
         model: &'m Model,
         controllers: Vec<Box<dyn AgentController>>,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, SetupError> {
         let n = model.n();
         if controllers.len() != n {
-            return Err(format!("{} controllers for {n} agents", controllers.len()));
+            return Err(SetupError::ControllerCount {
+                controllers: controllers.len(),
+                agents: n,
+            });
+        }
+        // An agent's tick holds one bearing per triangle neighbour ([`Walk::start`]).
+        let degree = model.graph.triangle.max_degree();
+        if degree > MAX_NEIGHBOURS {
+            return Err(SetupError::TooManyNeighbours {
+                degree,
+                max: MAX_NEIGHBOURS,
+            });
         }
         let mut info = Vec::new();
         let mut est_start = Vec::with_capacity(n + 1);
         for (i, c) in controllers.iter().enumerate() {
             if c.id() != model.agents[i].id {
-                return Err(format!(
-                    "controller {i} has id {}, expected {}",
-                    c.id(),
-                    model.agents[i].id
-                ));
+                return Err(SetupError::ControllerId {
+                    index: i,
+                    id: c.id(),
+                    expected: model.agents[i].id,
+                });
             }
             est_start.push(info.len());
             info.extend(resolve_estimates(model, i, &c.estimate_layout())?);
@@ -157,7 +157,7 @@ impl<'m> SampledSim<'m> {
         let slot_order = SlotOrder::for_model(model, |i| controllers[i].neighbour_order());
         let mut radio = Radio::new(&model.radio, n, model.seed, capacity);
         radio.attach_channel(&model.graph.radio, period);
-        let sim = Self {
+        Ok(Self {
             model,
             footprints: controllers.iter().map(|c| Footprint::of(&**c)).collect(),
             controllers,
@@ -175,7 +175,6 @@ impl<'m> SampledSim<'m> {
             outputs: vec![None; n],
             error: None,
             forces: vec![Vec2::zeros(); n],
-            bearings: Vec::with_capacity(model.graph.triangle.max_degree()),
             slot_order,
             estimates: vec![model.initial_estimate; info.len()],
             est_start,
@@ -187,23 +186,7 @@ impl<'m> SampledSim<'m> {
             stats: ControlStats::default(),
             direct,
             local: false,
-        };
-        sim.huge_pages();
-        Ok(sim)
-    }
-
-    /// Backs the per-agent memory every tick walks (controllers, frame buffers) with huge
-    /// pages where the system allows it ([`huge_pages`](super::huge_pages)): a hint, no
-    /// value changes.
-    fn huge_pages(&self) {
-        let mut regions = Regions::new();
-        for c in &self.controllers {
-            regions.add(&**c);
-        }
-        for b in self.outboxes.iter().chain(&self.sent).chain(&self.inboxes) {
-            regions.add_buffer(b);
-        }
-        regions.collapse();
+        })
     }
 
     /// Runs `ticks` control periods (control, then `steps_per_tick` RK4 steps) without
@@ -277,34 +260,40 @@ impl SampledSim<'_> {
         }
     }
 
-    /// Every agent measured and its tick started, in agent order.
+    /// Every agent's tick started ([`Walk::start`]), in agent order.
     fn tick_sequential(&mut self, t: f64, dt: f64, tick: u64) -> Result<(), HilError> {
         let mut delivered = 0;
         let model = self.model;
-        // Field by field: the scene reads the state while the loop writes the mailboxes.
-        let scene = Scene::of(model, &self.plant, &self.senses, tick);
-        for i in 0..model.n() {
-            prefetch_agent(&self.footprints, &self.sent, i + prefetch::AHEAD);
-            self.bearings.clear();
-            let (velocity, partner_offset) = scene.measure(i, |b| self.bearings.push(b));
-            self.slot_order.apply(i, &mut self.bearings);
-            let m = Measurements {
-                time: t,
-                dt,
-                velocity,
-                bearings: &self.bearings,
-                partner_offset,
+        // Field by field: the walk reads the state while the loop writes the agents' parts.
+        let walk = Walk {
+            t,
+            dt,
+            scene: Scene::of(model, &self.plant, &self.senses, tick),
+            radio: &model.graph.radio,
+            slot_order: &self.slot_order,
+            sent: &self.sent,
+            footprints: &self.footprints,
+            copy_estimates: self.viewed,
+        };
+        let each = self
+            .controllers
+            .iter_mut()
+            .zip(&mut self.inboxes)
+            .zip(&mut self.outboxes)
+            .zip(&mut self.forces)
+            .zip(&mut self.outputs);
+        for (i, ((((controller, inbox), outbox), force), output)) in each.enumerate() {
+            let (a, b) = (self.est_start[i], self.est_start[i + 1]);
+            let mut slots = AgentSlots {
+                controller,
+                inbox,
+                outbox,
+                force,
+                estimates: &mut self.estimates[a..b],
             };
-            self.outboxes[i].clear();
-            let inbox = Self::inbox(&self.inboxes[i], &self.sent, &model.graph.radio, i);
-            delivered += inbox.len() as u64;
-            self.outputs[i] = self.controllers[i].start_tick(inbox, &m, &mut self.outboxes[i])?;
-            if self.viewed && self.outputs[i].is_some() {
-                // Done: its estimates while its state is in cache.
-                let c = &*self.controllers[i];
-                Self::read_estimates_of(c, &mut self.estimates, &self.est_start, i);
-            }
-            self.inboxes[i].clear();
+            let (out, frames) = walk.start(i, &mut slots)?;
+            delivered += frames;
+            *output = out;
         }
         self.count_direct(delivered);
         Ok(())
@@ -468,13 +457,13 @@ impl Engine for SampledSim<'_> {
             delivered: r.delivered,
             accepted: 0,
             rejected: 0,
-            by_reason: FrameStats::default(),
+            by_reason: FrameReasons::default(),
         };
         for ctl in &self.controllers {
             let s = ctl.frame_stats();
             c.accepted += u64::from(s.accepted);
             c.rejected += u64::from(s.rejected());
-            add_frame_stats(&mut c.by_reason, &s);
+            c.by_reason.add(&s);
         }
         c
     }

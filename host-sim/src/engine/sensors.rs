@@ -96,12 +96,10 @@ impl Sensors {
     /// zero (`with_range`: ranges are measured). When none does, every measurement is
     /// a function of the state alone ([`quiet_bearing`], [`velocity_with`],
     /// [`offset_with`] with zero noise give what the drawing methods give, bit for bit).
+    /// ([`SensorModel::departures`], the one classification of the sensors' fields.)
     pub fn draws(&self, with_range: bool) -> bool {
-        let m = &self.model;
-        m.bearing_noise > 0.0
-            || (with_range && m.range_noise > 0.0)
-            || m.velocity_noise > 0.0
-            || m.offset_noise > 0.0
+        let d = self.model.departures();
+        d.noise || (with_range && d.range_noise)
     }
 }
 

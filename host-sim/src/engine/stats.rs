@@ -30,37 +30,69 @@ pub struct FrameCounts {
     /// Delivered copies the receivers' cores rejected (CRC, stale sequence, …).
     pub rejected: u64,
     /// The receivers' cores' counters, summed: accepted and rejected by reason.
-    pub by_reason: FrameStats,
+    pub by_reason: FrameReasons,
 }
 
-/// Adds the counters of `b` to `a` (saturating, as the core counts).
-pub fn add_frame_stats(a: &mut FrameStats, b: &FrameStats) {
-    let FrameStats {
-        accepted,
-        bad_length,
-        bad_crc,
-        unknown_version,
-        mode_mismatch,
-        malformed,
-        unknown_sender,
-        stale,
-        invalid_value,
-        bad_tag,
-        replayed,
-        unsynced,
-    } = *b;
-    a.accepted = a.accepted.saturating_add(accepted);
-    a.bad_length = a.bad_length.saturating_add(bad_length);
-    a.bad_crc = a.bad_crc.saturating_add(bad_crc);
-    a.unknown_version = a.unknown_version.saturating_add(unknown_version);
-    a.mode_mismatch = a.mode_mismatch.saturating_add(mode_mismatch);
-    a.malformed = a.malformed.saturating_add(malformed);
-    a.unknown_sender = a.unknown_sender.saturating_add(unknown_sender);
-    a.stale = a.stale.saturating_add(stale);
-    a.invalid_value = a.invalid_value.saturating_add(invalid_value);
-    a.bad_tag = a.bad_tag.saturating_add(bad_tag);
-    a.replayed = a.replayed.saturating_add(replayed);
-    a.unsynced = a.unsynced.saturating_add(unsynced);
+/// The receivers' cores' frame counters summed over the agents, in `u64` (each core
+/// counts its own in `u32`, [`FrameStats`]; a sum over 100,000 agents would saturate).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FrameReasons {
+    /// Frames accepted.
+    pub accepted: u64,
+    /// Rejected: wrong length.
+    pub bad_length: u64,
+    /// Rejected: CRC mismatch.
+    pub bad_crc: u64,
+    /// Rejected: unknown wire version.
+    pub unknown_version: u64,
+    /// Rejected: another integrity or estimator mode.
+    pub mode_mismatch: u64,
+    /// Rejected: malformed body.
+    pub malformed: u64,
+    /// Rejected: a sender that is not a neighbour.
+    pub unknown_sender: u64,
+    /// Rejected: a stale sequence number.
+    pub stale: u64,
+    /// Rejected: a value out of range.
+    pub invalid_value: u64,
+    /// Rejected (`auth`): a wrong tag.
+    pub bad_tag: u64,
+    /// Rejected (`auth`): a replayed counter.
+    pub replayed: u64,
+    /// Rejected (`auth`): no counter known yet.
+    pub unsynced: u64,
+}
+
+impl FrameReasons {
+    /// Adds one core's counters.
+    pub fn add(&mut self, b: &FrameStats) {
+        let FrameStats {
+            accepted,
+            bad_length,
+            bad_crc,
+            unknown_version,
+            mode_mismatch,
+            malformed,
+            unknown_sender,
+            stale,
+            invalid_value,
+            bad_tag,
+            replayed,
+            unsynced,
+        } = *b;
+        self.accepted += u64::from(accepted);
+        self.bad_length += u64::from(bad_length);
+        self.bad_crc += u64::from(bad_crc);
+        self.unknown_version += u64::from(unknown_version);
+        self.mode_mismatch += u64::from(mode_mismatch);
+        self.malformed += u64::from(malformed);
+        self.unknown_sender += u64::from(unknown_sender);
+        self.stale += u64::from(stale);
+        self.invalid_value += u64::from(invalid_value);
+        self.bad_tag += u64::from(bad_tag);
+        self.replayed += u64::from(replayed);
+        self.unsynced += u64::from(unsynced);
+    }
 }
 
 /// What the controllers did over a run.

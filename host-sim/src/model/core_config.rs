@@ -1,7 +1,7 @@
 //! From the model to `controller-core`: each agent's `AgentConfig` and core agent
 //! (the host simulates `Agent<f64, MT, NB>`).
 
-use super::{AngleModel, Estimator, Model};
+use super::{AngleModel, Estimator, Model, ModelError};
 use controller_core::{
     AgentConfig, AngleConfig, BearingFilter, EstimatorMode, LeaderConfig, LeaderRole, Limits, Schedule,
     ScheduleStep, TrackerConfig, TriangleConfig,
@@ -27,17 +27,17 @@ impl Model {
     }
 
     /// Agent `i`'s controller-core configuration. Fails only beyond the capacity `MT`.
-    pub fn agent_config(&self, i: usize) -> Result<AgentConfig<f64, MT>, String> {
+    pub fn agent_config(&self, i: usize) -> Result<AgentConfig<f64, MT>, ModelError> {
         self.agent_config_in::<MT>(i)
     }
 
     /// Agent `i`'s controller-core configuration with triangle capacity `M`. Fails when
     /// the agent belongs to more than `M` triangles, naming the agent.
-    pub fn agent_config_in<const M: usize>(&self, i: usize) -> Result<AgentConfig<f64, M>, String> {
-        let a = self
-            .agents
-            .get(i)
-            .ok_or_else(|| format!("no agent index {i}"))?;
+    pub fn agent_config_in<const M: usize>(
+        &self,
+        i: usize,
+    ) -> Result<AgentConfig<f64, M>, ModelError> {
+        let a = self.agents.get(i).ok_or(ModelError::NoAgent(i))?;
         let mut c = AgentConfig::new(a.id);
         for k in self.triangles_of(i) {
             let t = &self.triangles[k];
@@ -52,12 +52,12 @@ impl Model {
                 vertices: t.vertices.map(|v| self.agents[v].id),
                 angles: [ang(&t.angles[0]), ang(&t.angles[1])],
             };
-            c.triangles.push(tc).map_err(|_| {
-                format!(
-                    "agent {} belongs to more than {M} triangles (controller capacity)",
-                    a.name
-                )
-            })?;
+            c.triangles
+                .push(tc)
+                .map_err(|_| ModelError::TooManyTriangles {
+                    agent: a.name.clone(),
+                    capacity: M,
+                })?;
         }
         c.estimator = self.estimator_mode();
         c.initial_estimate = self.initial_estimate;
@@ -68,8 +68,8 @@ impl Model {
         c.limits = self.limits;
         c.bearing_filter = self.sensors.bearing_filter;
         c.integrity = self.integrity.core(&self.auth_key);
-        c.comm_every = u16::try_from(self.comm_every)
-            .map_err(|_| format!("comm_every = {} exceeds 65535", self.comm_every))?;
+        c.comm_every =
+            u16::try_from(self.comm_every).map_err(|_| ModelError::CommEvery(self.comm_every))?;
         c.comm_phase = u16::try_from(self.comm_phase(i)).unwrap_or(0);
         if let Some(l) = &self.leader {
             let role = if l.a == i {
@@ -97,7 +97,7 @@ impl Model {
     pub fn agent_config_f32<const M: usize>(
         &self,
         i: usize,
-    ) -> Result<AgentConfig<f32, M>, String> {
+    ) -> Result<AgentConfig<f32, M>, ModelError> {
         let c = self.agent_config(i)?;
         let f = |x: f64| x as f32;
         let mut t = AgentConfig::<f32, M>::new(c.id);
@@ -114,12 +114,10 @@ impl Model {
                     vertices: tri.vertices,
                     angles: [ang(&tri.angles[0]), ang(&tri.angles[1])],
                 })
-                .map_err(|_| {
-                    format!(
-                        "agent {} belongs to {} triangles; an f32 agent of this build holds at most {M}",
-                        c.id,
-                        c.triangles.len()
-                    )
+                .map_err(|_| ModelError::TooManyTrianglesF32 {
+                    id: c.id,
+                    triangles: c.triangles.len(),
+                    capacity: M,
                 })?;
         }
         t.estimator = c.estimator;
@@ -158,7 +156,7 @@ impl Model {
     }
 
     /// Builds agent `i`'s controller-core agent.
-    pub fn core_agent(&self, i: usize) -> Result<CoreAgent, String> {
+    pub fn core_agent(&self, i: usize) -> Result<CoreAgent, ModelError> {
         self.core_agent_in::<MT, NB>(i)
     }
 
@@ -168,10 +166,9 @@ impl Model {
     pub fn core_agent_in<const M: usize, const N: usize>(
         &self,
         i: usize,
-    ) -> Result<controller_core::Agent<f64, M, N>, String> {
+    ) -> Result<controller_core::Agent<f64, M, N>, ModelError> {
         let c = self.agent_config_in::<M>(i)?;
-        controller_core::Agent::new(c)
-            .map_err(|e| format!("controller-core refused agent index {i}: {e:?}"))
+        controller_core::Agent::new(c).map_err(|error| ModelError::CoreRefused { index: i, error })
     }
 }
 

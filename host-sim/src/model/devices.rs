@@ -39,15 +39,44 @@ impl SensorModel {
         }
     }
 
+    /// How these sensors depart from ideal ones: the one classification of their fields,
+    /// from which [`Self::is_noisy`] and the simulator's shortcut (sensors that draw
+    /// nothing from the random streams) follow. It destructures every field, so a new
+    /// field does not compile until it is classified here.
+    pub fn departures(&self) -> SensorDepartures {
+        let Self {
+            bearing_noise,
+            bearing_bias,
+            bearing_rate: _, // how rates are measured, exact or not: no noise or bias
+            velocity_noise,
+            velocity_bias,
+            offset_noise,
+            range_noise,
+        } = self;
+        SensorDepartures {
+            noise: *bearing_noise != 0.0 || *velocity_noise != 0.0 || *offset_noise != 0.0,
+            range_noise: *range_noise != 0.0,
+            bias: *bearing_bias != 0.0 || *velocity_bias != [0.0; 2],
+        }
+    }
+
     /// Whether any noise or bias is configured.
     pub fn is_noisy(&self) -> bool {
-        self.bearing_noise != 0.0
-            || self.bearing_bias != 0.0
-            || self.velocity_noise != 0.0
-            || self.velocity_bias != [0.0; 2]
-            || self.offset_noise != 0.0
-            || self.range_noise != 0.0
+        let d = self.departures();
+        d.noise || d.range_noise || d.bias
     }
+}
+
+/// How a [`SensorModel`] departs from ideal sensors ([`SensorModel::departures`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SensorDepartures {
+    /// Noise on what every agent measures (bearings, velocity, the leader's offset): each
+    /// measurement draws from its agent's random stream.
+    pub noise: bool,
+    /// Noise on ranges, which only the `measured` estimator measures.
+    pub range_noise: bool,
+    /// A bias (bearing rotation or velocity offset): a function of the state, no draw.
+    pub bias: bool,
 }
 
 /// The radio link model, in SI units.
@@ -92,15 +121,52 @@ impl RadioModel {
         }
     }
 
+    /// How this radio departs from the ideal one: the one classification of its fields,
+    /// from which [`Self::is_faulty`] and the simulator's direct delivery
+    /// (`engine::direct_radio`) follow. It destructures every field, so a new field (a new
+    /// fault, by the recipe of `docs/architecture.md`) does not compile until it is
+    /// classified here.
+    pub fn departures(&self) -> RadioDepartures {
+        let Self {
+            latency,
+            jitter,
+            loss,
+            duplication,
+            reordering,
+            reorder_delay: _, // a reordered copy's delay bound: it acts only with `reordering`
+            corruption,
+            bandwidth,
+            queue_limit: _, // the queue's longest wait: it acts only with a `bandwidth`
+            channel,
+        } = self;
+        RadioDepartures {
+            latency: *latency,
+            // Each of these draws from the radio's stream or holds frames in its queue
+            // (a reordering draws and counts even with no delay).
+            alters_frames: *loss != 0.0
+                || *duplication != 0.0
+                || *corruption != 0.0
+                || *reordering != 0.0
+                || *jitter != 0.0
+                || *bandwidth != 0.0
+                || channel.is_some(),
+        }
+    }
+
     /// Whether any fault or delay is configured.
     pub fn is_faulty(&self) -> bool {
-        self.latency != 0.0
-            || self.jitter != 0.0
-            || self.loss != 0.0
-            || self.duplication != 0.0
-            || self.reordering != 0.0
-            || self.corruption != 0.0
-            || self.bandwidth != 0.0
-            || self.channel.is_some()
+        let d = self.departures();
+        d.alters_frames || d.latency != 0.0
     }
+}
+
+/// How a [`RadioModel`] departs from the ideal radio ([`RadioModel::departures`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RadioDepartures {
+    /// The fixed latency (s): it delays every frame alike, so frames still arrive
+    /// unchanged and in order (at the next tick while it is under half a period).
+    pub latency: f64,
+    /// Something changes which frames arrive, when, or in which order: loss,
+    /// duplication, corruption, reordering, jitter, a bandwidth limit, a shared channel.
+    pub alters_frames: bool,
 }

@@ -2,7 +2,7 @@
 //! owned estimates by `(triangle, angle, edge)` of their own configuration; here they
 //! are resolved to agent indices (for the diagnostics, the CSV columns and the summary).
 
-use super::Model;
+use super::{Model, ModelError};
 use controller_core::OwnedEstimate;
 
 /// Where one owned estimate belongs (by agent index).
@@ -31,27 +31,28 @@ pub fn resolve_estimates(
     model: &Model,
     owner: usize,
     owned: &[OwnedEstimate<f64>],
-) -> Result<Vec<EstimateInfo>, String> {
+) -> Result<Vec<EstimateInfo>, ModelError> {
     let tris: Vec<usize> = model.triangles_of(owner).collect();
     owned
         .iter()
         .map(|e| {
             let k = *tris
                 .get(e.triangle)
-                .ok_or_else(|| format!("estimate of unknown triangle {}", e.triangle))?;
+                .ok_or(ModelError::UnknownTriangle(e.triangle))?;
             let a = model.triangles[k]
                 .angles
                 .get(e.angle)
-                .ok_or_else(|| format!("estimate of unknown angle {}", e.angle))?;
+                .ok_or(ModelError::UnknownAngle(e.angle))?;
             let (far, other) = match e.edge {
                 0 => (a.far[0], a.far[1]),
                 _ => (a.far[1], a.far[0]),
             };
             if model.agents[far].id != e.far || model.agents[a.apex].id != e.apex {
-                return Err(format!(
-                    "estimate layout mismatch for agent index {owner}: core says apex {} far {}",
-                    e.apex, e.far
-                ));
+                return Err(ModelError::LayoutMismatch {
+                    owner,
+                    apex: e.apex,
+                    far: e.far,
+                });
             }
             Ok(EstimateInfo {
                 owner,
@@ -69,7 +70,7 @@ pub fn resolve_estimates(
 
 /// Every agent's owned estimates, in agent order, as the agents' own configurations lay
 /// them out (the layout of the CSV columns and of `summary.json`).
-pub fn estimate_layout(model: &Model) -> Result<Vec<EstimateInfo>, String> {
+pub fn estimate_layout(model: &Model) -> Result<Vec<EstimateInfo>, ModelError> {
     let mut layout = Vec::new();
     for i in 0..model.n() {
         let a = model.core_agent(i)?;

@@ -9,7 +9,7 @@
 //! `z ↦ a·conj(z)` has `a = Σ z_i·w_i / Σ|z_i|²`; the one with the smaller residual
 //! `Σ|w|² − |Σ…|² / Σ|z|²` wins.
 
-use super::target::cross;
+use super::geometry::cross;
 use thiserror::Error;
 
 /// A position `[x, y]` (m).

@@ -3,6 +3,7 @@
 //! angles).
 
 use super::formation::TriangleModel;
+use super::geometry::{cross, sub};
 
 /// The target shape of a formation.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -11,16 +12,6 @@ pub struct Target {
     pub positions: Vec<[f64; 2]>,
     /// Given by the scenario's `[target]` (`false`: built by [`target_from_angles`]).
     pub from_file: bool,
-}
-
-fn sub(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
-    [a[0] - b[0], a[1] - b[1]]
-}
-
-/// `(b − a) × (c − a)`: positive when `a, b, c` turn counter-clockwise.
-pub fn cross(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
-    let (u, w) = (sub(b, a), sub(c, a));
-    u[0] * w[1] - u[1] * w[0]
 }
 
 /// The shape the desired angles encode (SPEC §3: a triangulated Laman graph fixes the

@@ -2,13 +2,13 @@
 //! with `[[attacks]]`, so that other runs' outputs do not change): what each attacker
 //! did, and why the agents rejected frames.
 
+use crate::engine::FrameReasons;
 use crate::engine::RunResult;
 use crate::model::{AttackKind, Model};
-use controller_core::FrameStats;
 use serde_json::{json, Map, Value};
 
 /// The receivers' rejections by reason.
-fn rejections(s: &FrameStats) -> Value {
+fn rejections(s: &FrameReasons) -> Value {
     json!({
         "bad_length": s.bad_length,
         "bad_crc": s.bad_crc,

@@ -5,7 +5,8 @@
 
 use super::plan::Perturb;
 use crate::design::{
-    initial_positions, Construction, ControlledAngle, DesignTriangle, Figures, Perturbation, Scale,
+    initial_positions, Construction, ControlledAngle, DesignError, DesignTriangle, Figures,
+    Perturbation, Scale,
 };
 use crate::model::Model;
 
@@ -23,17 +24,17 @@ pub struct Shape {
 
 /// The interior angle at `p` of the triangle `p, a, b` (degrees).
 fn angle_deg(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let u = [a[0] - p[0], a[1] - p[1]];
-    let w = [b[0] - p[0], b[1] - p[1]];
-    (u[0] * w[1] - u[1] * w[0])
-        .abs()
-        .atan2(u[0] * w[0] + u[1] * w[1])
-        .to_degrees()
+    crate::model::geometry::interior_angle(p, a, b).to_degrees()
 }
 
 /// Perturbed initial positions for `model` (its triangles, angle margin and collision
 /// distance), at `fraction` of the reference's size, from `seed`.
-pub fn positions(model: &Model, p: &Perturb, fraction: f64, seed: u64) -> Result<Shape, String> {
+pub fn positions(
+    model: &Model,
+    p: &Perturb,
+    fraction: f64,
+    seed: u64,
+) -> Result<Shape, DesignError> {
     let reference: Vec<[f64; 2]> = match &p.shape {
         Some(s) => s.clone(),
         None => model.agents.iter().map(|a| a.position).collect(),
@@ -87,8 +88,7 @@ pub fn positions(model: &Model, p: &Perturb, fraction: f64, seed: u64) -> Result
         },
         margin_deg,
         model.criteria.collision_distance,
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     Ok(Shape {
         positions: init.positions,
         rotation: init.rotation,

@@ -311,7 +311,7 @@ fn check_perturbation(
         shape: p.shape.clone(),
     };
     super::perturb::positions(model, &out, 0.0, 0)
-        .map_err(|reason| SweepError::new(INVALID, file, "perturbation.shape", reason))?;
+        .map_err(|e| SweepError::new(INVALID, file, "perturbation.shape", e.to_string()))?;
     Ok(out)
 }
 

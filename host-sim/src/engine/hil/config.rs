@@ -16,7 +16,9 @@ pub fn target_config(model: &Model, i: usize) -> Result<AgentConfig<f32, TARGET_
         agent: name.to_owned(),
         reason,
     };
-    let t = model.agent_config_f32::<TARGET_MT>(i).map_err(refused)?;
+    let t = model
+        .agent_config_f32::<TARGET_MT>(i)
+        .map_err(|e| refused(e.to_string()))?;
     Agent::<f32, TARGET_MT, TARGET_NB>::new(t.clone()).map_err(|e| {
         refused(format!(
             "{e} (the firmware's agent holds {TARGET_MT} triangles and {TARGET_NB} neighbours)"

@@ -16,6 +16,8 @@
 mod config;
 pub mod controller;
 mod error;
+#[cfg(feature = "fake-target")]
+#[doc(hidden)]
 pub mod fake;
 mod options;
 mod stats;
@@ -94,6 +96,7 @@ fn launch(
             })?;
             (s, TargetHandle::Qemu(p))
         }
+        #[cfg(feature = "fake-target")]
         Launcher::Fake(b) => {
             let h = fake::spawn(port, *b);
             let s = qemu::accept_until(&listener, deadline, || Ok(()))
@@ -117,9 +120,9 @@ type TargetOrder = (
 
 /// [`TargetOrder`] of agent `i`.
 fn target_order(model: &Model, i: usize) -> Result<TargetOrder, String> {
-    let core = model.core_agent(i)?;
+    let core = model.core_agent(i).map_err(|e| e.to_string())?;
     let layout: Vec<_> = core.owned_estimates().collect();
-    let infos = resolve_estimates(model, i, &layout)?;
+    let infos = resolve_estimates(model, i, &layout).map_err(|e| e.to_string())?;
     let slots = layout
         .iter()
         .zip(&infos)
@@ -150,6 +153,7 @@ pub fn controllers(
         Launcher::Qemu {
             program, firmware, ..
         } => Some(preflight(program, firmware)?),
+        #[cfg(feature = "fake-target")]
         Launcher::Fake(_) => None,
     };
     let startup = opts.timeout.max(Duration::from_secs_f64(STARTUP_TIMEOUT_S));
@@ -205,9 +209,9 @@ pub fn controllers(
                 Some(c) => out.push(Box::new(c)),
                 None => return Err(HilError::Usage(format!("agent index {i} twice"))),
             },
-            None => out.push(local_core(model, i).map_err(|reason| HilError::Refused {
+            None => out.push(local_core(model, i).map_err(|e| HilError::Refused {
                 agent: model.agents[i].name.clone(),
-                reason,
+                reason: e.to_string(),
             })?),
         }
     }
@@ -224,7 +228,7 @@ pub fn run(
     progress: &mut dyn FnMut(f64),
 ) -> Result<RunResult, RunError> {
     let ctl = controllers(model, opts)?;
-    let mut engine = SampledSim::with_controllers(model, ctl).map_err(RunError::Failed)?;
+    let mut engine = SampledSim::with_controllers(model, ctl)?;
     let mut result = drive(model, &mut engine, recorder, progress, Vec::new())?;
     engine.finish_controllers()?;
     result.hil = engine.link_stats();

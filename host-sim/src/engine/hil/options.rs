@@ -2,6 +2,7 @@
 //! made before anything starts: agent ids against the scenario, the firmware ELF, QEMU.
 
 use super::error::HilError;
+#[cfg(feature = "fake-target")]
 use super::fake::FakeBehaviour;
 use super::qemu;
 use crate::model::{Mode, Model};
@@ -49,7 +50,9 @@ pub enum Launcher {
         /// Where `qemu-agent-<id>.log` go.
         log_dir: PathBuf,
     },
-    /// The host-side stand-in (tests).
+    /// The host-side stand-in (host-sim's tests, feature `fake-target`; not public API).
+    #[cfg(feature = "fake-target")]
+    #[doc(hidden)]
     Fake(FakeBehaviour),
 }
 

@@ -6,13 +6,13 @@
 //! estimates for the diagnostics while its state is in cache (a separate pass over
 //! 100,000 agents' states costs a second walk through memory).
 
-use super::{prefetch_agent, SampledSim, Scene, CHUNK};
+use super::tick::{AgentSlots, Walk};
+use super::{SampledSim, Scene};
 use crate::engine::controller::AgentController;
-use crate::engine::prefetch;
 use crate::engine::radio::RadioFrame;
+use crate::engine::speed::CHUNK;
 use crate::engine::stats::ControlStats;
-use crate::model::graph::Adjacency;
-use controller_core::{BearingMeasurement, Measurements, Vec2, MAX_NEIGHBOURS};
+use controller_core::Vec2;
 
 /// What the parallel walk of a tick sums over the agents (in agent order).
 #[derive(Clone, Copy, Debug, Default)]
@@ -35,29 +35,6 @@ impl TickSums {
         self.stats.merge(&later.stats);
         self
     }
-}
-
-/// What an agent's tick reads of the others (shared by every thread).
-struct Walk<'a> {
-    t: f64,
-    dt: f64,
-    /// The state and sensors, with this tick's index.
-    scene: Scene<'a>,
-    radio: &'a Adjacency,
-    slot_order: &'a crate::engine::slot_order::SlotOrder,
-    sent: &'a [Vec<RadioFrame>],
-    footprints: &'a [crate::engine::prefetch::Footprint],
-    /// Each agent copies its estimates after its tick ([`SampledSim`]'s `viewed`).
-    copy_estimates: bool,
-}
-
-/// One agent's part of a tick: its controller, mailboxes, force and estimates.
-struct AgentSlots<'s> {
-    controller: &'s mut Box<dyn AgentController>,
-    inbox: &'s mut Vec<RadioFrame>,
-    outbox: &'s mut Vec<RadioFrame>,
-    force: &'s mut Vec2<f64>,
-    estimates: &'s mut [f64],
 }
 
 /// The agents `first..first + controllers.len()` with their parts of the simulator's
@@ -107,34 +84,13 @@ impl<'s> Agents<'s> {
 }
 
 impl Walk<'_> {
-    /// Agent `i`'s tick: its measurements ([`Scene::measure`], the bearings in its core's
-    /// slot order), its controller's tick, its force; returns its counters.
-    fn agent(&self, i: usize, a: AgentSlots<'_>) -> TickSums {
-        // Within a work item, the agents ahead are this thread's next ones.
-        prefetch_agent(self.footprints, self.sent, i + prefetch::AHEAD);
-        // A local core holds every triangle neighbour in at most MAX_NEIGHBOURS slots: the
-        // buffer holds every bearing.
-        let mut bearings: heapless::Vec<BearingMeasurement<f64>, MAX_NEIGHBOURS> =
-            heapless::Vec::new();
-        let (velocity, partner_offset) = self.scene.measure(i, |b| {
-            let _ = bearings.push(b);
-        });
-        self.slot_order.apply(i, &mut bearings);
-        let m = Measurements {
-            time: self.t,
-            dt: self.dt,
-            velocity,
-            bearings: &bearings,
-            partner_offset,
+    /// Agent `i`'s tick ([`Walk::start`]), its force, and its counters.
+    fn agent(&self, i: usize, mut a: AgentSlots<'_>) -> TickSums {
+        // Only in-process controllers take this walk (`SampledSim::parallel`): their tick
+        // completes at once and never fails.
+        let Ok((Some(out), delivered)) = self.start(i, &mut a) else {
+            return TickSums::default();
         };
-        a.outbox.clear();
-        let frames = SampledSim::inbox(a.inbox, self.sent, self.radio, i);
-        let delivered = frames.len() as u64;
-        let out = a.controller.tick(frames, &m, a.outbox);
-        if self.copy_estimates {
-            a.controller.read_estimates(a.estimates);
-        }
-        a.inbox.clear();
         *a.force = out.force;
         let mut sums = TickSums {
             delivered,

@@ -112,16 +112,12 @@ pub(super) fn whole_steps(interval: f64, dt: f64) -> Option<usize> {
     }
 }
 
-/// Interior angle at `p` of the triangle `p, a, b` (rad); NaN for coincident points.
+/// Interior angle at `p` of the triangle `p, a, b` (rad, the model's
+/// [`interior_angle`](crate::model::geometry::interior_angle)); NaN when `a` or `b`
+/// coincides with `p` (which the checks name as such).
 pub(super) fn interior_angle(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let u = [a[0] - p[0], a[1] - p[1]];
-    let w = [b[0] - p[0], b[1] - p[1]];
-    let nu = u[0].hypot(u[1]);
-    let nw = w[0].hypot(w[1]);
-    if nu == 0.0 || nw == 0.0 {
+    if a == p || b == p {
         return f64::NAN;
     }
-    ((u[0] * w[0] + u[1] * w[1]) / (nu * nw))
-        .clamp(-1.0, 1.0)
-        .acos()
+    crate::model::geometry::interior_angle(p, a, b)
 }

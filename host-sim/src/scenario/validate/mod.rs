@@ -143,7 +143,7 @@ fn check(
                 InvalidValue,
                 file,
                 &format!("agents[{i}]"),
-                e,
+                e.to_string(),
             ));
         }
     }

@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 pub enum TargetHandle {
     /// `qemu-system-arm` with the firmware (killed on drop).
     Qemu(QemuProcess),
-    /// The host-side stand-in of [`crate::engine::hil::fake`].
+    /// The host-side stand-in of `engine::hil::fake` (tests).
     Fake(Option<JoinHandle<Result<(), String>>>),
 }
 
