@@ -52,8 +52,8 @@ pub use agent::{
     OwnedEstimate, Status, StepOutput,
 };
 pub use config::{
-    AgentConfig, AgentId, AngleConfig, BearingFilter, ConfigError, EstimatorMode, Integrity, LeaderConfig,
-    LeaderRole, Limits, Schedule, ScheduleStep, TrackerConfig, TriangleConfig,
+    AgentConfig, AgentId, AngleConfig, BearingFilter, ConfigError, EstimatorMode, Integrity,
+    LeaderConfig, LeaderRole, Limits, Schedule, ScheduleStep, TrackerConfig, TriangleConfig,
     MAX_SCHEDULE_STEPS,
 };
 pub use scalar::Real;

@@ -17,19 +17,16 @@ use crate::config::TrackerConfig;
 use crate::geometry::perp;
 use crate::{Real, Vec2};
 
-/// One neighbour's track (S15–S17).
+/// One neighbour's track (S15–S17), besides its bearing `ŝ`, which the agent keeps as
+/// the neighbour's bearing (the caller passes it to [`Track::update`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Track<T: Real> {
-    /// `ŝ`, the smoothed unit bearing.
-    pub s: Vec2<T>,
     /// `ρ̂ ≥ 0`, the inverse distance (1/m).
     pub rho: T,
     /// Covariance of `(δθ, δρ)`: `[p00, p01, p11]`.
     pub p: [T; 3],
     /// Measurements in a row that failed the gate (S16).
     pub rejected: u8,
-    /// The track has been started by a first bearing.
-    pub live: bool,
 }
 
 /// What the tracker needs besides its configuration: the agent-wide constants.
@@ -45,31 +42,32 @@ pub struct TrackLimits<T: Real> {
 const MAX_REJECTED: u8 = 3;
 
 impl<T: Real> Track<T> {
-    /// Takes bearing `z` (unit) measured `dt` seconds after the previous one; `moved` is
-    /// the relative velocity `v_w − v_u` over that interval (as known at its start) and
-    /// `dv` the one now. Returns `(ŝ, ṡ̂)` (S15–S17). A first bearing,
-    /// a non-positive or non-finite `dt`, a bearing more than 90° from the prediction, or
-    /// [`MAX_REJECTED`] gated-out bearings in a row (re)start the track at `z` with zero
-    /// covariance cross term.
+    /// Takes bearing `z` (unit) measured `dt` seconds after the previous one, which gave
+    /// `s` (`ŝ`, updated in place); `moved` is the relative velocity `v_w − v_u` over that
+    /// interval (as known at its start) and `dv` the one now. Returns `ṡ̂` (S15–S17). A
+    /// non-positive or non-finite `dt` (the first bearing: the agent passes `−∞`), a
+    /// bearing more than 90° from the prediction, or three gated-out bearings in a row
+    /// (re)start the track at `z` with zero covariance cross term.
     pub fn update(
         &mut self,
+        s: &mut Vec2<T>,
         z: &Vec2<T>,
         moved: &Vec2<T>,
         dv: &Vec2<T>,
         dt: T,
         c: &TrackerConfig<T>,
         lim: &TrackLimits<T>,
-    ) -> (Vec2<T>, Vec2<T>) {
+    ) -> Vec2<T> {
         let r = c.bearing_noise * c.bearing_noise;
-        if !(self.live && dt > T::zero() && dt.finite()) {
-            self.start(z, r, lim);
-            return (self.s, rate(&self.s, self.rho, dv));
+        if !(dt > T::zero() && dt.finite()) {
+            self.start(s, z, r, lim);
+            return rate(s, self.rho, dv);
         }
         // S15: prediction along the bearing kinematics (S2, S3) with ρ̂ for 1/r.
-        let t = perp(&self.s);
-        let (a, b) = (t.dot(moved), self.s.dot(moved));
+        let t = perp(s);
+        let (a, b) = (t.dot(moved), s.dot(moved));
         let delta = dt * self.rho * a;
-        let s_pred = unit(&(self.s + t * delta));
+        let s_pred = unit(&(*s + t * delta));
         let rho_pred = clamp(self.rho - dt * self.rho * self.rho * b, lim.rho_max);
         let f01 = dt * a;
         let f11 = T::one() - T::lit(2.0) * dt * self.rho * b;
@@ -82,42 +80,43 @@ impl<T: Real> Track<T> {
         let tp = perp(&s_pred);
         let (e, along) = (tp.dot(z), s_pred.dot(z));
         if along <= T::zero() {
-            self.start(z, r, lim);
-            return (self.s, rate(&self.s, self.rho, dv));
+            self.start(s, z, r, lim);
+            return rate(s, self.rho, dv);
         }
         let sv = p00 + r;
         let gate = c.gate * c.gate * sv;
-        if !(e * e <= gate) {
+        // False for a NaN innovation as for an outlier.
+        let inside = e * e <= gate;
+        if !inside {
             // An outlier (or a NaN): predict only.
             self.rejected = self.rejected.saturating_add(1);
             if self.rejected >= MAX_REJECTED {
-                self.start(z, r, lim);
+                self.start(s, z, r, lim);
             } else {
-                self.s = s_pred;
+                *s = s_pred;
                 self.rho = rho_pred;
                 self.p = [p00, p01, p11];
             }
-            return (self.s, rate(&self.s, self.rho, dv));
+            return rate(s, self.rho, dv);
         }
         self.rejected = 0;
         let (k0, k1) = (p00 / sv, p01 / sv);
-        self.s = unit(&(s_pred + tp * (k0 * e)));
+        *s = unit(&(s_pred + tp * (k0 * e)));
         self.rho = clamp(rho_pred + k1 * e, lim.rho_max);
         let one_k0 = T::one() - k0;
         self.p = [one_k0 * p00, one_k0 * p01, p11 - k1 * p01];
-        (self.s, rate(&self.s, self.rho, dv))
+        rate(s, self.rho, dv)
     }
 
     /// (Re)starts the track at bearing `z` with `ρ̂(0)`: variance `R` on the angle, `ρ̂(0)²`
     /// (100 %) on the inverse distance.
-    fn start(&mut self, z: &Vec2<T>, r: T, lim: &TrackLimits<T>) {
+    fn start(&mut self, s: &mut Vec2<T>, z: &Vec2<T>, r: T, lim: &TrackLimits<T>) {
         let rho = clamp(lim.rho_initial, lim.rho_max);
+        *s = *z;
         *self = Self {
-            s: *z,
             rho,
             p: [r, T::zero(), rho * rho],
             rejected: 0,
-            live: true,
         };
     }
 }

@@ -80,6 +80,7 @@ fn run(
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let c = config(sigma.max(1e-3));
     let mut tr = Track::default();
+    let mut sh = Vec2::zeros();
     let mut prev = None;
     let steps = (t_end / DT).round() as usize;
     for k in 0..=steps {
@@ -87,7 +88,9 @@ fn run(
         let (s, _) = scene.truth(t);
         let z = rotate(&s, sigma * normal(&mut rng));
         let moved = scene.velocity((t - DT).max(0.0));
-        let (sh, rh) = tr.update(&z, &moved, &scene.velocity(t), DT, &c, &LIMITS);
+        // The first bearing has no previous one: an interval of −∞, as the agent passes.
+        let dt = if k == 0 { f64::NEG_INFINITY } else { DT };
+        let rh = tr.update(&mut sh, &z, &moved, &scene.velocity(t), dt, &c, &LIMITS);
         if let Some(zp) = prev {
             each(t, sh, rh, z, zp);
         }
@@ -144,7 +147,10 @@ fn noisy_bearings_unbiased_and_far_less_noisy_than_the_finite_difference() {
     let (s_rms, raw) = ((s_sq / n).sqrt(), (raw_sq / n).sqrt());
     // The finite difference: about √2 σ / Δt ≈ 4.9 rad/s of noise on a 0.1 rad/s rate.
     assert!(fd > 3.0, "finite difference RMS {fd}");
-    assert!(tr < fd / 100.0, "tracker RMS {tr} vs finite difference {fd}");
+    assert!(
+        tr < fd / 100.0,
+        "tracker RMS {tr} vs finite difference {fd}"
+    );
     assert!(s_rms < raw / 3.0, "bearing RMS {s_rms} vs raw {raw}");
     // Unbiased: the mean rate error is small against the rate (≈ 0.1 rad/s).
     let mean = bias / n;
@@ -187,25 +193,27 @@ fn an_outlier_is_gated_out_and_a_lost_track_restarts() {
     let c = config(SIGMA_2DEG);
     let mut tr = Track::default();
     let s = Vec2::new(1.0, 0.0);
+    let mut sh = Vec2::zeros();
     let dv = Vec2::zeros();
+    tr.update(&mut sh, &s, &dv, &dv, f64::NEG_INFINITY, &c, &LIMITS);
     for _ in 0..50 {
-        tr.update(&s, &dv, &dv, DT, &c, &LIMITS);
+        tr.update(&mut sh, &s, &dv, &dv, DT, &c, &LIMITS);
     }
     // 20° off: ten standard deviations.
     let wrong = rotate(&s, 20f64.to_radians());
-    let (sh, _) = tr.update(&wrong, &dv, &dv, DT, &c, &LIMITS);
+    tr.update(&mut sh, &wrong, &dv, &dv, DT, &c, &LIMITS);
     assert!((sh - s).norm() < 1e-9, "an outlier moved the track: {sh:?}");
     assert_eq!(tr.rejected, 1);
-    let (sh, _) = tr.update(&s, &dv, &dv, DT, &c, &LIMITS);
+    tr.update(&mut sh, &s, &dv, &dv, DT, &c, &LIMITS);
     assert!((sh - s).norm() < 1e-9);
     assert_eq!(tr.rejected, 0);
     // Three in a row: the neighbour really is elsewhere; the track restarts there.
     for _ in 0..3 {
-        tr.update(&wrong, &dv, &dv, DT, &c, &LIMITS);
+        tr.update(&mut sh, &wrong, &dv, &dv, DT, &c, &LIMITS);
     }
-    assert!((tr.s - wrong).norm() < 1e-12);
+    assert!((sh - wrong).norm() < 1e-12);
     // The restarted track's rate is S17 with ρ̂(0).
-    let (_, rate) = tr.update(&wrong, &dv, &Vec2::new(0.0, 1.0), DT, &c, &LIMITS);
+    let rate = tr.update(&mut sh, &wrong, &dv, &Vec2::new(0.0, 1.0), DT, &c, &LIMITS);
     let t = perp(&wrong);
     assert!((rate - t * t.dot(&Vec2::new(0.0, 1.0))).norm() < 0.05);
 }

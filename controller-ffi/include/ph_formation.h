@@ -78,14 +78,14 @@
 /**
  * Bytes of agent memory (`sizeof` the agent, for 32-bit targets such as Cortex-M).
  */
-#define PH_AGENT_SIZE 3760
+#define PH_AGENT_SIZE 3664
 #endif
 
 #if defined(PH_PTR64)
 /**
  * Bytes of agent memory (`sizeof` the agent, for 64-bit hosts).
  */
-#define PH_AGENT_SIZE 4096
+#define PH_AGENT_SIZE 4000
 #endif
 
 #if defined(PH_PTR32)

@@ -5,8 +5,8 @@
 //! to a core configuration type is a compile error here until it is mapped.
 
 use controller_core::{
-    AgentConfig, AngleConfig, BearingFilter, EstimatorMode, TrackerConfig, Integrity, LeaderConfig, LeaderRole, Limits, Schedule,
-    ScheduleStep, SwarmKey, TriangleConfig,
+    AgentConfig, AngleConfig, BearingFilter, EstimatorMode, Integrity, LeaderConfig, LeaderRole,
+    Limits, Schedule, ScheduleStep, SwarmKey, TrackerConfig, TriangleConfig,
 };
 
 use crate::status::ph_status;

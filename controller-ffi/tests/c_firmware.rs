@@ -231,7 +231,10 @@ fn c_firmware_figures() {
         elf,
         &[
             "-plugin".into(),
-            format!("{plugin},marker={marker},regions=32,out={}", counts.display()),
+            format!(
+                "{plugin},marker={marker},regions=32,out={}",
+                counts.display()
+            ),
         ],
     );
     assert_eq!(code, Some(0), "{log}");

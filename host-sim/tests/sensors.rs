@@ -110,7 +110,9 @@ fn a_noise_free_summary_is_unchanged_and_a_noisy_one_reports_the_noise() {
         assert!(n.get(k).is_some_and(|v| v.is_number()), "{k}: {n}");
     }
     assert_eq!(j["bearing_filter"]["kind"], "tracker");
-    let sigma = j["bearing_filter"]["bearing_noise_rad"].as_f64().expect("σ");
+    let sigma = j["bearing_filter"]["bearing_noise_rad"]
+        .as_f64()
+        .expect("σ");
     assert!((sigma - 1f64.to_radians()).abs() < 1e-12);
 }
 
@@ -120,7 +122,10 @@ fn bad_sensor_and_tracker_settings_name_their_field() {
         ("sensors.bearing_noise_deg=-1", "sensors.bearing_noise_deg"),
         ("sensors.bearing_noise_deg=nan", "sensors.bearing_noise_deg"),
         ("sensors.bearing_noise_deg=90", "sensors.bearing_noise_deg"),
-        ("sensors.tracker.rate_noise=-0.1", "sensors.tracker.rate_noise"),
+        (
+            "sensors.tracker.rate_noise=-0.1",
+            "sensors.tracker.rate_noise",
+        ),
         (
             "sensors.tracker.inverse_range_noise=inf",
             "sensors.tracker.inverse_range_noise",

@@ -310,7 +310,11 @@ fn take_bearing<T: Real, const MT: usize>(
         (None, BearingFilter::Tracker(c)) => {
             let moved = n.velocity - how.v_before;
             let dv = n.velocity - how.v;
-            n.track.update(&b.bearing, &moved, &dv, interval, c, &how.limits)
+            let mut s = n.s;
+            let rate = n
+                .track
+                .update(&mut s, &b.bearing, &moved, &dv, interval, c, &how.limits);
+            (s, rate)
         }
     };
     n.rate = rate;

@@ -67,7 +67,7 @@ impl Vehicle {
             let Some(agent) = model.agents.get(i) else {
                 continue;
             };
-            let config = model.agent_config(i)?;
+            let config = model.agent_config(i).map_err(|e| e.to_string())?;
             let force = config.limits.max_force;
             let acceleration = force / agent.mass;
             if acceleration.is_nan() || acceleration > l.max_acceleration {

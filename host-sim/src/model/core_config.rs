@@ -3,8 +3,8 @@
 
 use super::{AngleModel, Estimator, Model, ModelError};
 use controller_core::{
-    AgentConfig, AngleConfig, BearingFilter, EstimatorMode, LeaderConfig, LeaderRole, Limits, Schedule,
-    ScheduleStep, TrackerConfig, TriangleConfig,
+    AgentConfig, AngleConfig, BearingFilter, EstimatorMode, LeaderConfig, LeaderRole, Limits,
+    Schedule, ScheduleStep, TrackerConfig, TriangleConfig,
 };
 
 /// Triangle capacity of one host agent (`MT` of `controller_core::Agent`): the core's

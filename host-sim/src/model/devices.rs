@@ -48,6 +48,7 @@ impl SensorModel {
             bearing_noise,
             bearing_bias,
             bearing_rate: _, // how rates are measured, exact or not: no noise or bias
+            bearing_filter: _, // what the controllers do with the bearings: not a sensor error
             velocity_noise,
             velocity_bias,
             offset_noise,

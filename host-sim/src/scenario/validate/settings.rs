@@ -40,7 +40,13 @@ fn check_tracker(c: &mut Checker<'_>, t: &crate::scenario::settings::TrackerSpec
         within("bearing_noise_deg", b, 0.0, MAX_BEARING_NOISE_DEG, true);
     }
     within("rate_noise", t.rate_noise, 0.0, 100.0, false);
-    within("inverse_range_noise", t.inverse_range_noise, 0.0, 100.0, false);
+    within(
+        "inverse_range_noise",
+        t.inverse_range_noise,
+        0.0,
+        100.0,
+        false,
+    );
     within("gate", t.gate, 1.0, 1000.0, false);
 }
 
@@ -149,7 +155,10 @@ pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile) -> Timing {
         c.err(
             InvalidValue,
             "sensors.bearing_noise_deg",
-            format!("{} is not a bearing sensor: at most {MAX_BEARING_NOISE_DEG}°", se.bearing_noise_deg),
+            format!(
+                "{} is not a bearing sensor: at most {MAX_BEARING_NOISE_DEG}°",
+                se.bearing_noise_deg
+            ),
         );
     }
     check_tracker(c, &se.tracker);
