@@ -38,13 +38,22 @@ pub struct TrackLimits<T: Real> {
     pub rho_max: T,
 }
 
+/// The relative velocity `v_w − v_u` the tracker is driven by (S15, S17).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RelativeVelocity<T: Real> {
+    /// Over the interval since the previous bearing, as known at its start (S15).
+    pub moved: Vec2<T>,
+    /// Now (S17).
+    pub now: Vec2<T>,
+}
+
 /// Consecutive gated-out bearings after which the track restarts at the measurement.
 const MAX_REJECTED: u8 = 3;
 
 impl<T: Real> Track<T> {
     /// Takes bearing `z` (unit) measured `dt` seconds after the previous one, which gave
-    /// `s` (`ŝ`, updated in place); `moved` is the relative velocity `v_w − v_u` over that
-    /// interval (as known at its start) and `dv` the one now. Returns `ṡ̂` (S15–S17). A
+    /// `s` (`ŝ`, updated in place), with the relative velocity `dv`. Returns `ṡ̂`
+    /// (S15–S17). A
     /// non-positive or non-finite `dt` (the first bearing: the agent passes `−∞`), a
     /// bearing more than 90° from the prediction, or three gated-out bearings in a row
     /// (re)start the track at `z` with zero covariance cross term.
@@ -52,13 +61,13 @@ impl<T: Real> Track<T> {
         &mut self,
         s: &mut Vec2<T>,
         z: &Vec2<T>,
-        moved: &Vec2<T>,
-        dv: &Vec2<T>,
+        dv: &RelativeVelocity<T>,
         dt: T,
         c: &TrackerConfig<T>,
         lim: &TrackLimits<T>,
     ) -> Vec2<T> {
         let r = c.bearing_noise * c.bearing_noise;
+        let (moved, dv) = (&dv.moved, &dv.now);
         if !(dt > T::zero() && dt.finite()) {
             self.start(s, z, r, lim);
             return rate(s, self.rho, dv);

@@ -6,7 +6,7 @@
 mod testkit;
 
 use controller_core::geometry::{bearing_rate, perp};
-use controller_core::tracker::{Track, TrackLimits};
+use controller_core::tracker::{RelativeVelocity, Track, TrackLimits};
 use controller_core::{BearingFilter, ConfigError, TrackerConfig, Vec2};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -90,7 +90,11 @@ fn run(
         let moved = scene.velocity((t - DT).max(0.0));
         // The first bearing has no previous one: an interval of −∞, as the agent passes.
         let dt = if k == 0 { f64::NEG_INFINITY } else { DT };
-        let rh = tr.update(&mut sh, &z, &moved, &scene.velocity(t), dt, &c, &LIMITS);
+        let dv = RelativeVelocity {
+            moved,
+            now: scene.velocity(t),
+        };
+        let rh = tr.update(&mut sh, &z, &dv, dt, &c, &LIMITS);
         if let Some(zp) = prev {
             each(t, sh, rh, z, zp);
         }
@@ -194,26 +198,30 @@ fn an_outlier_is_gated_out_and_a_lost_track_restarts() {
     let mut tr = Track::default();
     let s = Vec2::new(1.0, 0.0);
     let mut sh = Vec2::zeros();
-    let dv = Vec2::zeros();
-    tr.update(&mut sh, &s, &dv, &dv, f64::NEG_INFINITY, &c, &LIMITS);
+    let dv = RelativeVelocity::default();
+    tr.update(&mut sh, &s, &dv, f64::NEG_INFINITY, &c, &LIMITS);
     for _ in 0..50 {
-        tr.update(&mut sh, &s, &dv, &dv, DT, &c, &LIMITS);
+        tr.update(&mut sh, &s, &dv, DT, &c, &LIMITS);
     }
     // 20° off: ten standard deviations.
     let wrong = rotate(&s, 20f64.to_radians());
-    tr.update(&mut sh, &wrong, &dv, &dv, DT, &c, &LIMITS);
+    tr.update(&mut sh, &wrong, &dv, DT, &c, &LIMITS);
     assert!((sh - s).norm() < 1e-9, "an outlier moved the track: {sh:?}");
     assert_eq!(tr.rejected, 1);
-    tr.update(&mut sh, &s, &dv, &dv, DT, &c, &LIMITS);
+    tr.update(&mut sh, &s, &dv, DT, &c, &LIMITS);
     assert!((sh - s).norm() < 1e-9);
     assert_eq!(tr.rejected, 0);
     // Three in a row: the neighbour really is elsewhere; the track restarts there.
     for _ in 0..3 {
-        tr.update(&mut sh, &wrong, &dv, &dv, DT, &c, &LIMITS);
+        tr.update(&mut sh, &wrong, &dv, DT, &c, &LIMITS);
     }
     assert!((sh - wrong).norm() < 1e-12);
     // The restarted track's rate is S17 with ρ̂(0).
-    let rate = tr.update(&mut sh, &wrong, &dv, &Vec2::new(0.0, 1.0), DT, &c, &LIMITS);
+    let turning = RelativeVelocity {
+        moved: Vec2::zeros(),
+        now: Vec2::new(0.0, 1.0),
+    };
+    let rate = tr.update(&mut sh, &wrong, &turning, DT, &c, &LIMITS);
     let t = perp(&wrong);
     assert!((rate - t * t.dot(&Vec2::new(0.0, 1.0))).norm() < 0.05);
 }

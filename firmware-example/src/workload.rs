@@ -51,6 +51,9 @@ pub struct StepConfig {
     pub triangles: usize,
     /// How every agent of the bench protects its frames.
     pub integrity: Integrity,
+    /// Every agent differentiates its bearings (SPEC §2) instead of running the bearing
+    /// tracker (SPEC §11, the default): the `_fd` rows, the wire's own cost.
+    pub finite_difference: bool,
 }
 
 /// The `auth` configurations' key: the public placeholder (see [`crate::keys`]).
@@ -58,47 +61,68 @@ const AUTH: Integrity = Integrity::Auth(crate::keys::PLACEHOLDER_SWARM_KEY);
 
 /// The configurations measured by the `measure` binary, in order: `crc16`
 /// integrity (`triN`), `link` (`triN_link`: no trailer, the radio checks its own
-/// CRC) and `auth` (`triN_auth`).
-pub const STEP_CONFIGS: [StepConfig; 8] = [
+/// CRC), `auth` (`triN_auth`), and `crc16` with finite-difference bearing rates
+/// instead of the bearing tracker (`triN_fd`).
+pub const STEP_CONFIGS: [StepConfig; 10] = [
     StepConfig {
         name: "tri1",
         triangles: 1,
         integrity: Integrity::Crc16,
+        finite_difference: false,
     },
     StepConfig {
         name: "tri2",
         triangles: 2,
         integrity: Integrity::Crc16,
+        finite_difference: false,
     },
     StepConfig {
         name: "tri4",
         triangles: 4,
         integrity: Integrity::Crc16,
+        finite_difference: false,
     },
     StepConfig {
         name: "tri8",
         triangles: 8,
         integrity: Integrity::Crc16,
+        finite_difference: false,
     },
     StepConfig {
         name: "tri2_link",
         triangles: 2,
         integrity: Integrity::Link,
+        finite_difference: false,
     },
     StepConfig {
         name: "tri8_link",
         triangles: 8,
         integrity: Integrity::Link,
+        finite_difference: false,
     },
     StepConfig {
         name: "tri2_auth",
         triangles: 2,
         integrity: AUTH,
+        finite_difference: false,
     },
     StepConfig {
         name: "tri8_auth",
         triangles: 8,
         integrity: AUTH,
+        finite_difference: false,
+    },
+    StepConfig {
+        name: "tri2_fd",
+        triangles: 2,
+        integrity: Integrity::Crc16,
+        finite_difference: true,
+    },
+    StepConfig {
+        name: "tri8_fd",
+        triangles: 8,
+        integrity: Integrity::Crc16,
+        finite_difference: true,
     },
 ];
 
@@ -302,6 +326,7 @@ impl StepResult {
 struct Fan {
     k: usize,
     integrity: Integrity,
+    finite_difference: bool,
 }
 
 impl Fan {
@@ -310,6 +335,7 @@ impl Fan {
             k @ 1..=MAX_TRIANGLES => Ok(Fan {
                 k,
                 integrity: cfg.integrity,
+                finite_difference: cfg.finite_difference,
             }),
             _ => Err(BenchError::Triangles),
         }
@@ -408,6 +434,9 @@ impl Fan {
         };
         c.limits.max_force = 1.0e5;
         c.integrity = self.integrity;
+        if self.finite_difference {
+            c.bearing_filter = controller_core::BearingFilter::FiniteDifference;
+        }
         c
     }
 

@@ -5,7 +5,7 @@
 use super::state::{AngleState, ApexPart, Neighbour, Side};
 use super::{Agent, BearingMeasurement, Fault, MeasurementError, Measurements};
 use crate::config::{AgentId, BearingFilter, EstimatorMode};
-use crate::tracker::TrackLimits;
+use crate::tracker::{RelativeVelocity, TrackLimits};
 use crate::{law, Real, Vec2};
 
 /// Neither NaN nor infinite, in two float operations: `x − x` is 0 exactly for finite `x`
@@ -308,12 +308,14 @@ fn take_bearing<T: Real, const MT: usize>(
         // neighbour's from its last frame, sent at about the last tick): the motion since
         // the last tick with the own velocity then, the rate with the own velocity now.
         (None, BearingFilter::Tracker(c)) => {
-            let moved = n.velocity - how.v_before;
-            let dv = n.velocity - how.v;
+            let dv = RelativeVelocity {
+                moved: n.velocity - how.v_before,
+                now: n.velocity - how.v,
+            };
             let mut s = n.s;
             let rate = n
                 .track
-                .update(&mut s, &b.bearing, &moved, &dv, interval, c, &how.limits);
+                .update(&mut s, &b.bearing, &dv, interval, c, &how.limits);
             (s, rate)
         }
     };
