@@ -615,7 +615,12 @@ fn qemu_agent_3_runs_the_bearing_tracker_with_noisy_bearings() {
             "radio.loss=0.1",
         ],
     );
-    assert_eq!(o.status.code(), Some(0), "not converged: {}", text(&o.stderr));
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "not converged: {}",
+        text(&o.stderr)
+    );
     let s = summary(&out);
     assert_eq!(s["outcome"], "converged");
     assert_eq!(s["bearing_filter"]["kind"], "tracker");
