@@ -56,7 +56,9 @@ impl<T: Real> Track<T> {
     /// (S15–S17). A
     /// non-positive or non-finite `dt` (the first bearing: the agent passes `−∞`), a
     /// bearing more than 90° from the prediction, or three gated-out bearings in a row
-    /// (re)start the track at `z` with zero covariance cross term.
+    /// (re)start the track at `z` with zero covariance cross term. Not inlined: the
+    /// agent's neighbour loop stays small on the finite-difference path.
+    #[inline(never)]
     pub fn update(
         &mut self,
         s: &mut Vec2<T>,

@@ -4,7 +4,7 @@
 
 use super::state::{AngleState, ApexPart, Neighbour, Side};
 use super::{Agent, BearingMeasurement, Fault, MeasurementError, Measurements};
-use crate::config::{AgentId, BearingFilter, EstimatorMode};
+use crate::config::{AgentId, BearingFilter, EstimatorMode, TrackerConfig};
 use crate::tracker::{RelativeVelocity, TrackLimits};
 use crate::{law, Real, Vec2};
 
@@ -66,15 +66,21 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         self.time = m.time;
         let v_before = core::mem::replace(&mut self.velocity, m.velocity);
         self.partner_offset = m.partner_offset;
-        let how = Filtering {
-            filter: &self.config.bearing_filter,
-            v: &m.velocity,
-            v_before: &v_before,
-            limits: TrackLimits {
-                rho_initial: T::one() / self.config.initial_estimate,
-                rho_max: T::one() / self.config.min_estimate,
-            },
+        // The tracker's inputs, only when it runs (no divisions on the finite-difference
+        // path).
+        let tracking = match &self.config.bearing_filter {
+            BearingFilter::Tracker(c) => Some(Tracking {
+                c,
+                v: m.velocity,
+                v_before,
+                limits: TrackLimits {
+                    rho_initial: T::one() / self.config.initial_estimate,
+                    rho_max: T::one() / self.config.min_estimate,
+                },
+            }),
+            BearingFilter::FiniteDifference => None,
         };
+        let how = tracking.as_ref();
         // The oldest neighbour (ages are never NaN: ∞ + a finite dt ≥ 0, or 0 when heard).
         let mut oldest = T::zero();
         if in_order {
@@ -86,7 +92,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     oldest = n.age;
                 }
                 match bearings.next() {
-                    Some(b) => take_bearing(n, b, dt, &how),
+                    Some(b) => take_bearing(n, b, dt, how),
                     None => no_bearing(n, dt),
                 }
             }
@@ -97,7 +103,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     oldest = n.age;
                 }
                 match bearing_to(m.bearings, n.id) {
-                    Some(b) => take_bearing(n, b, dt, &how),
+                    Some(b) => take_bearing(n, b, dt, how),
                     None => no_bearing(n, dt),
                 }
             }
@@ -277,45 +283,44 @@ fn bearing_to<T: Real>(
     bearings.iter().find(|b| b.neighbour == id)
 }
 
-/// What [`take_bearing`] needs of the agent: its bearing filter, its own velocity of this
-/// tick and of the last, and the tracker's limits.
-struct Filtering<'a, T: Real> {
-    filter: &'a BearingFilter<T>,
-    v: &'a Vec2<T>,
-    v_before: &'a Vec2<T>,
+/// What [`take_bearing`] needs of the agent to run the bearing tracker: its settings, its
+/// own velocity of this tick and of the last, and the tracker's limits.
+struct Tracking<'a, T: Real> {
+    c: &'a TrackerConfig<T>,
+    v: Vec2<T>,
+    v_before: Vec2<T>,
     limits: TrackLimits<T>,
 }
 
-/// Stores a checked bearing of this tick and its rate (`dt`: time since the last tick).
+/// Stores a checked bearing of this tick and its rate (`dt`: time since the last tick);
+/// `tracking` when the agent runs the bearing tracker.
 #[inline(always)]
 fn take_bearing<T: Real, const MT: usize>(
     n: &mut Neighbour<T, MT>,
     b: &BearingMeasurement<T>,
     dt: T,
-    how: &Filtering<'_, T>,
+    tracking: Option<&Tracking<'_, T>>,
 ) {
     let interval = n.bearing_age + dt;
-    let (s, rate) = match (b.rate, how.filter) {
+    let (s, rate) = match (b.rate, tracking) {
         (Some(rate), _) => (b.bearing, rate),
         // Finite difference of successive bearings (SPEC §2), over the time since the
         // previous bearing (a missed tick widens the interval). Without a previous
         // bearing the interval is −∞: zero rate.
-        (None, BearingFilter::FiniteDifference) if interval > T::zero() => {
-            (b.bearing, (b.bearing - n.s) / interval)
-        }
-        (None, BearingFilter::FiniteDifference) => (b.bearing, Vec2::zeros()),
+        (None, None) if interval > T::zero() => (b.bearing, (b.bearing - n.s) / interval),
+        (None, None) => (b.bearing, Vec2::zeros()),
         // SPEC §11: the tracker, driven by the relative velocity Δv = v_w − v_u (the
         // neighbour's from its last frame, sent at about the last tick): the motion since
         // the last tick with the own velocity then, the rate with the own velocity now.
-        (None, BearingFilter::Tracker(c)) => {
+        (None, Some(t)) => {
             let dv = RelativeVelocity {
-                moved: n.velocity - how.v_before,
-                now: n.velocity - how.v,
+                moved: n.velocity - t.v_before,
+                now: n.velocity - t.v,
             };
             let mut s = n.s;
             let rate = n
                 .track
-                .update(&mut s, &b.bearing, &dv, interval, c, &how.limits);
+                .update(&mut s, &b.bearing, &dv, interval, t.c, &t.limits);
             (s, rate)
         }
     };
