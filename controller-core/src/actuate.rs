@@ -32,15 +32,19 @@ pub enum ActuateError {
     Friction,
     /// The speed limit is NaN or not positive (use infinity for none).
     MaxSpeed,
+    /// The lead is not finite and non-negative.
+    Lead,
 }
 
-/// The virtual plant of SPEC S1 for one agent: mass, friction `D^r` per axis, and the
-/// vehicle's largest velocity setpoint.
+/// The virtual plant of SPEC S1 for one agent: mass, friction `D^r` per axis, the
+/// vehicle's largest velocity setpoint, and the lead that compensates the vehicle's own
+/// velocity loop (S19).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct VirtualMass<T> {
     mass: T,
     friction: [T; 2],
     max_speed: T,
+    lead: T,
 }
 
 impl<T: Real> VirtualMass<T> {
@@ -61,7 +65,40 @@ impl<T: Real> VirtualMass<T> {
             mass,
             friction,
             max_speed,
+            lead: T::zero(),
         })
+    }
+
+    /// The same plant with lead `lead` (s, finite, ≥ 0): the time constant of the
+    /// vehicle's velocity loop, which the setpoint then anticipates (S19). 0 (the
+    /// default) gives the virtual velocity itself.
+    pub fn with_lead(self, lead: T) -> Result<Self, ActuateError> {
+        if !(lead.finite() && lead >= T::zero()) {
+            return Err(ActuateError::Lead);
+        }
+        Ok(Self { lead, ..self })
+    }
+
+    /// The lead (s).
+    pub fn lead(&self) -> T {
+        self.lead
+    }
+
+    /// S19: the setpoint for a vehicle whose velocity follows its setpoint with time
+    /// constant `τ` (the lead): the virtual velocity `next` plus `τ` times the virtual
+    /// acceleration over the period `dt` from `from`,
+    /// `v_sp = v_{k+1} + τ (v_{k+1} − v_k) / Δt`, limited to the speed limit. Then
+    /// `v̇ = (v_sp − v) / τ` makes the vehicle's velocity error to the virtual one decay
+    /// as `e^{−t/τ}` instead of lagging behind it. Without lead, or for `dt ≤ 0`,
+    /// `next` itself.
+    pub fn setpoint(&self, from: [T; 2], next: [T; 2], dt: T) -> [T; 2] {
+        if !(self.lead > T::zero() && dt > T::zero() && dt.finite()) {
+            return next;
+        }
+        let k = self.lead / dt;
+        let [x, y] = next;
+        let [x0, y0] = from;
+        self.limit([x + k * (x - x0), y + k * (y - y0)])
     }
 
     /// The mass.
@@ -147,7 +184,8 @@ impl<T: Real> VelocityCommand<T> {
         self.command = None;
     }
 
-    /// The current setpoint (`None` before the first step).
+    /// The current virtual velocity (`None` before the first step): the setpoint
+    /// without lead.
     pub fn command(&self) -> Option<[T; 2]> {
         self.command
     }
@@ -157,14 +195,15 @@ impl<T: Real> VelocityCommand<T> {
         &self.plant
     }
 
-    /// One control period: integrates S1 from the previous setpoint (or, on the first
-    /// step, from `measured`, the vehicle's velocity) under `force` for `dt` seconds and
-    /// returns the new setpoint.
+    /// One control period: integrates S1 from the previous virtual velocity (or, on the
+    /// first step, from `measured`, the vehicle's velocity) under `force` for `dt`
+    /// seconds (S18) and returns the new setpoint (S19: the new virtual velocity, led by
+    /// the plant's lead).
     pub fn step(&mut self, force: [T; 2], measured: [T; 2], dt: T) -> [T; 2] {
         let from = self.command.unwrap_or(measured);
         let next = self.plant.step(from, force, dt);
         self.command = Some(next);
-        next
+        self.plant.setpoint(from, next, dt)
     }
 }
 
@@ -242,6 +281,41 @@ mod tests {
         assert_eq!(
             VirtualMass::new(1.0, [0.0; 2], 0.0),
             Err(ActuateError::MaxSpeed)
+        );
+    }
+
+    /// S19: with lead τ, a first-order vehicle `v̇ = (v_sp − v)/τ` follows the virtual
+    /// velocity with an error that decays; without lead it lags by about `τ a`.
+    #[test]
+    fn the_lead_cancels_a_first_order_velocity_loop() {
+        let tau = 0.2_f64;
+        let lag = |lead: f64| {
+            let plant = VirtualMass::new(1.0, [0.5; 2], f64::INFINITY)
+                .and_then(|p| p.with_lead(lead))
+                .unwrap();
+            let mut c = VelocityCommand::new(plant);
+            let (dt, sub) = (0.01, 100);
+            let mut v = 0.0;
+            let mut worst: f64 = 0.0;
+            for k in 0..300 {
+                // A force that keeps changing: the virtual velocity ramps and turns.
+                let u = if k < 150 { 1.0 } else { -1.0 };
+                let sp = c.step([u, 0.0], [v, 0.0], dt)[0];
+                for _ in 0..sub {
+                    v += (sp - v) / tau * (dt / f64::from(sub));
+                }
+                if k > 20 {
+                    worst = worst.max((v - c.command().unwrap()[0]).abs());
+                }
+            }
+            worst
+        };
+        let (without, with) = (lag(0.0), lag(tau));
+        assert!(without > 0.15, "{without}");
+        assert!(with < 0.03 * without, "{with} vs {without}");
+        assert_eq!(
+            VirtualMass::new(1.0_f64, [0.0; 2], 1.0).and_then(|p| p.with_lead(-1.0)),
+            Err(ActuateError::Lead)
         );
     }
 

@@ -69,7 +69,7 @@ fn bench(
                 Some(p) => p.install(step),
                 None => step(),
             }
-            black_box(&sim.plant.q);
+            black_box(sim.plant.q());
         });
     });
 }

@@ -18,8 +18,18 @@ use std::time::Instant;
 
 /// A simulation engine the driver advances: sampled or continuous.
 pub trait Engine {
-    /// Runs the controllers at a control instant `t` (sampled mode; no-op in continuous).
+    /// Runs the controllers at a control instant `t` (sampled mode; no-op in continuous):
+    /// every agent, or with own clocks those due at `t`.
     fn control(&mut self, t: f64);
+    /// Whether some agent ticks at RK4 step `k` (by default every `steps_per_tick`).
+    fn ticks_at(&self, model: &Model, k: usize) -> bool {
+        k.is_multiple_of(model.steps_per_tick.max(1))
+    }
+    /// The first RK4 step after `k` at which some agent ticks.
+    fn next_tick_after(&self, model: &Model, k: usize) -> usize {
+        let spt = model.steps_per_tick.max(1);
+        (k / spt + 1) * spt
+    }
     /// Advances the state by one RK4 step from `t`.
     fn integrate(&mut self, t: f64);
     /// Advances the state by the RK4 steps `k..k + steps` of `model` (step `j` starts at
@@ -68,6 +78,24 @@ fn signed_area(q: &[Vec2<f64>], t: [usize; 3]) -> f64 {
     geometry::cross(p(t[0]), p(t[1]), p(t[2]))
 }
 
+/// Why the formation cannot track `v*`, if the vehicle's speed limit is below some step
+/// of it (`docs/world.md`): a warning, and part of the outcome's reason.
+pub fn speed_limit_note(model: &Model) -> Option<String> {
+    let limit = model.world.max_speed()?;
+    let step = model
+        .velocity_reference
+        .steps
+        .iter()
+        .find(|s| s.value[0].hypot(s.value[1]) > limit)?;
+    let [x, y] = step.value;
+    Some(format!(
+        "velocity_reference from {} s: v* = ({x}, {y}) m/s, |v*| = {:.2} m/s is above the \
+         vehicle's speed limit plant.max_speed = {limit} m/s: the formation cannot track v*",
+        step.from,
+        x.hypot(y)
+    ))
+}
+
 /// Runs `model` in its mode, logging rows to `recorder` and reporting the simulated time
 /// to `progress`.
 pub fn run(
@@ -76,6 +104,9 @@ pub fn run(
     progress: &mut dyn FnMut(f64),
 ) -> Result<RunResult, RunError> {
     let mut warnings = Vec::new();
+    if let Some(w) = speed_limit_note(model) {
+        warnings.push(w);
+    }
     match model.mode {
         Mode::Sampled => {
             let mut e = SampledSim::new(model)?;
@@ -130,8 +161,9 @@ pub fn drive(
     let mut k = 0;
     loop {
         let t = model.time(k);
+        // The diagnostics look at every control period (the common clock's ticks).
         let tick = k.is_multiple_of(spt);
-        if tick {
+        if engine.ticks_at(model, k) {
             engine.control(t);
             if let Some(e) = engine.take_error() {
                 let _ = recorder.finish();
@@ -167,7 +199,7 @@ pub fn drive(
         }
         // The steps up to the next instant that looks at the state: a control tick, a log
         // instant or the end.
-        let next = next_instant(k, spt, log_every, total);
+        let next = next_instant(k, spt, log_every, total).min(engine.next_tick_after(model, k));
         engine.integrate_steps(model, k, next - k);
         steps += next - k;
         // As at every step that is a multiple of `progress_every`.
@@ -179,7 +211,12 @@ pub fn drive(
     recorder.finish()?;
     progress(diag.snap.t);
     let (q, v, est) = engine.view();
-    let (outcome, reason) = monitor.verdict(model, &diag.snap, q);
+    let (outcome, mut reason) = monitor.verdict(model, &diag.snap, q);
+    if outcome != crate::analysis::Outcome::Converged {
+        if let Some(note) = speed_limit_note(model) {
+            reason = format!("{reason}; {note}");
+        }
+    }
     let s = &diag.snap;
     Ok(RunResult {
         outcome,

@@ -39,6 +39,14 @@ pub enum SetupError {
         /// `controller_core::MAX_NEIGHBOURS`.
         max: usize,
     },
+    /// An agent's virtual mass (`controller_core::actuate`) refused its plant's figures.
+    #[error("agent {agent}: the vehicle's virtual mass refused its figures: {error:?}")]
+    Vehicle {
+        /// The agent index.
+        agent: usize,
+        /// What the core refused.
+        error: controller_core::actuate::ActuateError,
+    },
 }
 
 /// Why a run stopped without a result.

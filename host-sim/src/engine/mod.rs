@@ -24,6 +24,7 @@ pub mod sensors;
 pub mod slot_order;
 pub mod speed;
 mod stats;
+pub mod world;
 
 pub use continuous::ContinuousSim;
 pub use controller::{local_core, AgentController, LocalCore, LOCAL_CAPACITIES};

@@ -19,17 +19,18 @@ use super::controller::{local_core, AgentController, Inbox};
 use super::driver::Engine;
 use super::error::SetupError;
 use super::hil::{HilError, LinkStats};
-use super::plant::Plant;
+use super::plant::{new_plant, Held, Plant};
 use super::radio::{Radio, RadioFrame};
 use super::sensors::{offset_with, quiet_bearing, velocity_with, Sensors, Sight};
 use super::slot_order::SlotOrder;
 use super::speed::prefetch::{self, Footprint};
 use super::speed::{CHUNK, PARALLEL_MIN_AGENTS};
 use super::stats::{ControlStats, FrameCounts, FrameReasons};
+use super::world::{Clocks, Headings, Wind};
 use crate::model::graph::Adjacency;
 use crate::model::{resolve_estimates, BearingRate, EstimateInfo, Estimator, Model};
 use controller_core::{BearingMeasurement, StepOutput, Vec2, MAX_NEIGHBOURS};
-use tick::{AgentSlots, Walk};
+use tick::{world_force, AgentSlots, AgentTick, Walk};
 
 /// Whether every frame of a tick arrives, unchanged and in sender order, at the next tick:
 /// nothing in the radio alters frames ([`RadioModel::departures`](crate::model::RadioModel::departures),
@@ -46,8 +47,10 @@ pub struct SampledSim<'m> {
     controllers: Vec<Box<dyn AgentController>>,
     /// Where each controller lies in memory ([`prefetch`]).
     footprints: Vec<Footprint>,
-    /// The plant state.
-    pub plant: Plant,
+    /// Every agent's vehicle ([`crate::engine::plant`]).
+    pub plant: Box<dyn Plant>,
+    /// The robot's world besides the vehicle: headings, clocks, wind.
+    world: WorldState,
     /// Who measures whom, and with which sensors.
     senses: Senses,
     radio: Radio,
@@ -145,7 +148,8 @@ impl<'m> SampledSim<'m> {
         let capacity = (links * FRAMES_PER_TICK * 2)
             .saturating_mul(ticks_in_flight)
             .min(1 << 20);
-        let direct = direct_radio(model);
+        // Agents on their own clocks hear frames through the radio's queue.
+        let direct = direct_radio(model) && model.world.clock.is_none();
         // Direct delivery reads the senders' frames in place: no inbox.
         let inboxes = (0..n)
             .map(|i| {
@@ -161,7 +165,8 @@ impl<'m> SampledSim<'m> {
             model,
             footprints: controllers.iter().map(|c| Footprint::of(&**c)).collect(),
             controllers,
-            plant: Plant::new(model),
+            plant: new_plant(model)?,
+            world: WorldState::new(model),
             senses: Senses {
                 sensors: Sensors::new(&model.sensors, model.seed),
                 ids: model.agents.iter().map(|a| a.id).collect(),
@@ -224,23 +229,27 @@ impl<'m> SampledSim<'m> {
 }
 
 impl SampledSim<'_> {
-    /// `steps` RK4 steps of the plant under the held forces: on every thread when the
-    /// ticks are, each work item taking every step of its agents (one fork-join);
-    /// otherwise one step over all agents at a time (measured faster on one thread).
+    /// `steps` RK4 steps of the plant under the held forces (and the wind): on every
+    /// thread when the ticks are, each work item taking every step of its agents (one
+    /// fork-join); otherwise one step over all agents at a time (measured faster on one
+    /// thread).
     fn plant_steps(&mut self, steps: usize) {
         let dt = self.model.dt;
-        if self.parallel() {
-            self.plant.step_parallel(&self.forces, dt, steps, CHUNK);
-        } else {
-            for _ in 0..steps {
-                self.plant.step(&self.forces, dt);
-            }
-        }
+        let chunk = self.parallel().then_some(CHUNK);
+        let held = Held {
+            forces: &self.forces,
+            wind: self.world.wind.as_ref().map_or(&[], |w| w.now.as_slice()),
+        };
+        self.plant.step(&held, dt, steps, chunk);
     }
 
-    /// Whether this tick runs on every thread of the current rayon pool.
+    /// Whether this tick runs on every thread of the current rayon pool (agents on their
+    /// own clocks tick one by one).
     fn parallel(&self) -> bool {
-        self.local && self.model.n() >= PARALLEL_MIN_AGENTS && rayon::current_num_threads() > 1
+        self.local
+            && self.model.n() >= PARALLEL_MIN_AGENTS
+            && rayon::current_num_threads() > 1
+            && self.world.clocks.is_none()
     }
 
     /// What agent `i` takes in at this tick: what the radio delivered, or with direct
@@ -260,21 +269,23 @@ impl SampledSim<'_> {
         }
     }
 
-    /// Every agent's tick started ([`Walk::start`]), in agent order.
-    fn tick_sequential(&mut self, t: f64, dt: f64, tick: u64) -> Result<(), HilError> {
+    /// Every due agent's tick started ([`Walk::start`]), in agent order: every agent at
+    /// `at`, or with own clocks those `self.world.due` lists, each at its own tick.
+    fn tick_sequential(&mut self, at: AgentTick) -> Result<(), HilError> {
         let mut delivered = 0;
         let model = self.model;
         // Field by field: the walk reads the state while the loop writes the agents' parts.
         let walk = Walk {
-            t,
-            dt,
-            scene: Scene::of(model, &self.plant, &self.senses, tick),
+            at,
+            headings: self.world.headings.as_ref(),
+            scene: Scene::of(model, &*self.plant, &self.senses),
             radio: &model.graph.radio,
             slot_order: &self.slot_order,
             sent: &self.sent,
             footprints: &self.footprints,
             copy_estimates: self.viewed,
         };
+        let clocked = self.world.clocks.is_some();
         let each = self
             .controllers
             .iter_mut()
@@ -283,6 +294,11 @@ impl SampledSim<'_> {
             .zip(&mut self.forces)
             .zip(&mut self.outputs);
         for (i, ((((controller, inbox), outbox), force), output)) in each.enumerate() {
+            let at = match (clocked, self.world.due.get(i)) {
+                (false, _) => at,
+                (true, Some(Some(own))) => *own,
+                (true, _) => continue,
+            };
             let (a, b) = (self.est_start[i], self.est_start[i + 1]);
             let mut slots = AgentSlots {
                 controller,
@@ -291,12 +307,28 @@ impl SampledSim<'_> {
                 force,
                 estimates: &mut self.estimates[a..b],
             };
-            let (out, frames) = walk.start(i, &mut slots)?;
+            let (out, frames) = walk.start(i, &mut slots, at)?;
             delivered += frames;
             *output = out;
         }
         self.count_direct(delivered);
         Ok(())
+    }
+
+    /// With own clocks: which agents tick at RK4 step `step` (time `t`), each at its own
+    /// clock's reading (`self.world.due`); their next ticks are scheduled.
+    fn schedule_due(&mut self, t: f64, step: usize) {
+        let w = &mut self.world;
+        let Some(clocks) = &mut w.clocks else {
+            return;
+        };
+        w.due.clear();
+        for i in 0..self.model.n() {
+            w.due.push(clocks.due(i, step).then(|| {
+                let (time, dt, tick) = clocks.tick(i, t, step);
+                AgentTick { time, dt, tick }
+            }));
+        }
     }
 
     /// Agent `i`'s frames of this tick through the radio (and the attackers that
@@ -308,7 +340,7 @@ impl SampledSim<'_> {
             self.radio.broadcast_frame(t, i, receivers, *f);
             if !self.attacks.is_empty() {
                 self.attacks
-                    .overhear(t, i, f.as_bytes(), &self.plant.q, model, &mut self.radio);
+                    .overhear(t, i, f.as_bytes(), self.plant.q(), model, &mut self.radio);
             }
         }
     }
@@ -336,7 +368,7 @@ impl SampledSim<'_> {
 }
 
 impl Engine for SampledSim<'_> {
-    /// Two phases: every agent is measured in agent order and its tick started (local
+    /// Two phases: every due agent is measured in agent order and its tick started (local
     /// controllers complete it at once, remote ones only send their inputs), then every
     /// output is collected and every agent's frames broadcast, in agent order (so the
     /// random streams are drawn in the same order as without remote controllers).
@@ -352,22 +384,26 @@ impl Engine for SampledSim<'_> {
             // The frames of the last tick are read where their senders left them.
             std::mem::swap(&mut self.outboxes, &mut self.sent);
         } else {
-            self.radio.observe(&self.plant.q);
+            self.radio.observe(self.plant.q());
             if !self.attacks.is_empty() {
                 let period = model.dt * model.steps_per_tick as f64;
                 self.attacks
-                    .tick(t, period, &self.plant.q, model, &mut self.radio);
+                    .tick(t, period, self.plant.q(), model, &mut self.radio);
             }
             self.radio.deliver(t, &mut self.inboxes);
         }
         let dt = self.last_tick.map_or(0.0, |p| t - p);
         // Measured with this tick's streams; the next tick draws from new ones.
-        let tick = self.ticks;
+        let at = AgentTick {
+            time: t,
+            dt,
+            tick: self.ticks,
+        };
         self.ticks += 1;
         if parallel {
             // Forces, counters and statistics kept on every thread: only the radio's
             // broadcasts (one random stream, in agent order) remain.
-            self.tick_parallel(t, dt, tick);
+            self.tick_parallel(t, dt, at.tick);
             if !self.direct {
                 for i in 0..model.n() {
                     self.broadcast(t, i);
@@ -376,11 +412,18 @@ impl Engine for SampledSim<'_> {
             self.last_tick = Some(t);
             return;
         }
-        if let Err(e) = self.tick_sequential(t, dt, tick) {
+        self.schedule_due(t, model.step_of(t));
+        if let Err(e) = self.tick_sequential(at) {
             self.error = Some(e);
             return;
         }
+        let clocked = self.world.clocks.is_some();
         for i in 0..model.n() {
+            let at = match (clocked, self.world.due.get(i)) {
+                (false, _) => at,
+                (true, Some(Some(own))) => *own,
+                (true, _) => continue,
+            };
             let out = match self.outputs[i].take() {
                 Some(out) => out,
                 None => match self.controllers[i].finish_tick(&mut self.outboxes[i]) {
@@ -403,7 +446,11 @@ impl Engine for SampledSim<'_> {
             } else {
                 self.broadcast(t, i);
             }
-            self.forces[i] = out.force;
+            let force = world_force(self.world.headings.as_ref(), i, &at, out.force);
+            self.forces[i] = force;
+            if self.plant.takes_commands() {
+                self.plant.command(i, force, at.dt);
+            }
             self.stats.record(
                 t,
                 i,
@@ -413,7 +460,7 @@ impl Engine for SampledSim<'_> {
                 out.force.norm(),
             );
         }
-        self.estimates_fresh = self.viewed;
+        self.estimates_fresh = self.viewed && !clocked;
         self.last_tick = Some(t);
     }
 
@@ -421,9 +468,32 @@ impl Engine for SampledSim<'_> {
         self.plant_steps(1);
     }
 
-    /// The plant does not depend on `t`: all the steps at once.
-    fn integrate_steps(&mut self, _model: &Model, _k: usize, steps: usize) {
+    /// The plant does not depend on `t`: all the steps at once (the wind advances at
+    /// every control period).
+    fn integrate_steps(&mut self, model: &Model, k: usize, steps: usize) {
+        if let Some(w) = &mut self.world.wind {
+            if k.is_multiple_of(model.steps_per_tick.max(1)) {
+                w.advance(model.control_period());
+            }
+        }
         self.plant_steps(steps);
+    }
+
+    fn ticks_at(&self, model: &Model, k: usize) -> bool {
+        match &self.world.clocks {
+            Some(c) => c.any_due(k),
+            None => k.is_multiple_of(model.steps_per_tick.max(1)),
+        }
+    }
+
+    fn next_tick_after(&self, model: &Model, k: usize) -> usize {
+        match &self.world.clocks {
+            Some(c) => c.next_after(k),
+            None => {
+                let spt = model.steps_per_tick.max(1);
+                (k / spt + 1) * spt
+            }
+        }
     }
 
     fn view(&mut self) -> (&[Vec2<f64>], &[Vec2<f64>], &[f64]) {
@@ -436,7 +506,7 @@ impl Engine for SampledSim<'_> {
             }
             self.estimates_fresh = true;
         }
-        (&self.plant.q, &self.plant.v, &self.estimates)
+        (self.plant.q(), self.plant.v(), &self.estimates)
     }
 
     fn estimate_info(&self) -> &[EstimateInfo] {
@@ -489,6 +559,28 @@ impl Engine for SampledSim<'_> {
     }
 }
 
+/// The robot's world besides the vehicle (`docs/world.md`): each agent's heading
+/// estimate, its own clock, the wind; `None` where the world is ideal.
+struct WorldState {
+    headings: Option<Headings>,
+    clocks: Option<Clocks>,
+    wind: Option<Wind>,
+    /// With own clocks: the agents that tick at the current step, each at its tick.
+    due: Vec<Option<AgentTick>>,
+}
+
+impl WorldState {
+    fn new(model: &Model) -> Self {
+        let w = &model.world;
+        Self {
+            headings: w.heading.as_ref().map(|h| Headings::new(model, h)),
+            clocks: w.clock.as_ref().map(|c| Clocks::new(model, c)),
+            wind: w.wind.as_ref().map(|x| Wind::new(model, x)),
+            due: Vec::new(),
+        }
+    }
+}
+
 /// How a tick measures: exact bearing rates, ranges, sensors that draw nothing.
 #[derive(Clone, Copy, Debug)]
 struct MeasureMode {
@@ -505,28 +597,25 @@ struct Senses {
     partner: Vec<Option<usize>>,
 }
 
-/// What one tick's measurements read: the state, who sees whom, the sensors and the
-/// tick's index (of the agents' random streams).
+/// What one tick's measurements read: the state, who sees whom and the sensors.
 struct Scene<'a> {
     graph: &'a Adjacency,
     q: &'a [Vec2<f64>],
     v: &'a [Vec2<f64>],
     senses: &'a Senses,
-    tick: u64,
     mode: MeasureMode,
 }
 
 impl<'a> Scene<'a> {
-    /// Tick `tick`'s scene of a simulator's parts (taken one by one, so that the caller
-    /// may write its other fields meanwhile).
-    fn of(model: &'a Model, plant: &'a Plant, senses: &'a Senses, tick: u64) -> Self {
+    /// The scene of a simulator's parts (taken one by one, so that the caller may write
+    /// its other fields meanwhile).
+    fn of(model: &'a Model, plant: &'a dyn Plant, senses: &'a Senses) -> Self {
         let ranged = model.estimator == Estimator::Measured;
         Self {
             graph: &model.graph.triangle,
-            q: &plant.q,
-            v: &plant.v,
+            q: plant.q(),
+            v: plant.v(),
             senses,
-            tick,
             mode: MeasureMode {
                 exact: model.sensors.bearing_rate == BearingRate::Exact,
                 ranged,
@@ -535,14 +624,15 @@ impl<'a> Scene<'a> {
         }
     }
 
-    /// Agent `i`'s measurements: its bearings in graph order (to `push`), then its own
-    /// velocity and (a leader) its partner offset, drawn in that order from its stream of
-    /// this tick ([`Sensors::stream`]); with sensors that draw nothing
+    /// Agent `i`'s measurements at its tick `tick`: its bearings in graph order (to
+    /// `push`), then its own velocity and (a leader) its partner offset, drawn in that
+    /// order from its stream of the tick ([`Sensors::stream`]); with sensors that draw nothing
     /// ([`MeasureMode::quiet`]) the same values from the state alone, without a stream.
     #[inline]
     fn measure(
         &self,
         i: usize,
+        tick: u64,
         mut push: impl FnMut(BearingMeasurement<f64>),
     ) -> (Vec2<f64>, Option<Vec2<f64>>) {
         let (q, v, m) = (self.q, self.v, self.mode);
@@ -567,7 +657,7 @@ impl<'a> Scene<'a> {
                 partner.map(|p| offset_with(&q[i], &q[p], [0.0; 2])),
             );
         }
-        let mut draws = sensors.stream(i, self.tick);
+        let mut draws = sensors.stream(i, tick);
         for &j in self.graph.of(i) {
             if let Some(b) = draws.bearing(&sight(j), m.exact, m.ranged) {
                 push(b);

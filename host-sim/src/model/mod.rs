@@ -19,6 +19,7 @@ mod options;
 pub mod shape;
 pub mod target;
 pub mod wire_ids;
+pub mod world;
 
 pub use attack::{AttackKind, AttackModel};
 pub use channel::{Access, ChannelModel, IntegrityMode};
@@ -31,6 +32,7 @@ pub use formation::{AgentModel, AngleModel, LeaderModel, TriangleModel};
 pub use graph::Graph;
 pub use options::{BearingRate, Estimator, Mode};
 pub use target::Target;
+pub use world::{ClockModel, HeadingModel, VehicleModel, VelocityTracking, WindModel, WorldModel};
 
 use controller_core::{Limits, Schedule};
 
@@ -90,6 +92,8 @@ pub struct Model {
     pub target: Target,
     /// Adversaries on the radio (`[[attacks]]`; empty: none).
     pub attacks: Vec<AttackModel>,
+    /// The robot's world: vehicle, wind, headings, clocks (`docs/world.md`).
+    pub world: WorldModel,
 }
 
 impl Model {
@@ -137,6 +141,12 @@ impl Model {
         } else {
             k as f64 * self.dt
         }
+    }
+
+    /// The RK4 step at time `t` (the nearest; [`Self::time`] inverted).
+    #[inline]
+    pub fn step_of(&self, t: f64) -> usize {
+        (t / self.dt).round().max(0.0) as usize
     }
 
     /// Total number of RK4 steps of the run.

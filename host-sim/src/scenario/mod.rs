@@ -13,6 +13,7 @@ mod source;
 pub mod strip;
 pub mod toml_text;
 mod validate;
+pub mod world;
 
 pub use builtin::{builtin, Builtin, BUILTINS};
 pub use error::{ErrorKind, ScenarioError, ScenarioErrors};
@@ -24,6 +25,7 @@ pub use settings::{ChannelSpec, ControllerSpec, Integration, RadioSpec, SensorSp
 pub use source::Source;
 pub use strip::strip_model;
 pub use validate::{validate, validate_text};
+pub use world::{ClockSpec, HeadingSpec, PlantKind, PlantSpec, WindSpec, PRESETS};
 
 use crate::model::Model;
 

@@ -3,6 +3,7 @@
 //! run-wide sections are in [`super::settings`].
 
 use super::settings::{AttackSpec, ControllerSpec, Integration, RadioSpec, SensorSpec};
+use super::world::{ClockSpec, HeadingSpec, PlantSpec, WindSpec};
 use crate::model::{Criteria, Mode};
 use serde::{Deserialize, Serialize};
 
@@ -257,6 +258,22 @@ pub struct ScenarioFile {
     /// `[[attacks]]`: adversaries on the radio (`docs/attacks.md`).
     #[serde(default)]
     pub attacks: Vec<AttackSpec>,
+    /// `world`: a preset of the robot's world (`ideal`, `crazyflie`; `docs/world.md`),
+    /// merged under the file.
+    #[serde(default)]
+    pub world: Option<String>,
+    /// `[plant]`: the vehicle.
+    #[serde(default)]
+    pub plant: PlantSpec,
+    /// `[wind]` (optional).
+    #[serde(default)]
+    pub wind: Option<WindSpec>,
+    /// `[heading]`: body frames and heading estimates (optional).
+    #[serde(default)]
+    pub heading: Option<HeadingSpec>,
+    /// `[clock]`: each agent's own clock (optional).
+    #[serde(default)]
+    pub clock: Option<ClockSpec>,
 }
 
 /// `[target]`: the target shape, one `[x, y]` per agent in `[[agents]]` order; compared

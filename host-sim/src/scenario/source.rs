@@ -7,6 +7,7 @@ use super::schema::ScenarioFile;
 use super::toml_text::{
     did_you_mean, field_at, line_col, one_line, parse_override_value, set_path,
 };
+use super::world::{self, PRESETS};
 use std::path::Path;
 
 /// A scenario's TOML text and where it came from.
@@ -82,7 +83,7 @@ impl Source {
     pub fn parse(&self, overrides: &[String]) -> Result<ScenarioFile, ScenarioError> {
         // Deserialize the file itself first: errors carry its line and column.
         let file: ScenarioFile = toml::from_str(&self.text).map_err(|e| self.toml_error(&e))?;
-        if overrides.is_empty() {
+        if overrides.is_empty() && file.world.is_none() {
             return Ok(file);
         }
         let mut value: toml::Value = toml::from_str(&self.text).map_err(|e| self.toml_error(&e))?;
@@ -119,7 +120,57 @@ impl Source {
                 )
             })?;
         }
-        Ok(parsed)
+        match parsed.world.clone() {
+            Some(world) => self.with_world(value, &world),
+            None => Ok(parsed),
+        }
+    }
+
+    /// The scenario `value` (the file with its overrides) with the world preset `name`
+    /// merged under it ([`super::world::merge_under`]).
+    fn with_world(
+        &self,
+        mut value: toml::Value,
+        name: &str,
+    ) -> Result<ScenarioFile, ScenarioError> {
+        let names: Vec<&str> = PRESETS.iter().map(|p| p.name).collect();
+        let preset = world::preset(name).ok_or_else(|| {
+            ScenarioError::new(
+                ErrorKind::InvalidValue,
+                &self.label,
+                "world",
+                format!(
+                    "unknown world `{name}`; the presets are {}",
+                    names.join(", ")
+                ),
+            )
+        })?;
+        let under: toml::Table = toml::from_str(preset.toml).map_err(|e| {
+            ScenarioError::new(
+                ErrorKind::Syntax,
+                &self.label,
+                "world",
+                format!(
+                    "the preset `{name}` does not parse: {}",
+                    one_line(e.message())
+                ),
+            )
+        })?;
+        if let toml::Value::Table(t) = &mut value {
+            world::merge_under(t, &under);
+        }
+        value.try_into().map_err(|e: toml::de::Error| {
+            ScenarioError::new(
+                ErrorKind::Syntax,
+                &self.label,
+                "world",
+                format!(
+                    "world = \"{name}\": {}{}",
+                    one_line(&e.to_string()),
+                    suggestion(e.message())
+                ),
+            )
+        })
     }
 
     fn toml_error(&self, e: &toml::de::Error) -> ScenarioError {

@@ -76,6 +76,7 @@ pub fn strip_model(n: usize, duration: f64) -> Model {
         criteria: Criteria::default(),
         graph: Graph::new(n, &tri, None),
         attacks: Vec::new(),
+        world: crate::model::WorldModel::ideal(),
         // The equilateral strip the 60° angles encode.
         target: Target {
             positions: (0..n)

@@ -6,7 +6,7 @@
 //! estimates for the diagnostics while its state is in cache (a separate pass over
 //! 100,000 agents' states costs a second walk through memory).
 
-use super::tick::{AgentSlots, Walk};
+use super::tick::{world_force, AgentSlots, AgentTick, Walk};
 use super::{SampledSim, Scene};
 use crate::engine::controller::AgentController;
 use crate::engine::radio::RadioFrame;
@@ -88,10 +88,10 @@ impl Walk<'_> {
     fn agent(&self, i: usize, mut a: AgentSlots<'_>) -> TickSums {
         // Only in-process controllers take this walk (`SampledSim::parallel`): their tick
         // completes at once and never fails.
-        let Ok((Some(out), delivered)) = self.start(i, &mut a) else {
+        let Ok((Some(out), delivered)) = self.start(i, &mut a, self.at) else {
             return TickSums::default();
         };
-        *a.force = out.force;
+        *a.force = world_force(self.headings, i, &self.at, out.force);
         let mut sums = TickSums {
             delivered,
             broadcasts: a.outbox.len() as u64,
@@ -99,8 +99,14 @@ impl Walk<'_> {
             stats: ControlStats::default(),
         };
         let norm = out.force.norm();
-        sums.stats
-            .record(self.t, i, out.status, out.saturated, out.degenerate, norm);
+        sums.stats.record(
+            self.at.time,
+            i,
+            out.status,
+            out.saturated,
+            out.degenerate,
+            norm,
+        );
         sums
     }
 
@@ -152,9 +158,9 @@ impl SampledSim<'_> {
     pub(super) fn tick_parallel(&mut self, t: f64, dt: f64, tick: u64) {
         let model = self.model;
         let walk = Walk {
-            t,
-            dt,
-            scene: Scene::of(model, &self.plant, &self.senses, tick),
+            at: AgentTick { time: t, dt, tick },
+            headings: self.world.headings.as_ref(),
+            scene: Scene::of(model, &*self.plant, &self.senses),
             radio: &model.graph.radio,
             slot_order: &self.slot_order,
             sent: &self.sent,
@@ -177,5 +183,10 @@ impl SampledSim<'_> {
             self.radio.count_direct_sums(sums.broadcasts, sums.copies);
         }
         self.stats.merge(&sums.stats);
+        if self.plant.takes_commands() {
+            for (i, f) in self.forces.iter().enumerate() {
+                self.plant.command(i, *f, dt);
+            }
+        }
     }
 }

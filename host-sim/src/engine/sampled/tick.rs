@@ -9,13 +9,25 @@ use crate::engine::hil::HilError;
 use crate::engine::radio::RadioFrame;
 use crate::engine::slot_order::SlotOrder;
 use crate::engine::speed::prefetch::{self, Footprint};
+use crate::engine::world::Headings;
 use crate::model::graph::Adjacency;
 use controller_core::{BearingMeasurement, Measurements, StepOutput, Vec2, MAX_NEIGHBOURS};
 
+/// When one agent ticks: its clock's reading, the time since its previous tick by its
+/// clock, and the index of its tick (of its random streams).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(super) struct AgentTick {
+    pub(super) time: f64,
+    pub(super) dt: f64,
+    pub(super) tick: u64,
+}
+
 /// What an agent's tick reads of the others (shared by every thread).
 pub(super) struct Walk<'a> {
-    pub(super) t: f64,
-    pub(super) dt: f64,
+    /// This tick on the common clock (every agent's when the clocks are ideal).
+    pub(super) at: AgentTick,
+    /// Every agent's heading estimate, when the world has body frames.
+    pub(super) headings: Option<&'a Headings>,
     /// The state and sensors, with this tick's index.
     pub(super) scene: Scene<'a>,
     pub(super) radio: &'a Adjacency,
@@ -45,6 +57,7 @@ impl Walk<'_> {
         &self,
         i: usize,
         a: &mut AgentSlots<'_>,
+        at: AgentTick,
     ) -> Result<(Option<StepOutput<f64>>, u64), HilError> {
         // The agents ahead in this walk are the next ones.
         prefetch_agent(self.footprints, self.sent, i + prefetch::AHEAD);
@@ -52,13 +65,24 @@ impl Walk<'_> {
         // MAX_NEIGHBOURS triangle neighbours: one bearing each fits.
         let mut bearings: heapless::Vec<BearingMeasurement<f64>, MAX_NEIGHBOURS> =
             heapless::Vec::new();
-        let (velocity, partner_offset) = self.scene.measure(i, |b| {
+        let (mut velocity, mut partner_offset) = self.scene.measure(i, at.tick, |b| {
             let _ = bearings.push(b);
         });
+        if let Some(h) = self.headings {
+            // Measured in the body frame, turned into the agent's world frame through its
+            // heading estimate: the world rotated by its error e_i (docs/world.md).
+            let f = h.frames(i, at.time, at.tick);
+            for b in &mut bearings {
+                b.bearing = f.sensed(&b.bearing);
+                b.rate = b.rate.map(|r| f.sensed(&r));
+            }
+            velocity = f.sensed(&velocity);
+            partner_offset = partner_offset.map(|p| f.sensed(&p));
+        }
         self.slot_order.apply(i, &mut bearings);
         let m = Measurements {
-            time: self.t,
-            dt: self.dt,
+            time: at.time,
+            dt: at.dt,
             velocity,
             bearings: &bearings,
             partner_offset,
@@ -72,5 +96,21 @@ impl Walk<'_> {
         }
         a.inbox.clear();
         Ok((out, delivered))
+    }
+}
+
+/// Agent `i`'s force `U` of its tick `at` in the world frame: the agent commands it in
+/// its estimated world frame, its body applies it in the true one (`R(−e_i) U`,
+/// docs/world.md); unchanged without body frames.
+#[inline]
+pub(super) fn world_force(
+    headings: Option<&Headings>,
+    i: usize,
+    at: &AgentTick,
+    force: Vec2<f64>,
+) -> Vec2<f64> {
+    match headings {
+        Some(h) => h.frames(i, at.time, at.tick).applied(&force),
+        None => force,
     }
 }

@@ -12,6 +12,7 @@ mod references;
 mod settings;
 mod target;
 mod triangles;
+mod world;
 
 use crate::model::{Graph, Model, RadioModel, SensorModel};
 use crate::scenario::error::{ErrorKind::InvalidValue, ScenarioError, ScenarioErrors};
@@ -58,6 +59,7 @@ fn check(
     let comm_every = comm::comm_every(&mut c, s, period);
     let channel = comm::channel(&mut c, s, period);
     let auth_key = comm::auth_key(&mut c, s);
+    let world = world::check(&mut c, s, period);
     let (mut agents, index) = agents::check(&mut c, s);
     let (triangles, ids_ok) = triangles::check(&mut c, s, &index, margin);
     let order = graph::check(&mut c, s, &agents, &triangles, ids_ok, margin);
@@ -134,6 +136,7 @@ fn check(
         graph,
         attacks,
         target,
+        world,
     };
     // Last line of defence: the core's own checks (should agree with the above).
     let mut core_errors = Vec::new();

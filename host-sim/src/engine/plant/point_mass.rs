@@ -1,19 +1,23 @@
-//! The plant S1 (`q̇ = v`, `m v̇ = −D^r v + U`) of every agent, integrated with
-//! fixed-step RK4 while the controllers' forces are held (zero-order hold).
+//! The paper's plant S1 (`q̇ = v`, `m v̇ = −D^r v + U`) of every agent, integrated with
+//! fixed-step RK4 while the controllers' forces are held (zero-order hold); with wind,
+//! `m v̇ = −D^r v + U + m a_w`.
 
+use super::{Held, Plant};
 use crate::model::Model;
 use controller_core::Vec2;
 use rayon::prelude::*;
 
 /// Positions and velocities of all agents, with their masses and friction.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Plant {
+pub struct PointMass {
     /// Positions `q_n`.
     pub q: Vec<Vec2<f64>>,
     /// Velocities `v_n`.
     pub v: Vec<Vec2<f64>>,
     mass: Vec<f64>,
     friction: Vec<[f64; 2]>,
+    /// The held forces with the wind's (reused: no allocation per step).
+    scratch: Vec<Vec2<f64>>,
 }
 
 /// `v̇ = (U − D v) / m` for one agent.
@@ -25,7 +29,7 @@ pub fn acceleration(v: &Vec2<f64>, u: &Vec2<f64>, mass: f64, friction: &[f64; 2]
     )
 }
 
-impl Plant {
+impl PointMass {
     /// The initial state of the model's agents.
     pub fn new(model: &Model) -> Self {
         let a = &model.agents;
@@ -38,6 +42,7 @@ impl Plant {
                 .collect(),
             mass: a.iter().map(|x| x.mass).collect(),
             friction: a.iter().map(|x| x.friction).collect(),
+            scratch: Vec::new(),
         }
     }
 
@@ -53,7 +58,7 @@ impl Plant {
 
     /// One RK4 step of length `dt` with the forces held constant. The agents are
     /// uncoupled between control ticks, so each is integrated on its own.
-    pub fn step(&mut self, forces: &[Vec2<f64>], dt: f64) {
+    pub fn step_once(&mut self, forces: &[Vec2<f64>], dt: f64) {
         step_agents(
             Span {
                 q: &mut self.q,
@@ -66,10 +71,10 @@ impl Plant {
         );
     }
 
-    /// `steps` of [`Self::step`] on every thread of the current rayon pool, `chunk` agents
-    /// per work item, each taking all the steps of its agents (one fork-join for all the
-    /// steps, and a run's state stays in its thread's cache); the same result bit for bit
-    /// (each agent's step is independent).
+    /// `steps` of [`Self::step_once`] on every thread of the current rayon pool, `chunk`
+    /// agents per work item, each taking all the steps of its agents (one fork-join for
+    /// all the steps, and a run's state stays in its thread's cache); the same result bit
+    /// for bit (each agent's step is independent).
     pub fn step_parallel(&mut self, forces: &[Vec2<f64>], dt: f64, steps: usize, chunk: usize) {
         let chunk = chunk.max(1);
         self.q
@@ -87,6 +92,45 @@ impl Plant {
                     step_agents(Span { q, v, u, m, d }, dt);
                 }
             });
+    }
+}
+
+impl Plant for PointMass {
+    fn q(&self) -> &[Vec2<f64>] {
+        &self.q
+    }
+
+    fn v(&self) -> &[Vec2<f64>] {
+        &self.v
+    }
+
+    /// With wind, the held force of agent `n` becomes `U_n + m_n a_w,n` (S1 with the
+    /// wind's force), one step at a time over all agents.
+    fn step(&mut self, held: &Held<'_>, dt: f64, steps: usize, chunk: Option<usize>) {
+        if !held.wind.is_empty() {
+            let mut with_wind = std::mem::take(&mut self.scratch);
+            with_wind.clear();
+            with_wind.extend(
+                held.forces
+                    .iter()
+                    .zip(held.wind)
+                    .zip(&self.mass)
+                    .map(|((u, w), m)| u + w * *m),
+            );
+            for _ in 0..steps {
+                self.step_once(&with_wind, dt);
+            }
+            self.scratch = with_wind;
+            return;
+        }
+        match chunk {
+            Some(chunk) => self.step_parallel(held.forces, dt, steps, chunk),
+            None => {
+                for _ in 0..steps {
+                    self.step_once(held.forces, dt);
+                }
+            }
+        }
     }
 }
 
@@ -217,15 +261,16 @@ mod tests {
     #[test]
     fn constant_force_matches_closed_form() {
         // m v̇ = −d v + U: v(t) = U/d (1 − e^{−d t / m}).
-        let mut p = Plant {
+        let mut p = PointMass {
             q: vec![Vec2::zeros()],
             v: vec![Vec2::zeros()],
             mass: vec![2.0],
             friction: vec![[0.5, 0.5]],
+            scratch: Vec::new(),
         };
         let u = [Vec2::new(1.0, -2.0)];
         for _ in 0..1000 {
-            p.step(&u, 1e-3);
+            p.step_once(&u, 1e-3);
         }
         let k: f64 = 0.5 / 2.0;
         let v = (1.0 - (-k).exp()) / 0.5;
@@ -279,7 +324,8 @@ mod tests {
     fn parallel_steps_in_runs_are_single_steps_bit_for_bit() {
         let n = 37;
         let f = |i: usize, k: f64| (i as f64 * 0.53 + k).cos() * (1.0 + k);
-        let plant = Plant {
+        let plant = PointMass {
+            scratch: Vec::new(),
             q: (0..n).map(|i| Vec2::new(f(i, 1.0), f(i, 2.0))).collect(),
             v: (0..n).map(|i| Vec2::new(f(i, 3.0), f(i, 4.0))).collect(),
             mass: (0..n).map(|i| 0.3 + f(i, 7.0).abs()).collect(),
@@ -289,11 +335,11 @@ mod tests {
         let dt = 0.071;
         let mut one = plant.clone();
         for _ in 0..10 {
-            one.step(&u, dt);
+            one.step_once(&u, dt);
         }
         let mut parallel = plant;
         parallel.step_parallel(&u, dt, 10, 4);
-        let bits = |p: &Plant| -> Vec<[u64; 4]> {
+        let bits = |p: &PointMass| -> Vec<[u64; 4]> {
             p.q.iter()
                 .zip(&p.v)
                 .map(|(q, v)| [q.x, q.y, v.x, v.y].map(f64::to_bits))

@@ -1,0 +1,53 @@
+//! The vehicles: what every agent's body does with its controller's output between
+//! ticks. One [`Plant`] per run, holding every agent's state; the paper's point mass S1
+//! ([`PointMass`]) and a velocity-tracking vehicle ([`VelocityTrackingPlant`]).
+//! `docs/architecture.md` ("Add a vehicle") says how to add one: a file here and a
+//! variant of [`crate::model::VehicleModel`].
+
+mod point_mass;
+mod velocity_tracking;
+
+pub use point_mass::{acceleration, PointMass};
+pub use velocity_tracking::{tracking_acceleration, VelocityTrackingPlant};
+
+use super::error::SetupError;
+use crate::model::{Model, VehicleModel};
+use controller_core::Vec2;
+
+/// What the plant holds between ticks: every agent's last force (N, world frame) and
+/// the wind's acceleration on it (m/s²; empty: no wind).
+#[derive(Clone, Copy, Debug)]
+pub struct Held<'a> {
+    /// The forces of the agents' last ticks, in agent order.
+    pub forces: &'a [Vec2<f64>],
+    /// The wind on each agent, in agent order, or empty.
+    pub wind: &'a [Vec2<f64>],
+}
+
+/// Every agent's vehicle: its state, what it does with a tick's force, and its motion
+/// between ticks.
+pub trait Plant: Send + Sync {
+    /// Positions `q_n` (m, world frame).
+    fn q(&self) -> &[Vec2<f64>];
+    /// Velocities `v_n` (m/s, world frame).
+    fn v(&self) -> &[Vec2<f64>];
+    /// Whether the plant needs [`Plant::command`] at every tick (a point mass reads the
+    /// held forces in [`Plant::step`] and needs nothing more).
+    fn takes_commands(&self) -> bool {
+        false
+    }
+    /// Agent `i`'s force of its tick (N, world frame), `period` seconds by its own clock
+    /// after its previous tick.
+    fn command(&mut self, _i: usize, _force: Vec2<f64>, _period: f64) {}
+    /// `steps` RK4 steps of length `dt` under `held`; `chunk`: on every thread of the
+    /// current rayon pool, `chunk` agents per work item (the same bits either way).
+    fn step(&mut self, held: &Held<'_>, dt: f64, steps: usize, chunk: Option<usize>);
+}
+
+/// The plant of `model`'s vehicle, at the model's initial state.
+pub fn new_plant(model: &Model) -> Result<Box<dyn Plant>, SetupError> {
+    Ok(match &model.world.vehicle {
+        VehicleModel::PointMass => Box::new(PointMass::new(model)),
+        VehicleModel::VelocityTracking(v) => Box::new(VelocityTrackingPlant::new(model, v)?),
+    })
+}

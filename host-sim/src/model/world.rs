@@ -1,0 +1,138 @@
+//! The robot's world (`docs/world.md`): the vehicle each agent is, the wind on it, its
+//! heading and body frame, and its own clock. The ideal world ([`WorldModel::ideal`]) is
+//! the paper's: point masses pushed by the ideal force, one world frame, one clock.
+
+/// The vehicle model of every agent (`[plant] model`).
+#[derive(Clone, Debug, PartialEq)]
+pub enum VehicleModel {
+    /// SPEC S1: `m v̇ = −D^r v + U` (the paper's plant).
+    PointMass,
+    /// A vehicle whose own controller tracks a velocity setpoint (a Crazyflie in
+    /// position/velocity mode, a rover's wheel controller); the agent's force becomes the
+    /// setpoint through the virtual mass of `controller_core::actuate`.
+    VelocityTracking(VelocityTracking),
+}
+
+/// A velocity-tracking vehicle: `v̇ = sat_{a_max}((v_sp − v) / τ)`, `|v_sp| ≤ v_max`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VelocityTracking {
+    /// `τ`, the time constant of the vehicle's velocity loop (s, > 0).
+    pub time_constant: f64,
+    /// `a_max`, the largest acceleration the vehicle can give itself (m/s², > 0; from a
+    /// tilt limit θ: `g tan θ`).
+    pub max_acceleration: f64,
+    /// `v_max`, the largest velocity setpoint (m/s, > 0).
+    pub max_speed: f64,
+    /// The lead the agent's actuation gives its setpoints (s, ≥ 0; SPEC S19): what the
+    /// agent believes `τ` to be.
+    pub lead: f64,
+}
+
+/// Wind on every agent: a constant part plus gusts, each agent's gust an independent
+/// first-order (Ornstein–Uhlenbeck) process per axis. In units of acceleration (the
+/// wind's force per unit mass).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WindModel {
+    /// The constant part (m/s²).
+    pub mean: [f64; 2],
+    /// The gusts' stationary standard deviation per axis (m/s²).
+    pub gust: f64,
+    /// The gusts' correlation time (s, > 0).
+    pub gust_time_constant: f64,
+}
+
+/// Every agent's heading (the direction of its body x axis) and the agent's own
+/// estimate of it. Bearings, velocity and the partner offset are measured in the body
+/// frame; the agent turns them into its world frame, and its command back into the body
+/// frame, through its estimate, whose error `e_i(t) = e_i(0) + ω_i t + n_i(t)` rotates
+/// everything it senses and commands.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HeadingModel {
+    /// The true heading of every agent (rad).
+    pub initial: f64,
+    /// Each agent's true heading is `initial` plus a uniform draw in `±spread` (rad).
+    pub spread: f64,
+    /// Standard deviation of each agent's initial estimate error `e_i(0)` (rad).
+    pub error: f64,
+    /// Standard deviation of each agent's drift rate `ω_i` of its estimate error (rad/s).
+    pub drift: f64,
+    /// Standard deviation of the white estimate noise `n_i` at each tick (rad).
+    pub noise: f64,
+}
+
+/// Every agent's own clock: it ticks at its own instants. Agent `i`'s clock reads
+/// `τ_i(t) = (1 + ε_i) t + φ_i`; its `k`-th tick is due when `τ_i = k T` (`T` the
+/// control period), jittered.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClockModel {
+    /// Each agent's phase `φ_i` is drawn uniformly in `[0, offset)` (s).
+    pub offset: f64,
+    /// Each agent's rate error `ε_i` is drawn uniformly in `±ppm · 10⁻⁶`.
+    pub ppm: f64,
+    /// Standard deviation of each tick's instant (s; clamped to ±0.45 T).
+    pub jitter: f64,
+}
+
+impl ClockModel {
+    /// Whether every clock is the simulator's: no phase, rate error or jitter.
+    pub fn is_ideal(&self) -> bool {
+        self.offset == 0.0 && self.ppm == 0.0 && self.jitter == 0.0
+    }
+}
+
+/// The world of a run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WorldModel {
+    /// The preset the world was filled from (`ideal` or `crazyflie`).
+    pub preset: String,
+    /// The vehicle.
+    pub vehicle: VehicleModel,
+    /// Wind, if any.
+    pub wind: Option<WindModel>,
+    /// Headings and body frames, if modelled (`None`: every agent measures and acts in
+    /// the world frame).
+    pub heading: Option<HeadingModel>,
+    /// Own clocks, if any is not ideal (`None`: every agent ticks at the same instants).
+    pub clock: Option<ClockModel>,
+    /// Settings that are assumptions rather than published figures, as `key: reason`
+    /// (written to `summary.json`).
+    pub assumptions: Vec<String>,
+}
+
+impl WorldModel {
+    /// The paper's world: point masses, no wind, one frame, one clock.
+    pub fn ideal() -> Self {
+        Self {
+            preset: "ideal".to_owned(),
+            vehicle: VehicleModel::PointMass,
+            wind: None,
+            heading: None,
+            clock: None,
+            assumptions: Vec::new(),
+        }
+    }
+
+    /// Whether this is the paper's world (the simulator's fast paths apply).
+    pub fn is_ideal(&self) -> bool {
+        let Self {
+            preset: _, // a name: the models below are what counts
+            vehicle,
+            wind,
+            heading,
+            clock,
+            assumptions: _, // documentation of the values
+        } = self;
+        *vehicle == VehicleModel::PointMass
+            && wind.is_none()
+            && heading.is_none()
+            && clock.is_none()
+    }
+
+    /// The vehicle's speed limit, if it has one (m/s).
+    pub fn max_speed(&self) -> Option<f64> {
+        match &self.vehicle {
+            VehicleModel::PointMass => None,
+            VehicleModel::VelocityTracking(v) => Some(v.max_speed),
+        }
+    }
+}
