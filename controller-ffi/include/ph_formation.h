@@ -63,10 +63,10 @@
 
 /**
  * Version of this C ABI (the header's structs and functions; 3: `ph_config` gained
- * `bearing_filter`). Compare the header's
+ * `bearing_filter`; 4: `ph_actuator` and `ph_actuator_init` gained the lead). Compare the header's
  * value with `ph_abi_version()` of the library you link.
  */
-#define PH_ABI_VERSION 3
+#define PH_ABI_VERSION 4
 
 /**
  * An upper bound of a blob's length: a configuration with every capacity used
@@ -478,7 +478,13 @@ typedef struct {
    */
   float max_speed;
   /**
-   * The current velocity setpoint (m/s, world frame), valid when `has_command`.
+   * Lead (s, ≥ 0): the time constant of the vehicle's own velocity loop, which the
+   * setpoints anticipate (SPEC S19); 0 for none.
+   */
+  float lead;
+  /**
+   * The virtual velocity (m/s, world frame: the setpoint without lead), valid when
+   * `has_command`.
    */
   float command[2];
   /**
@@ -900,8 +906,10 @@ extern "C" {
 /**
  * Fills `*actuator` for `agent`: mass `mass`, the friction `D^r` of the agent's
  * configuration (so that the controller cancels the friction the plant has), speed
- * limit `max_speed`, no setpoint yet. `PH_ERR_ARGUMENT` for a mass that is not finite
- * and positive or a `max_speed` that is NaN or not positive.
+ * limit `max_speed`, lead `lead` (the vehicle's velocity-loop time constant, SPEC S19;
+ * 0 for none), no setpoint yet. `PH_ERR_ARGUMENT` for a mass that is not finite and
+ * positive, a `max_speed` that is NaN or not positive, or a lead that is not finite and
+ * non-negative.
  *
  * # Safety
  * `actuator` is NULL or writable; `agent` as for `ph_stats`.
@@ -909,13 +917,15 @@ extern "C" {
 ph_status ph_actuator_init(ph_actuator *actuator,
                            const ph_agent *agent,
                            float mass,
-                           float max_speed);
+                           float max_speed,
+                           float lead);
 
 /**
- * One control period: integrates S1 from the previous setpoint (the first time from
- * `velocity[0..2]`, the vehicle's measured velocity) under `force[0..2]` (the
- * `ph_output.force` of this tick) for `dt` seconds, and writes the new setpoint to
- * `setpoint[0..2]` and `actuator->command`. `PH_ERR_ARGUMENT` (nothing written) for
+ * One control period: integrates S1 from the previous virtual velocity (the first time
+ * from `velocity[0..2]`, the vehicle's measured velocity) under `force[0..2]` (the
+ * `ph_output.force` of this tick) for `dt` seconds (SPEC S18), keeps the new virtual
+ * velocity in `actuator->command`, and writes the setpoint (S19: led by
+ * `actuator->lead`) to `setpoint[0..2]`. `PH_ERR_ARGUMENT` (nothing written) for
  * an actuator whose parameters `ph_actuator_init` would refuse.
  *
  * # Safety

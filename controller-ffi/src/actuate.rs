@@ -20,7 +20,11 @@ pub struct ph_actuator {
     pub friction: [f32; 2],
     /// Largest setpoint speed (m/s, > 0; `INFINITY` for none): the vehicle's limit.
     pub max_speed: f32,
-    /// The current velocity setpoint (m/s, world frame), valid when `has_command`.
+    /// Lead (s, ≥ 0): the time constant of the vehicle's own velocity loop, which the
+    /// setpoints anticipate (SPEC S19); 0 for none.
+    pub lead: f32,
+    /// The virtual velocity (m/s, world frame: the setpoint without lead), valid when
+    /// `has_command`.
     pub command: [f32; 2],
     /// 1 once `ph_actuate` has produced a setpoint.
     pub has_command: u8,
@@ -28,8 +32,10 @@ pub struct ph_actuator {
 
 /// Fills `*actuator` for `agent`: mass `mass`, the friction `D^r` of the agent's
 /// configuration (so that the controller cancels the friction the plant has), speed
-/// limit `max_speed`, no setpoint yet. `PH_ERR_ARGUMENT` for a mass that is not finite
-/// and positive or a `max_speed` that is NaN or not positive.
+/// limit `max_speed`, lead `lead` (the vehicle's velocity-loop time constant, SPEC S19;
+/// 0 for none), no setpoint yet. `PH_ERR_ARGUMENT` for a mass that is not finite and
+/// positive, a `max_speed` that is NaN or not positive, or a lead that is not finite and
+/// non-negative.
 ///
 /// # Safety
 /// `actuator` is NULL or writable; `agent` as for `ph_stats`.
@@ -39,16 +45,19 @@ pub unsafe extern "C" fn ph_actuator_init(
     agent: *const ph_agent,
     mass: f32,
     max_speed: f32,
+    lead: f32,
 ) -> ph_status {
     // SAFETY: per this function's contract.
     let r = unsafe { storage::agent_ref(agent) }.and_then(|a| {
         let friction = a.config().friction;
-        let plant =
-            VirtualMass::new(mass, friction, max_speed).map_err(|_| ph_status::PH_ERR_ARGUMENT)?;
+        let plant = VirtualMass::new(mass, friction, max_speed)
+            .and_then(|p| p.with_lead(lead))
+            .map_err(|_| ph_status::PH_ERR_ARGUMENT)?;
         let value = ph_actuator {
             mass: plant.mass(),
             friction: plant.friction(),
             max_speed: plant.max_speed(),
+            lead: plant.lead(),
             command: [0.0; 2],
             has_command: 0,
         };
@@ -58,10 +67,11 @@ pub unsafe extern "C" fn ph_actuator_init(
     status(r)
 }
 
-/// One control period: integrates S1 from the previous setpoint (the first time from
-/// `velocity[0..2]`, the vehicle's measured velocity) under `force[0..2]` (the
-/// `ph_output.force` of this tick) for `dt` seconds, and writes the new setpoint to
-/// `setpoint[0..2]` and `actuator->command`. `PH_ERR_ARGUMENT` (nothing written) for
+/// One control period: integrates S1 from the previous virtual velocity (the first time
+/// from `velocity[0..2]`, the vehicle's measured velocity) under `force[0..2]` (the
+/// `ph_output.force` of this tick) for `dt` seconds (SPEC S18), keeps the new virtual
+/// velocity in `actuator->command`, and writes the setpoint (S19: led by
+/// `actuator->lead`) to `setpoint[0..2]`. `PH_ERR_ARGUMENT` (nothing written) for
 /// an actuator whose parameters `ph_actuator_init` would refuse.
 ///
 /// # Safety
@@ -84,11 +94,12 @@ pub unsafe extern "C" fn ph_actuate(
         // SAFETY: per this function's contract.
         let a = unsafe { input(actuator.cast_const()) }?;
         let plant = VirtualMass::new(a.mass, a.friction, a.max_speed)
+            .and_then(|p| p.with_lead(a.lead))
             .map_err(|_| ph_status::PH_ERR_ARGUMENT)?;
         let mut command = VelocityCommand::resume(plant, (a.has_command != 0).then_some(a.command));
         let next = command.step(*force, *velocity, dt);
         let updated = ph_actuator {
-            command: next,
+            command: command.command().unwrap_or(next),
             has_command: 1,
             ..*a
         };

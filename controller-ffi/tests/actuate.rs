@@ -46,7 +46,7 @@ fn the_c_api_steps_the_cores_velocity_command() {
     let mut act = ph_actuator::default();
     // SAFETY: valid pointers.
     assert_eq!(
-        unsafe { ph_actuator_init(&mut act, a, 2.0, 1.0) },
+        unsafe { ph_actuator_init(&mut act, a, 2.0, 1.0, 0.0) },
         ph_status::PH_OK
     );
     assert_eq!(act.friction, [0.5, 0.25], "the agent's D^r");
@@ -90,6 +90,49 @@ fn the_c_api_steps_the_cores_velocity_command() {
     assert_eq!(setpoint, measured);
 }
 
+/// With a lead, the setpoint is the core's led setpoint (S19) and the actuator keeps the
+/// virtual velocity; a negative lead is refused.
+#[test]
+fn the_lead_is_the_cores() {
+    let mut mem = Memory([0; PH_AGENT_SIZE]);
+    let a = agent(&mut mem);
+    let mut act = ph_actuator::default();
+    // SAFETY: valid pointers.
+    unsafe {
+        assert_eq!(
+            ph_actuator_init(&mut act, a, 1.0, 2.0, -0.1),
+            ph_status::PH_ERR_ARGUMENT
+        );
+        assert_eq!(
+            ph_actuator_init(&mut act, a, 1.0, 2.0, 0.23),
+            ph_status::PH_OK
+        );
+    }
+    assert_eq!(act.lead, 0.23);
+    let plant = VirtualMass::new(1.0_f32, [0.5, 0.25], 2.0)
+        .and_then(|p| p.with_lead(0.23))
+        .unwrap();
+    let mut reference = VelocityCommand::new(plant);
+    let (measured, force) = ([0.1_f32, 0.0], [1.0_f32, -1.0]);
+    let mut setpoint = [0.0_f32; 2];
+    for _ in 0..3 {
+        // SAFETY: valid pointers to 2 floats.
+        let s = unsafe {
+            ph_actuate(
+                &mut act,
+                force.as_ptr(),
+                measured.as_ptr(),
+                0.01,
+                setpoint.as_mut_ptr(),
+            )
+        };
+        assert_eq!(s, ph_status::PH_OK);
+        assert_eq!(setpoint, reference.step(force, measured, 0.01));
+        assert_eq!(Some(act.command), reference.command());
+        assert_ne!(setpoint, act.command, "the lead moves the setpoint ahead");
+    }
+}
+
 #[test]
 fn bad_arguments_are_refused() {
     let mut mem = Memory([0; PH_AGENT_SIZE]);
@@ -98,20 +141,20 @@ fn bad_arguments_are_refused() {
     // SAFETY: valid pointers (or NULL).
     unsafe {
         assert_eq!(
-            ph_actuator_init(&mut act, a, 0.0, 1.0),
+            ph_actuator_init(&mut act, a, 0.0, 1.0, 0.0),
             ph_status::PH_ERR_ARGUMENT
         );
         assert_eq!(
-            ph_actuator_init(&mut act, a, 1.0, f32::NAN),
+            ph_actuator_init(&mut act, a, 1.0, f32::NAN, 0.0),
             ph_status::PH_ERR_ARGUMENT
         );
         assert_eq!(
-            ph_actuator_init(core::ptr::null_mut(), a, 1.0, 1.0),
+            ph_actuator_init(core::ptr::null_mut(), a, 1.0, 1.0, 0.0),
             ph_status::PH_ERR_NULL
         );
         let zero = Memory([0; PH_AGENT_SIZE]);
         assert_eq!(
-            ph_actuator_init(&mut act, zero.0.as_ptr().cast(), 1.0, 1.0),
+            ph_actuator_init(&mut act, zero.0.as_ptr().cast(), 1.0, 1.0, 0.0),
             ph_status::PH_ERR_NOT_INITIALIZED
         );
         // A never-initialised actuator (mass 0) is refused and left alone.

@@ -23,7 +23,8 @@ ph_status agent_loop_init(agent_loop *loop, uint8_t *memory, size_t size, uint8_
         s = ph_agent_init_blob(loop->agent, size, blob, len);
 #endif
     if (s == PH_OK)
-        s = ph_actuator_init(&loop->actuator, loop->agent, FORMATION_MASS, FORMATION_MAX_SPEED);
+        s = ph_actuator_init(&loop->actuator, loop->agent, FORMATION_MASS, FORMATION_MAX_SPEED,
+                             FORMATION_LEAD);
     if (s == PH_OK)
         s = formation_state_init(&loop->formation, loop->agent);
     return s;

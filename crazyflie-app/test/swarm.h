@@ -18,10 +18,10 @@
 #include "ph_formation.h"
 
 #define SWARM_N 4
-/* Velocity tracking lag of the simulated Crazyflie (s): an assumption, not a
- * measurement; the formation converges here for 0.05 to 0.3 s. */
+/* Velocity tracking lag of the simulated Crazyflie (s): the value derived from the
+ * firmware's velocity gain (FORMATION_LEAD, docs/world.md), not a measurement. */
 #ifndef SWARM_TAU
-#define SWARM_TAU 0.1f
+#define SWARM_TAU FORMATION_LEAD
 #endif
 /* Give up after this many simulated seconds. */
 #define SWARM_MAX_TIME_S 60u

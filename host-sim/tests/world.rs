@@ -1,0 +1,270 @@
+//! The robot's world (docs/world.md): clocks that drift by exactly their ppm, body frames
+//! that change nothing when every heading estimate is right, the wind's gust process, the
+//! `crazyflie` preset on room-sized formations, the speed-limit warning, and every new
+//! field refused with file, field and reason.
+
+use host_sim::engine::world::{Clocks, Headings, Wind};
+use host_sim::engine::{self as sim, NullRecorder, RunResult};
+use host_sim::model::{ClockModel, HeadingModel, Model, WindModel};
+use host_sim::{load, Outcome};
+
+fn model(name: &str, overrides: &[&str]) -> Model {
+    let o: Vec<String> = overrides.iter().map(|s| (*s).to_owned()).collect();
+    load(name, &o).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+fn run(m: &Model) -> RunResult {
+    sim::run(m, &mut NullRecorder, &mut |_| {}).expect("run")
+}
+
+fn refused(overrides: &[&str]) -> String {
+    let o: Vec<String> = overrides.iter().map(|s| (*s).to_owned()).collect();
+    match load("formation-only", &o) {
+        Ok(_) => panic!("{overrides:?} was accepted"),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// Each agent's clock reads `(1 + ε) t + φ` and ticks `k T` apart on it: over 1,000 s an
+/// agent of rate error ε ticks `⌊1000 (1 + ε) / T⌋ + 1` times, and its readings advance
+/// by exactly its rate.
+#[test]
+fn a_clock_drifts_by_exactly_its_ppm() {
+    let m = model("formation-only", &["duration=1000"]);
+    let c = ClockModel {
+        offset: 0.0,
+        ppm: 50.0,
+        jitter: 0.0,
+    };
+    let mut clocks = Clocks::new(&m, &c);
+    let period = m.control_period();
+    let steps = m.total_steps();
+    let mut counts = vec![0u64; m.n()];
+    let mut last = vec![(0.0, 0.0); m.n()];
+    for step in 0..=steps {
+        if !clocks.any_due(step) {
+            continue;
+        }
+        let t = m.time(step);
+        for (i, count) in counts.iter_mut().enumerate() {
+            if clocks.due(i, step) {
+                let (local, _, k) = clocks.tick(i, t, step);
+                assert_eq!(k, *count, "agent {i}: ticks in order");
+                *count += 1;
+                last[i] = (t, local);
+            }
+        }
+    }
+    let mut rates = Vec::new();
+    for (i, &count) in counts.iter().enumerate() {
+        let rate = clocks.rate(i);
+        let ppm = (rate - 1.0) * 1e6;
+        assert!(ppm.abs() <= 50.0, "agent {i}: {ppm} ppm");
+        let want = (1000.0 * rate / period + 1e-9).floor() as u64 + 1;
+        assert_eq!(count, want, "agent {i} at {ppm:.2} ppm");
+        let (t, local) = last[i];
+        assert!(
+            (local - rate * t).abs() < 1e-9,
+            "agent {i}: reading {local} at {t}"
+        );
+        rates.push(ppm);
+    }
+    // Different agents, different crystals.
+    assert!(
+        rates.iter().any(|&p| (p - rates[0]).abs() > 1.0),
+        "{rates:?}"
+    );
+}
+
+/// A run with own clocks ticks every agent at its own rate and still converges; the same
+/// seed gives the same bits on one thread and on four.
+#[test]
+fn own_clocks_converge_and_are_reproducible_on_any_pool() {
+    let m = model(
+        "formation-only",
+        &[
+            "duration=30",
+            "clock.ppm=50",
+            "clock.offset_s=0.01",
+            "clock.jitter_s=0.0002",
+        ],
+    );
+    let on = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| run(&m))
+    };
+    let (one, four) = (on(1), on(4));
+    assert_eq!(one.outcome, Outcome::Converged, "{}", one.reason);
+    let bits = |r: &RunResult| -> Vec<u64> {
+        r.final_positions
+            .iter()
+            .flatten()
+            .map(|x| x.to_bits())
+            .collect()
+    };
+    assert_eq!(bits(&one), bits(&four));
+    // Every agent ticked at about 100 Hz for 30 s (a random phase may skip t = 0).
+    let ticks = one.control.ticks;
+    assert!((4 * 2999..=4 * 3001).contains(&ticks), "{ticks}");
+}
+
+/// Bearings and velocities are measured in each agent's body frame and turned back by
+/// its heading estimate, its force the other way: with every estimate exact, headings
+/// spread all round give the world-frame run (to rounding).
+#[test]
+fn a_body_frame_run_is_the_world_frame_run_when_every_heading_is_known() {
+    let world = run(&model("paper", &["duration=20"]));
+    let body = run(&model(
+        "paper",
+        &[
+            "duration=20",
+            "heading.spread_deg=180",
+            "heading.initial_deg=37",
+        ],
+    ));
+    assert_eq!(body.outcome, world.outcome);
+    for (a, b) in world.final_positions.iter().zip(&body.final_positions) {
+        let d = (a[0] - b[0]).hypot(a[1] - b[1]);
+        assert!(d < 1e-8, "{a:?} vs {b:?}");
+    }
+    // The true headings really differ: the frames are not all the world's.
+    let m = model("paper", &["heading.spread_deg=180"]);
+    let h = Headings::new(
+        &m,
+        &HeadingModel {
+            initial: 0.0,
+            spread: std::f64::consts::PI,
+            error: 0.0,
+            drift: 0.0,
+            noise: 0.0,
+        },
+    );
+    assert!(h.truth.iter().any(|&x| x.abs() > 0.5), "{:?}", h.truth);
+}
+
+/// A heading error turns what the agent senses and commands: a leader pair whose
+/// estimates are off turns the leader edge with them.
+#[test]
+fn heading_errors_turn_the_leader_edge() {
+    let r = run(&model(
+        "paper",
+        &["duration=60", "heading.error_deg=5", "seed=3"],
+    ));
+    let exact = run(&model("paper", &["duration=60", "seed=3"]));
+    assert!(
+        r.final_displacement_error > 100.0 * exact.final_displacement_error.max(1e-6),
+        "{} vs {}",
+        r.final_displacement_error,
+        exact.final_displacement_error
+    );
+}
+
+/// The gusts are an Ornstein–Uhlenbeck process: stationary variance σ² per axis and
+/// correlation `e^{−h/τ}` one step apart, over many agents.
+#[test]
+fn gusts_have_their_variance_and_correlation() {
+    let m = host_sim::scenario::strip_model(400, 1.0);
+    let w = WindModel {
+        mean: [0.0; 2],
+        gust: 0.3,
+        gust_time_constant: 2.0,
+    };
+    let mut wind = Wind::new(&m, &w);
+    let h = 0.5;
+    let (mut var, mut cov, mut count) = (0.0, 0.0, 0.0);
+    for _ in 0..50 {
+        let before: Vec<_> = wind.now.clone();
+        wind.advance(h);
+        for (a, b) in before.iter().zip(&wind.now) {
+            var += b.x * b.x + b.y * b.y;
+            cov += a.x * b.x + a.y * b.y;
+            count += 2.0;
+        }
+    }
+    let (var, rho) = (var / count, cov / count / (var / count));
+    assert!((var / 0.09 - 1.0).abs() < 0.05, "variance {var}");
+    let want = (-h / 2.0f64).exp();
+    assert!((rho - want).abs() < 0.03, "correlation {rho} vs {want}");
+}
+
+/// `world = "crazyflie"` flies room-sized formations: formation-only and the 20-agent
+/// strip converge, and summary figures name the preset and its assumptions.
+#[test]
+fn the_crazyflie_world_flies_room_sized_formations() {
+    for (name, duration) in [
+        ("formation-only", "100"),
+        ("../host-sim/scenarios/strip20.toml", "60"),
+    ] {
+        let path = if name.starts_with("..") {
+            concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/strip20.toml")
+        } else {
+            name
+        };
+        let m = model(path, &["world=crazyflie", &format!("duration={duration}")]);
+        assert_eq!(m.world.preset, "crazyflie");
+        assert!(m.world.clock.is_some() && m.world.heading.is_some());
+        assert!(!m.world.assumptions.is_empty());
+        let r = run(&m);
+        assert_eq!(r.outcome, Outcome::Converged, "{name}: {}", r.reason);
+    }
+}
+
+/// The paper's v* = (3, 3) m/s is beyond a Crazyflie: the run says so in a warning and in
+/// its outcome's reason, naming v* and the limit.
+#[test]
+fn a_reference_above_the_speed_limit_is_named() {
+    let r = run(&model("paper", &["world=crazyflie", "duration=20"]));
+    assert_ne!(r.outcome, Outcome::Converged);
+    let says = |s: &str| s.contains("v* = (3, 3)") && s.contains("plant.max_speed = 1");
+    assert!(r.warnings.iter().any(|w| says(w)), "{:?}", r.warnings);
+    assert!(says(&r.reason), "{}", r.reason);
+}
+
+/// Every new field is checked with its name and the reason.
+#[test]
+fn bad_world_values_are_refused_with_their_field() {
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &[
+                "plant.model=velocity_tracking",
+                "plant.time_constant_s=-0.1",
+            ],
+            "plant.time_constant_s",
+        ),
+        (
+            &["plant.model=velocity_tracking", "plant.max_tilt_deg=90"],
+            "plant.max_tilt_deg",
+        ),
+        (
+            &["plant.model=velocity_tracking", "plant.max_speed=0"],
+            "plant.max_speed",
+        ),
+        (
+            &["plant.model=velocity_tracking", "plant.lead_s=nan"],
+            "plant.lead_s",
+        ),
+        (&["wind.gust=-1"], "wind.gust"),
+        (
+            &["wind.gust_time_constant_s=0"],
+            "wind.gust_time_constant_s",
+        ),
+        (&["wind.mean=[inf, 0.0]"], "wind.mean"),
+        (&["heading.spread_deg=200"], "heading.spread_deg"),
+        (&["heading.drift_deg_per_s=-1"], "heading.drift_deg_per_s"),
+        (&["clock.ppm=nan"], "clock.ppm"),
+        (&["clock.jitter_s=0.01"], "clock.jitter_s"),
+        (&["clock.offset_s=-1"], "clock.offset_s"),
+        (&["world=mars"], "world"),
+        (&["mode=continuous", "clock.ppm=10"], "mode"),
+    ];
+    for (overrides, field) in cases {
+        let e = refused(overrides);
+        assert!(
+            e.contains("formation-only") && e.contains(field),
+            "{overrides:?}: {e}"
+        );
+    }
+}
