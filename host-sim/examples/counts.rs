@@ -6,6 +6,7 @@
 //! ```sh
 //! counts strip N WARM TICKS   # the N-agent strip: WARM ticks, then TICKS counted (engine only)
 //! counts paper DURATION       # the paper run, DURATION s, whole (diagnostics included)
+//! counts crazyflie DURATION   # strip20 under world = "crazyflie", DURATION s, whole
 //! ```
 //!
 //! Everything runs on one thread (a one-thread rayon pool): the counts do not depend on
@@ -55,7 +56,24 @@ fn case(args: &[String]) -> Result<u64, String> {
             let ticks = (duration / model.control_period()).round() as u64;
             Ok(model.n() as u64 * ticks)
         }
-        _ => Err("usage: counts strip N WARM TICKS | counts paper DURATION".into()),
+        Some("crazyflie") => {
+            // docs/world.md: the 20-agent strip in world = "crazyflie" (vehicles, wind,
+            // headings, own clocks, noisy bearings, the shared channel), whole.
+            let duration = number(1, "DURATION")?;
+            let strip20 = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/strip20.toml");
+            let model = host_sim::load(
+                strip20,
+                &["world=crazyflie".to_owned(), format!("duration={duration}")],
+            )
+            .map_err(|e| e.to_string())?;
+            counted(&model, None, 0.0, 0);
+            let ticks = (duration / model.control_period()).round() as u64;
+            Ok(model.n() as u64 * ticks)
+        }
+        _ => Err(
+            "usage: counts strip N WARM TICKS | counts paper DURATION | counts crazyflie DURATION"
+                .into(),
+        ),
     }
 }
 

@@ -40,7 +40,7 @@ const LL: u64 = 32 << 20;
 /// the same ratio of the memory a tick walks to the cache, so the same misses per
 /// agent-step (41.8 both, and 6,803 and 6,802 instructions, dev build), in 15 s. The strips count ticks after warm-up ticks (the
 /// first tick receives nothing); the paper run is counted whole (diagnostics included).
-pub const CASES: [Case; 4] = [
+pub const CASES: [Case; 5] = [
     Case {
         name: "strip_1000",
         args: &["strip", "1000", "2", "4"],
@@ -62,6 +62,13 @@ pub const CASES: [Case; 4] = [
     Case {
         name: "paper",
         args: &["paper", "2"],
+        ll_bytes: LL,
+        ci: true,
+    },
+    // The robot's world (docs/world.md): strip20 under world = "crazyflie", whole.
+    Case {
+        name: "crazyflie_strip20",
+        args: &["crazyflie", "2"],
         ll_bytes: LL,
         ci: true,
     },
