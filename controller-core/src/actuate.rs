@@ -38,7 +38,7 @@ pub enum ActuateError {
 
 /// The virtual plant of SPEC S1 for one agent: mass, friction `D^r` per axis, the
 /// vehicle's largest velocity setpoint, and the lead that compensates the vehicle's own
-/// velocity loop (S19).
+/// velocity loop (S21).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct VirtualMass<T> {
     mass: T,
@@ -70,7 +70,7 @@ impl<T: Real> VirtualMass<T> {
     }
 
     /// The same plant with lead `lead` (s, finite, ≥ 0): the time constant of the
-    /// vehicle's velocity loop, which the setpoint then anticipates (S19). 0 (the
+    /// vehicle's velocity loop, which the setpoint then anticipates (S21). 0 (the
     /// default) gives the virtual velocity itself.
     pub fn with_lead(self, lead: T) -> Result<Self, ActuateError> {
         if !(lead.finite() && lead >= T::zero()) {
@@ -84,7 +84,7 @@ impl<T: Real> VirtualMass<T> {
         self.lead
     }
 
-    /// S19: the setpoint for a vehicle whose velocity follows its setpoint with time
+    /// S21: the setpoint for a vehicle whose velocity follows its setpoint with time
     /// constant `τ` (the lead): the virtual velocity `next` plus `τ` times the virtual
     /// acceleration over the period `dt` from `from`,
     /// `v_sp = v_{k+1} + τ (v_{k+1} − v_k) / Δt`, limited to the speed limit. Then
@@ -197,7 +197,7 @@ impl<T: Real> VelocityCommand<T> {
 
     /// One control period: integrates S1 from the previous virtual velocity (or, on the
     /// first step, from `measured`, the vehicle's velocity) under `force` for `dt`
-    /// seconds (S18) and returns the new setpoint (S19: the new virtual velocity, led by
+    /// seconds (S20) and returns the new setpoint (S21: the new virtual velocity, led by
     /// the plant's lead).
     pub fn step(&mut self, force: [T; 2], measured: [T; 2], dt: T) -> [T; 2] {
         let from = self.command.unwrap_or(measured);
@@ -284,7 +284,7 @@ mod tests {
         );
     }
 
-    /// S19: with lead τ, a first-order vehicle `v̇ = (v_sp − v)/τ` follows the virtual
+    /// S21: with lead τ, a first-order vehicle `v̇ = (v_sp − v)/τ` follows the virtual
     /// velocity with an error that decays; without lead it lags by about `τ a`.
     #[test]
     fn the_lead_cancels_a_first_order_velocity_loop() {

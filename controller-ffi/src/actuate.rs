@@ -21,7 +21,7 @@ pub struct ph_actuator {
     /// Largest setpoint speed (m/s, > 0; `INFINITY` for none): the vehicle's limit.
     pub max_speed: f32,
     /// Lead (s, ≥ 0): the time constant of the vehicle's own velocity loop, which the
-    /// setpoints anticipate (SPEC S19); 0 for none.
+    /// setpoints anticipate (SPEC S21); 0 for none.
     pub lead: f32,
     /// The virtual velocity (m/s, world frame: the setpoint without lead), valid when
     /// `has_command`.
@@ -32,7 +32,7 @@ pub struct ph_actuator {
 
 /// Fills `*actuator` for `agent`: mass `mass`, the friction `D^r` of the agent's
 /// configuration (so that the controller cancels the friction the plant has), speed
-/// limit `max_speed`, lead `lead` (the vehicle's velocity-loop time constant, SPEC S19;
+/// limit `max_speed`, lead `lead` (the vehicle's velocity-loop time constant, SPEC S21;
 /// 0 for none), no setpoint yet. `PH_ERR_ARGUMENT` for a mass that is not finite and
 /// positive, a `max_speed` that is NaN or not positive, or a lead that is not finite and
 /// non-negative.
@@ -69,8 +69,8 @@ pub unsafe extern "C" fn ph_actuator_init(
 
 /// One control period: integrates S1 from the previous virtual velocity (the first time
 /// from `velocity[0..2]`, the vehicle's measured velocity) under `force[0..2]` (the
-/// `ph_output.force` of this tick) for `dt` seconds (SPEC S18), keeps the new virtual
-/// velocity in `actuator->command`, and writes the setpoint (S19: led by
+/// `ph_output.force` of this tick) for `dt` seconds (SPEC S20), keeps the new virtual
+/// velocity in `actuator->command`, and writes the setpoint (S21: led by
 /// `actuator->lead`) to `setpoint[0..2]`. `PH_ERR_ARGUMENT` (nothing written) for
 /// an actuator whose parameters `ph_actuator_init` would refuse.
 ///

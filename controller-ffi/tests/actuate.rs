@@ -90,7 +90,7 @@ fn the_c_api_steps_the_cores_velocity_command() {
     assert_eq!(setpoint, measured);
 }
 
-/// With a lead, the setpoint is the core's led setpoint (S19) and the actuator keeps the
+/// With a lead, the setpoint is the core's led setpoint (S21) and the actuator keeps the
 /// virtual velocity; a negative lead is refused.
 #[test]
 fn the_lead_is_the_cores() {

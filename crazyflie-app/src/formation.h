@@ -32,7 +32,7 @@
 #ifndef FORMATION_MAX_SPEED
 #define FORMATION_MAX_SPEED 1.0f
 #endif
-/* Lead of the setpoints (s, SPEC S19): the time constant of the Crazyflie's velocity
+/* Lead of the setpoints (s, SPEC S21): the time constant of the Crazyflie's velocity
  * loop, derived from PID_VEL_X_KP = PID_VEL_Y_KP = 25 deg per m/s
  * (platform_defaults_cf2.h): 1 / (g tan(25 deg)/(m/s)) ~ 0.23 s (docs/world.md). */
 #ifndef FORMATION_LEAD

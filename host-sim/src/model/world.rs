@@ -23,7 +23,7 @@ pub struct VelocityTracking {
     pub max_acceleration: f64,
     /// `v_max`, the largest velocity setpoint (m/s, > 0).
     pub max_speed: f64,
-    /// The lead the agent's actuation gives its setpoints (s, ≥ 0; SPEC S19): what the
+    /// The lead the agent's actuation gives its setpoints (s, ≥ 0; SPEC S21): what the
     /// agent believes `τ` to be.
     pub lead: f64,
 }

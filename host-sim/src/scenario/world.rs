@@ -18,7 +18,7 @@ pub struct PlantSpec {
     pub max_tilt_deg: f64,
     /// `velocity_tracking`: the largest velocity setpoint (m/s).
     pub max_speed: f64,
-    /// `velocity_tracking`: the lead of the agents' setpoints (s, SPEC S19); default
+    /// `velocity_tracking`: the lead of the agents' setpoints (s, SPEC S21); default
     /// `time_constant_s` (the agents know their vehicle's loop).
     pub lead_s: Option<f64>,
 }

@@ -6,7 +6,7 @@
 //! (first order with time constant `τ`, the acceleration limited in norm to `a_max`, the
 //! wind `a_w` acting on top: a proportional velocity loop leaves a steady error `τ a_w`).
 //! At each of its ticks the agent's force `U` becomes the setpoint through the virtual
-//! mass of SPEC S18 with the lead of S19 (`controller_core::actuate::VelocityCommand`,
+//! mass of SPEC S20 with the lead of S21 (`controller_core::actuate::VelocityCommand`,
 //! the same code the Crazyflie app calls through `ph_actuate`), limited to `v_max`.
 
 use super::{Held, Plant};
