@@ -21,7 +21,10 @@ use super::error::SetupError;
 use super::hil::{HilError, LinkStats};
 use super::plant::Plant;
 use super::radio::{Radio, RadioFrame};
-use super::sensors::{offset_with, quiet_bearing, velocity_with, Sensors, Sight};
+use super::sensors::{
+    bearing_sensor, offset_with, quiet_bearing, velocity_with, BearingKind, BearingSensor, Sensors,
+    Sight, World,
+};
 use super::slot_order::SlotOrder;
 use super::speed::prefetch::{self, Footprint};
 use super::speed::{CHUNK, PARALLEL_MIN_AGENTS};
@@ -48,6 +51,8 @@ pub struct SampledSim<'m> {
     footprints: Vec<Footprint>,
     /// The plant state.
     pub plant: Plant,
+    /// Each agent's true heading (rad).
+    headings: Vec<f64>,
     /// Who measures whom, and with which sensors.
     senses: Senses,
     radio: Radio,
@@ -162,8 +167,10 @@ impl<'m> SampledSim<'m> {
             footprints: controllers.iter().map(|c| Footprint::of(&**c)).collect(),
             controllers,
             plant: Plant::new(model),
+            headings: vec![0.0; n],
             senses: Senses {
                 sensors: Sensors::new(&model.sensors, model.seed),
+                bearing: bearing_sensor(&model.sensors, n, period),
                 ids: model.agents.iter().map(|a| a.id).collect(),
                 partner: model.partners(),
             },
@@ -268,7 +275,7 @@ impl SampledSim<'_> {
         let walk = Walk {
             t,
             dt,
-            scene: Scene::of(model, &self.plant, &self.senses, tick),
+            scene: Scene::of(model, &self.plant, &self.senses, &self.headings, tick),
             radio: &model.graph.radio,
             slot_order: &self.slot_order,
             sent: &self.sent,
@@ -359,6 +366,13 @@ impl Engine for SampledSim<'_> {
                     .tick(t, period, &self.plant.q, model, &mut self.radio);
             }
             self.radio.deliver(t, &mut self.inboxes);
+        }
+        if let Some(sensor) = &mut self.senses.bearing {
+            sensor.prepare(&World {
+                q: &self.plant.q,
+                v: &self.plant.v,
+                headings: &self.headings,
+            });
         }
         let dt = self.last_tick.map_or(0.0, |p| t - p);
         // Measured with this tick's streams; the next tick draws from new ones.
@@ -497,10 +511,12 @@ struct MeasureMode {
     quiet: bool,
 }
 
-/// What a run's agents measure with: the sensors, every agent's wire id (a bearing's
-/// tag) and leader partner.
+/// What a run's agents measure with: the sensors, the bearing sensor (`None`: the
+/// omnidirectional ideal one, [`Scene::measure`]'s own loops), every agent's wire id (a
+/// bearing's tag) and leader partner.
 struct Senses {
     sensors: Sensors,
+    bearing: Option<Box<dyn BearingSensor>>,
     ids: Vec<u8>,
     partner: Vec<Option<usize>>,
 }
@@ -511,6 +527,8 @@ struct Scene<'a> {
     graph: &'a Adjacency,
     q: &'a [Vec2<f64>],
     v: &'a [Vec2<f64>],
+    /// Each agent's true heading (rad).
+    headings: &'a [f64],
     senses: &'a Senses,
     tick: u64,
     mode: MeasureMode,
@@ -519,12 +537,19 @@ struct Scene<'a> {
 impl<'a> Scene<'a> {
     /// Tick `tick`'s scene of a simulator's parts (taken one by one, so that the caller
     /// may write its other fields meanwhile).
-    fn of(model: &'a Model, plant: &'a Plant, senses: &'a Senses, tick: u64) -> Self {
+    fn of(
+        model: &'a Model,
+        plant: &'a Plant,
+        senses: &'a Senses,
+        headings: &'a [f64],
+        tick: u64,
+    ) -> Self {
         let ranged = model.estimator == Estimator::Measured;
         Self {
             graph: &model.graph.triangle,
             q: &plant.q,
             v: &plant.v,
+            headings,
             senses,
             tick,
             mode: MeasureMode {
@@ -539,17 +564,22 @@ impl<'a> Scene<'a> {
     /// velocity and (a leader) its partner offset, drawn in that order from its stream of
     /// this tick ([`Sensors::stream`]); with sensors that draw nothing
     /// ([`MeasureMode::quiet`]) the same values from the state alone, without a stream.
+    /// With a bearing sensor, the bearings are its ([`Self::measure_through`]).
     #[inline]
     fn measure(
         &self,
         i: usize,
         mut push: impl FnMut(BearingMeasurement<f64>),
     ) -> (Vec2<f64>, Option<Vec2<f64>>) {
+        if let Some(sensor) = self.senses.bearing.as_deref() {
+            return self.measure_through(sensor, i, push);
+        }
         let (q, v, m) = (self.q, self.v, self.mode);
         let Senses {
             sensors,
             ids,
             partner,
+            bearing: _,
         } = self.senses;
         let model = sensors.model();
         let partner = partner[i];
@@ -575,6 +605,36 @@ impl<'a> Scene<'a> {
         }
         let velocity = draws.velocity(&v[i]);
         (velocity, partner.map(|p| draws.offset(&q[i], &q[p])))
+    }
+
+    /// [`Self::measure`] with the bearings of `sensor` ([`BearingSensor::bearing`]), then
+    /// the velocity and partner offset, all from agent `i`'s stream of this tick.
+    #[inline(never)]
+    fn measure_through(
+        &self,
+        sensor: &dyn BearingSensor,
+        i: usize,
+        mut push: impl FnMut(BearingMeasurement<f64>),
+    ) -> (Vec2<f64>, Option<Vec2<f64>>) {
+        let (q, v, m) = (self.q, self.v, self.mode);
+        let s = self.senses;
+        let world = World {
+            q,
+            v,
+            headings: self.headings,
+        };
+        let kind = BearingKind {
+            exact_rate: m.exact,
+            with_range: m.ranged,
+        };
+        let mut draws = s.sensors.stream(i, self.tick);
+        for &j in self.graph.of(i) {
+            if let Some(b) = sensor.bearing(&world, &s.ids, i, j, kind, &mut draws) {
+                push(b);
+            }
+        }
+        let velocity = draws.velocity(&v[i]);
+        (velocity, s.partner[i].map(|p| draws.offset(&q[i], &q[p])))
     }
 }
 

@@ -154,7 +154,7 @@ impl SampledSim<'_> {
         let walk = Walk {
             t,
             dt,
-            scene: Scene::of(model, &self.plant, &self.senses, tick),
+            scene: Scene::of(model, &self.plant, &self.senses, &self.headings, tick),
             radio: &model.graph.radio,
             slot_order: &self.slot_order,
             sent: &self.sent,
