@@ -336,6 +336,14 @@ fn bad_camera_settings_are_refused_with_file_field_and_reason() {
         assert_eq!(first.file, file, "{set}: {e}");
         assert!(first.reason.contains(reason), "{set}: {e}");
     }
+    // A position that is not a number is the agent's error (no closest pair of it).
+    let sets = [
+        "agents.0.position=[nan, 0.0]".to_owned(),
+        "sensors.camera.occlusion_radius_m=0.1".to_owned(),
+    ];
+    let e = load(file, &sets).expect_err("nan");
+    assert_eq!(e.0[0].field, "agents[0].position", "{e}");
+    assert!(e.0.iter().all(|e| !e.field.contains("camera")), "{e}");
     // Just below the spacing: accepted.
     let ok = ["sensors.camera.occlusion_radius_m=1.27".to_owned()];
     assert!(load(file, &ok).is_ok());

@@ -163,6 +163,12 @@ impl Draws<'_> {
         velocity_with(self.model, v, noise)
     }
 
+    /// A uniform draw in `[0, 1)` (a bearing sensor's chances: detection, outliers).
+    #[inline]
+    pub fn uniform(&mut self) -> f64 {
+        self.rng.random::<f64>()
+    }
+
     /// A leader's measured partner offset `q_partner − q_self`.
     #[inline]
     pub fn offset(&mut self, q_self: &Vec2<f64>, q_partner: &Vec2<f64>) -> Vec2<f64> {

@@ -26,7 +26,6 @@ use super::source::{BearingKind, BearingSensor, World};
 use super::{Draws, Sight};
 use crate::model::CameraModel;
 use controller_core::{BearingMeasurement, Vec2};
-use rand::Rng;
 use std::f64::consts::TAU;
 
 /// Every agent's camera and what it keeps between ticks.
@@ -72,13 +71,6 @@ impl Camera {
         self.occluders
             .as_ref()
             .is_none_or(|o| !o.hides(image.q, i, j, r))
-    }
-}
-
-impl Draws<'_> {
-    /// A uniform draw in `[0, 1)`.
-    fn uniform(&mut self) -> f64 {
-        self.rng.random::<f64>()
     }
 }
 

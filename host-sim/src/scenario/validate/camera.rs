@@ -83,7 +83,11 @@ pub(super) fn check(
 /// (a larger body would hide everything from the agents inside it). The closest pair from
 /// an R*-tree of the initial positions: `O(N log N)`.
 fn check_bodies(c: &mut Checker<'_>, radius: f64, agents: &[AgentModel]) {
-    if radius.is_nan() || radius <= 0.0 || agents.len() < 2 {
+    let finite = agents
+        .iter()
+        .all(|a| a.position.iter().all(|x| x.is_finite()));
+    // Positions that are not numbers are reported by the agents' own checks.
+    if radius.is_nan() || radius <= 0.0 || agents.len() < 2 || !finite {
         return;
     }
     let points = agents
