@@ -21,7 +21,10 @@ use super::error::SetupError;
 use super::hil::{HilError, LinkStats};
 use super::plant::{new_plant, Held, Plant};
 use super::radio::{Radio, RadioFrame};
-use super::sensors::{offset_with, quiet_bearing, velocity_with, Sensors, Sight};
+use super::sensors::{
+    bearing_sensor, offset_with, quiet_bearing, velocity_with, BearingKind, BearingSensor, Sensors,
+    Sight, World,
+};
 use super::slot_order::SlotOrder;
 use super::speed::prefetch::{self, Footprint};
 use super::speed::{CHUNK, PARALLEL_MIN_AGENTS};
@@ -169,6 +172,7 @@ impl<'m> SampledSim<'m> {
             world: WorldState::new(model),
             senses: Senses {
                 sensors: Sensors::new(&model.sensors, model.seed),
+                bearing: bearing_sensor(&model.sensors, n, period),
                 ids: model.agents.iter().map(|a| a.id).collect(),
                 partner: model.partners(),
             },
@@ -278,7 +282,7 @@ impl SampledSim<'_> {
         let walk = Walk {
             at,
             headings: self.world.headings.as_ref(),
-            scene: Scene::of(model, &*self.plant, &self.senses),
+            scene: Scene::of(model, &*self.plant, &self.senses, &self.world.truth),
             radio: &model.graph.radio,
             slot_order: &self.slot_order,
             sent: &self.sent,
@@ -391,6 +395,16 @@ impl Engine for SampledSim<'_> {
                     .tick(t, period, self.plant.q(), model, &mut self.radio);
             }
             self.radio.deliver(t, &mut self.inboxes);
+        }
+        // At every control period of the common clock (with own clocks, the agents that
+        // tick in between see the camera's history and occlusions of the last one).
+        let common = model.step_of(t).is_multiple_of(model.steps_per_tick.max(1));
+        if let (Some(sensor), true) = (&mut self.senses.bearing, common) {
+            sensor.prepare(&World {
+                q: self.plant.q(),
+                v: self.plant.v(),
+                headings: &self.world.truth,
+            });
         }
         let dt = self.last_tick.map_or(0.0, |p| t - p);
         // Measured with this tick's streams; the next tick draws from new ones.
@@ -567,6 +581,9 @@ struct WorldState {
     wind: Option<Wind>,
     /// With own clocks: the agents that tick at the current step, each at its tick.
     due: Vec<Option<AgentTick>>,
+    /// Each agent's true heading (rad; 0 without a heading model): the camera's
+    /// boresight.
+    truth: Vec<f64>,
 }
 
 impl WorldState {
@@ -577,6 +594,10 @@ impl WorldState {
             clocks: w.clock.as_ref().map(|c| Clocks::new(model, c)),
             wind: w.wind.as_ref().map(|x| Wind::new(model, x)),
             due: Vec::new(),
+            truth: match &w.heading {
+                Some(h) => Headings::new(model, h).truth,
+                None => vec![0.0; model.n()],
+            },
         }
     }
 }
@@ -589,10 +610,12 @@ struct MeasureMode {
     quiet: bool,
 }
 
-/// What a run's agents measure with: the sensors, every agent's wire id (a bearing's
-/// tag) and leader partner.
+/// What a run's agents measure with: the sensors, the bearing sensor (`None`: the
+/// omnidirectional ideal one, [`Scene::measure`]'s own loops), every agent's wire id (a
+/// bearing's tag) and leader partner.
 struct Senses {
     sensors: Sensors,
+    bearing: Option<Box<dyn BearingSensor>>,
     ids: Vec<u8>,
     partner: Vec<Option<usize>>,
 }
@@ -602,6 +625,8 @@ struct Scene<'a> {
     graph: &'a Adjacency,
     q: &'a [Vec2<f64>],
     v: &'a [Vec2<f64>],
+    /// Each agent's true heading (rad).
+    headings: &'a [f64],
     senses: &'a Senses,
     mode: MeasureMode,
 }
@@ -609,12 +634,13 @@ struct Scene<'a> {
 impl<'a> Scene<'a> {
     /// The scene of a simulator's parts (taken one by one, so that the caller may write
     /// its other fields meanwhile).
-    fn of(model: &'a Model, plant: &'a dyn Plant, senses: &'a Senses) -> Self {
+    fn of(model: &'a Model, plant: &'a dyn Plant, senses: &'a Senses, headings: &'a [f64]) -> Self {
         let ranged = model.estimator == Estimator::Measured;
         Self {
             graph: &model.graph.triangle,
             q: plant.q(),
             v: plant.v(),
+            headings,
             senses,
             mode: MeasureMode {
                 exact: model.sensors.bearing_rate == BearingRate::Exact,
@@ -628,6 +654,7 @@ impl<'a> Scene<'a> {
     /// `push`), then its own velocity and (a leader) its partner offset, drawn in that
     /// order from its stream of the tick ([`Sensors::stream`]); with sensors that draw nothing
     /// ([`MeasureMode::quiet`]) the same values from the state alone, without a stream.
+    /// With a bearing sensor, the bearings are its ([`Self::measure_through`]).
     #[inline]
     fn measure(
         &self,
@@ -635,11 +662,15 @@ impl<'a> Scene<'a> {
         tick: u64,
         mut push: impl FnMut(BearingMeasurement<f64>),
     ) -> (Vec2<f64>, Option<Vec2<f64>>) {
+        if let Some(sensor) = self.senses.bearing.as_deref() {
+            return self.measure_through(sensor, i, tick, push);
+        }
         let (q, v, m) = (self.q, self.v, self.mode);
         let Senses {
             sensors,
             ids,
             partner,
+            bearing: _,
         } = self.senses;
         let model = sensors.model();
         let partner = partner[i];
@@ -665,6 +696,37 @@ impl<'a> Scene<'a> {
         }
         let velocity = draws.velocity(&v[i]);
         (velocity, partner.map(|p| draws.offset(&q[i], &q[p])))
+    }
+
+    /// [`Self::measure`] with the bearings of `sensor` ([`BearingSensor::bearing`]), then
+    /// the velocity and partner offset, all from agent `i`'s stream of this tick.
+    #[inline(never)]
+    fn measure_through(
+        &self,
+        sensor: &dyn BearingSensor,
+        i: usize,
+        tick: u64,
+        mut push: impl FnMut(BearingMeasurement<f64>),
+    ) -> (Vec2<f64>, Option<Vec2<f64>>) {
+        let (q, v, m) = (self.q, self.v, self.mode);
+        let s = self.senses;
+        let world = World {
+            q,
+            v,
+            headings: self.headings,
+        };
+        let kind = BearingKind {
+            exact_rate: m.exact,
+            with_range: m.ranged,
+        };
+        let mut draws = s.sensors.stream(i, tick);
+        for &j in self.graph.of(i) {
+            if let Some(b) = sensor.bearing(&world, &s.ids, i, j, kind, &mut draws) {
+                push(b);
+            }
+        }
+        let velocity = draws.velocity(&v[i]);
+        (velocity, s.partner[i].map(|p| draws.offset(&q[i], &q[p])))
     }
 }
 

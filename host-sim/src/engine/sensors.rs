@@ -6,6 +6,18 @@
 //! ([`Sensors::stream`]: a xoshiro256++ generator seeded from the run's seed, the agent's
 //! index and the tick's), so that a tick's agents can be measured on any thread in any
 //! order and give the same bits.
+//!
+//! Which bearings are seen: every neighbour's, at once, unless a bearing sensor
+//! ([`BearingSensor`], the seam in `sensors/source.rs`; today the [`Camera`]) says
+//! otherwise.
+
+mod camera;
+mod latency;
+mod occlusion;
+mod source;
+
+pub use camera::Camera;
+pub use source::{bearing_sensor, BearingKind, BearingSensor, World};
 
 use crate::model::SensorModel;
 use controller_core::{geometry, BearingMeasurement, Vec2};
@@ -149,6 +161,12 @@ impl Draws<'_> {
         let s = self.model.velocity_noise;
         let noise = [self.gauss(s), self.gauss(s)];
         velocity_with(self.model, v, noise)
+    }
+
+    /// A uniform draw in `[0, 1)` (a bearing sensor's chances: detection, outliers).
+    #[inline]
+    pub fn uniform(&mut self) -> f64 {
+        self.rng.random::<f64>()
     }
 
     /// A leader's measured partner offset `q_partner − q_self`.

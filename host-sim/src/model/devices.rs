@@ -22,6 +22,9 @@ pub struct SensorModel {
     pub offset_noise: f64,
     /// Range noise (m).
     pub range_noise: f64,
+    /// The camera that limits which neighbours are seen (`[sensors.camera]`); `None`:
+    /// every neighbour's bearing is seen, at once (the omnidirectional ideal sensor).
+    pub camera: Option<CameraModel>,
 }
 
 impl SensorModel {
@@ -36,6 +39,7 @@ impl SensorModel {
             velocity_bias: [0.0; 2],
             offset_noise: 0.0,
             range_noise: 0.0,
+            camera: None,
         }
     }
 
@@ -53,6 +57,9 @@ impl SensorModel {
             velocity_bias,
             offset_noise,
             range_noise,
+            // which neighbours are seen and when: the engine's bearing sensor
+            // (`engine/sensors/camera.rs`), which draws from the streams on its own
+            camera: _,
         } = self;
         SensorDepartures {
             noise: *bearing_noise != 0.0 || *velocity_noise != 0.0 || *offset_noise != 0.0,
@@ -65,6 +72,42 @@ impl SensorModel {
     pub fn is_noisy(&self) -> bool {
         let d = self.departures();
         d.noise || d.range_noise || d.bias
+    }
+}
+
+/// Every agent's camera, its bearing sensor (`[sensors.camera]`, docs/sensors.md): which
+/// neighbours it sees and how late, and how its detections go wrong. SI units.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CameraModel {
+    /// Field of view (rad), centred on the agent's heading; `2π` sees all round.
+    pub fov: f64,
+    /// Largest distance at which a neighbour is seen (m); `f64::INFINITY`: no limit.
+    pub range: f64,
+    /// Radius of the disc each agent's body occupies in the view of the others (m):
+    /// a body closer than a neighbour that crosses the line of sight hides it; 0: nothing
+    /// hides anything.
+    pub occlusion_radius: f64,
+    /// Probability that a visible neighbour is detected at a tick.
+    pub detection_probability: f64,
+    /// Probability that a detected bearing is replaced by a uniformly random direction.
+    pub outlier_probability: f64,
+    /// Age of the image (s): a bearing describes the geometry this long ago.
+    pub latency: f64,
+}
+
+impl CameraModel {
+    /// A camera that sees everything at once: 360°, no range limit, no occlusion,
+    /// certain detection, no outliers, no latency (the ideal sensor, through the camera's
+    /// code path).
+    pub fn all_seeing() -> Self {
+        Self {
+            fov: std::f64::consts::TAU,
+            range: f64::INFINITY,
+            occlusion_radius: 0.0,
+            detection_probability: 1.0,
+            outlier_probability: 0.0,
+            latency: 0.0,
+        }
     }
 }
 

@@ -92,6 +92,41 @@ pub struct SensorSpec {
     pub offset_noise: f64,
     /// Standard deviation of the range noise (m), `measured` estimator only.
     pub range_noise: f64,
+    /// `[sensors.camera]`: the camera every agent sees its neighbours through (optional;
+    /// absent: every neighbour's bearing is seen, at once).
+    pub camera: Option<CameraSpec>,
+}
+
+/// `[sensors.camera]`: every agent's camera (docs/sensors.md). Each field defaults to the
+/// ideal camera's value.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CameraSpec {
+    /// Field of view (degrees), centred on the agent's heading; 360 sees all round.
+    pub fov_deg: f64,
+    /// Largest distance at which a neighbour is seen (m); default: no limit.
+    pub range_m: Option<f64>,
+    /// Radius of each agent's body as the others see it (m); 0: nothing hides anything.
+    pub occlusion_radius_m: f64,
+    /// Probability that a visible neighbour is detected at a tick.
+    pub detection_probability: f64,
+    /// Probability that a detected bearing is replaced by a uniformly random direction.
+    pub outlier_probability: f64,
+    /// Age of the image (s): a bearing describes the geometry this long ago.
+    pub latency_s: f64,
+}
+
+impl Default for CameraSpec {
+    fn default() -> Self {
+        Self {
+            fov_deg: 360.0,
+            range_m: None,
+            occlusion_radius_m: 0.0,
+            detection_probability: 1.0,
+            outlier_probability: 0.0,
+            latency_s: 0.0,
+        }
+    }
 }
 
 impl Default for SensorSpec {
@@ -106,6 +141,7 @@ impl Default for SensorSpec {
             velocity_bias: [0.0, 0.0],
             offset_noise: 0.0,
             range_noise: 0.0,
+            camera: None,
         }
     }
 }

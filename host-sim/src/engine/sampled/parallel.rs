@@ -160,7 +160,7 @@ impl SampledSim<'_> {
         let walk = Walk {
             at: AgentTick { time: t, dt, tick },
             headings: self.world.headings.as_ref(),
-            scene: Scene::of(model, &*self.plant, &self.senses),
+            scene: Scene::of(model, &*self.plant, &self.senses, &self.world.truth),
             radio: &model.graph.radio,
             slot_order: &self.slot_order,
             sent: &self.sent,

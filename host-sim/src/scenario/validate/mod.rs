@@ -5,6 +5,7 @@
 
 mod agents;
 mod attacks;
+mod camera;
 mod checker;
 mod comm;
 mod graph;
@@ -61,6 +62,7 @@ fn check(
     let auth_key = comm::auth_key(&mut c, s);
     let world = world::check(&mut c, s, period);
     let (mut agents, index) = agents::check(&mut c, s);
+    let camera = camera::check(&mut c, s, &agents);
     let (triangles, ids_ok) = triangles::check(&mut c, s, &index, margin);
     let order = graph::check(&mut c, s, &agents, &triangles, ids_ok, margin);
     let leader = references::leader(&mut c, s, &index);
@@ -119,6 +121,7 @@ fn check(
             velocity_bias: se.velocity_bias,
             offset_noise: se.offset_noise,
             range_noise: se.range_noise,
+            camera,
         },
         radio: RadioModel {
             latency: ra.latency,

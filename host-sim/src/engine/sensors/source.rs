@@ -1,0 +1,74 @@
+//! The seam for bearing sensors: where an agent's bearing of a neighbour comes from.
+//!
+//! Without a bearing sensor (`sensors.camera` absent) every neighbour's bearing is seen at
+//! once, by the omnidirectional ideal sensor of [`Draws::bearing`] and
+//! [`quiet_bearing`](super::quiet_bearing): the simulator's fast path, untouched. A
+//! [`BearingSensor`] replaces it for every bearing of a run:
+//!
+//! 1. [`BearingSensor::prepare`] once per control tick, sequentially, before any agent is
+//!    measured, with the true state ([`World`]): a sensor keeps what it needs (a history
+//!    for a latency, a spatial index for occlusion).
+//! 2. [`BearingSensor::bearing`] for each agent and each of its triangle neighbours in
+//!    graph order, possibly on many threads at once (hence `&self`), drawing from the
+//!    agent's own stream of the tick ([`Draws`]): a sensor that draws the same numbers in
+//!    the same order for the same state gives the same bits on any number of threads.
+//!
+//! A new bearing sensor is one file beside this one that implements the trait, and one
+//! line in [`bearing_sensor`] that picks it from the [`SensorModel`] (docs/architecture.md,
+//! "Add a sensor").
+
+use super::camera::Camera;
+use super::Draws;
+use crate::model::SensorModel;
+use controller_core::{BearingMeasurement, Vec2};
+
+/// The true state of every agent at a control tick, as a bearing sensor reads it (world
+/// frame).
+#[derive(Clone, Copy, Debug)]
+pub struct World<'a> {
+    /// Positions (m).
+    pub q: &'a [Vec2<f64>],
+    /// Velocities (m/s).
+    pub v: &'a [Vec2<f64>],
+    /// Each agent's true heading (rad, world frame, counter-clockwise from `x`).
+    pub headings: &'a [f64],
+}
+
+/// What a bearing carries besides its direction (the run's settings).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BearingKind {
+    /// The exact S2 rate of the (seen) state (`sensors.bearing_rate = "exact"`).
+    pub exact_rate: bool,
+    /// The (noisy) distance (the `measured` estimator).
+    pub with_range: bool,
+}
+
+/// A model of the sensor through which every agent sees its neighbours' bearings.
+pub trait BearingSensor: Send + Sync + std::fmt::Debug {
+    /// Takes in the true state of this control tick, before any agent is measured.
+    fn prepare(&mut self, world: &World<'_>);
+
+    /// Agent `i`'s bearing of neighbour `j` at this tick (tagged with `ids[j]`), `None`
+    /// when it is not measured, drawing from `draws`, agent `i`'s stream of the tick.
+    /// `world` is the state given to the last [`Self::prepare`].
+    fn bearing(
+        &self,
+        world: &World<'_>,
+        ids: &[u8],
+        i: usize,
+        j: usize,
+        kind: BearingKind,
+        draws: &mut Draws<'_>,
+    ) -> Option<BearingMeasurement<f64>>;
+}
+
+/// The bearing sensor of a run of `n` agents with control period `period` (s): `None`
+/// for the omnidirectional ideal sensor (no `[sensors.camera]`).
+pub fn bearing_sensor(
+    model: &SensorModel,
+    n: usize,
+    period: f64,
+) -> Option<Box<dyn BearingSensor>> {
+    let camera = model.camera.as_ref()?;
+    Some(Box::new(Camera::new(camera, n, period)))
+}
