@@ -43,7 +43,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     pub(super) fn sense_own(&mut self, m: &Measurements<'_, T>) -> Result<(), Fault> {
         let dt = m.dt;
         if !(finite(dt) && dt >= T::zero()) {
-            return Err(Fault::Measurement(MeasurementError::NonFinite));
+            return Err(Fault::Measurement(bad_dt(dt)));
         }
         // The checks read nothing that aging changes: age after them.
         let in_order = match self.check_measurements(m) {
@@ -81,6 +81,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             BearingFilter::FiniteDifference => None,
         };
         let how = tracking.as_ref();
+        let limits = &self.config.limits;
         // The oldest neighbour (ages are never NaN: ∞ + a finite dt ≥ 0, or 0 when heard).
         let mut oldest = T::zero();
         if in_order {
@@ -93,7 +94,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 }
                 match bearings.next() {
                     Some(b) => take_bearing(n, b, dt, how),
-                    None => no_bearing(n, dt),
+                    None => no_bearing(n, dt, limits, how),
                 }
             }
         } else {
@@ -104,7 +105,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 }
                 match bearing_to(m.bearings, n.id) {
                     Some(b) => take_bearing(n, b, dt, how),
-                    None => no_bearing(n, dt),
+                    None => no_bearing(n, dt, limits, how),
                 }
             }
         }
@@ -164,6 +165,17 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             }
         }
         Ok(in_order)
+    }
+}
+
+/// Why a `dt` that is not finite and non-negative was refused.
+#[cold]
+#[inline(never)]
+fn bad_dt<T: Real>(dt: T) -> MeasurementError {
+    if finite(dt) {
+        MeasurementError::NegativeDt
+    } else {
+        MeasurementError::NonFinite
     }
 }
 
@@ -331,10 +343,41 @@ fn take_bearing<T: Real, const MT: usize>(
     n.fresh = true;
 }
 
-/// No bearing to this neighbour this tick.
-#[inline(always)]
-fn no_bearing<T: Real, const MT: usize>(n: &mut Neighbour<T, MT>, dt: T) {
+/// No bearing to this neighbour this tick (SPEC §12). S18: the last one is still used
+/// while it is younger than the hold `T_h` ([`crate::Limits::bearing_hold`]; never for a
+/// neighbour not yet measured, whose age is −∞): with the finite difference the bearing,
+/// its rate and its range are held as they were; with the tracker `ŝ` and `ρ̂` are
+/// predicted (S15 without S16) and the rate is S17 on the prediction; the range is held.
+/// Past the hold it is missing (S19: the angles that need it cannot be formed). Out of
+/// the neighbour loop's way: a bearing is rarely missing.
+#[cold]
+#[inline(never)]
+fn no_bearing<T: Real, const MT: usize>(
+    n: &mut Neighbour<T, MT>,
+    dt: T,
+    limits: &crate::Limits<T>,
+    tracking: Option<&Tracking<'_, T>>,
+) {
+    let before = n.bearing_age;
     n.bearing_age += dt;
-    n.fresh = false;
-    n.range = None;
+    let since = n.bearing_age;
+    // S18: 0 ≤ τ < T_h (false for −∞, "never").
+    n.fresh = since >= T::zero() && since < limits.bearing_hold;
+    if !n.fresh {
+        n.range = None;
+        return;
+    }
+    if let Some(t) = tracking {
+        if before == T::zero() {
+            // The first tick without it: nothing of an earlier gap is left to subtract
+            // (a bearing with a measured rate bypasses the tracker's update).
+            n.track.predicted = T::zero();
+        }
+        // The same relative velocities as `take_bearing` gives the tracker (SPEC §11).
+        let dv = RelativeVelocity {
+            moved: n.velocity - t.v_before,
+            now: n.velocity - t.v,
+        };
+        n.rate = n.track.predict(&mut n.s, &dv, since, t.c, &t.limits);
+    }
 }
