@@ -106,7 +106,10 @@ impl core::fmt::Display for Fault {
         match self {
             Self::Measurement(e) => write!(f, "measurement refused: {e}"),
             Self::MissingBearing(id) => {
-                write!(f, "no bearing to agent {id} this tick, nor one within the hold")
+                write!(
+                    f,
+                    "no bearing to agent {id} this tick, nor one within the hold"
+                )
             }
             Self::Stale(id) => write!(f, "agent {id} not heard within the timeout"),
             Self::MissingData(id) => write!(f, "agent {id}'s frames lack data this step needs"),
