@@ -81,7 +81,6 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             BearingFilter::FiniteDifference => None,
         };
         let how = tracking.as_ref();
-        let limits = &self.config.limits;
         // The oldest neighbour (ages are never NaN: ∞ + a finite dt ≥ 0, or 0 when heard).
         let mut oldest = T::zero();
         if in_order {
@@ -94,7 +93,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 }
                 match bearings.next() {
                     Some(b) => take_bearing(n, b, dt, how),
-                    None => no_bearing(n, dt, limits, how),
+                    None => no_bearing(n, dt),
                 }
             }
         } else {
@@ -105,11 +104,20 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 }
                 match bearing_to(m.bearings, n.id) {
                     Some(b) => take_bearing(n, b, dt, how),
-                    None => no_bearing(n, dt, limits, how),
+                    None => no_bearing(n, dt),
                 }
             }
         }
         self.oldest = Some(oldest);
+        // The bearings are to distinct neighbours (checked): fewer than the neighbours
+        // means some are missing, and only then does the hold run (SPEC §12, S18).
+        if m.bearings.len() < self.neighbours.len() {
+            hold_missing(
+                self.neighbours.as_mut_slice(),
+                self.config.limits.bearing_hold,
+                how,
+            );
+        }
         Ok(())
     }
 
@@ -315,7 +323,12 @@ fn take_bearing<T: Real, const MT: usize>(
 ) {
     let interval = n.bearing_age + dt;
     let (s, rate) = match (b.rate, tracking) {
-        (Some(rate), _) => (b.bearing, rate),
+        (Some(rate), None) => (b.bearing, rate),
+        // A measured rate bypasses the tracker: nothing of a gap was predicted since.
+        (Some(rate), Some(_)) => {
+            n.track.predicted = T::zero();
+            (b.bearing, rate)
+        }
         // Finite difference of successive bearings (SPEC §2), over the time since the
         // previous bearing (a missed tick widens the interval). Without a previous
         // bearing the interval is −∞: zero rate.
@@ -343,41 +356,43 @@ fn take_bearing<T: Real, const MT: usize>(
     n.fresh = true;
 }
 
-/// No bearing to this neighbour this tick (SPEC §12). S18: the last one is still used
-/// while it is younger than the hold `T_h` ([`crate::Limits::bearing_hold`]; never for a
-/// neighbour not yet measured, whose age is −∞): with the finite difference the bearing,
-/// its rate and its range are held as they were; with the tracker `ŝ` and `ρ̂` are
-/// predicted (S15 without S16) and the rate is S17 on the prediction; the range is held.
-/// Past the hold it is missing (S19: the angles that need it cannot be formed). Out of
-/// the neighbour loop's way: a bearing is rarely missing.
+/// No bearing to this neighbour this tick: it ages ([`hold_missing`] decides then
+/// whether it is held).
+#[inline(always)]
+fn no_bearing<T: Real, const MT: usize>(n: &mut Neighbour<T, MT>, dt: T) {
+    n.bearing_age += dt;
+    n.fresh = false;
+}
+
+/// The neighbours without a bearing this tick (SPEC §12). S18: the last one is still
+/// used while it is younger than the hold `T_h` ([`crate::Limits::bearing_hold`]; never
+/// for a neighbour not yet measured, whose age is −∞): with the finite difference the
+/// bearing, its rate and its range are held as they were; with the tracker `ŝ` and `ρ̂`
+/// are predicted (S15 without S16) and the rate is S17 on the prediction; the range is
+/// held. Past the hold it is missing (S19: the angles that need it cannot be formed).
+/// Out of the neighbour loop's way: a bearing is rarely missing.
 #[cold]
 #[inline(never)]
-fn no_bearing<T: Real, const MT: usize>(
-    n: &mut Neighbour<T, MT>,
-    dt: T,
-    limits: &crate::Limits<T>,
+fn hold_missing<T: Real, const MT: usize>(
+    neighbours: &mut [Neighbour<T, MT>],
+    hold: T,
     tracking: Option<&Tracking<'_, T>>,
 ) {
-    let before = n.bearing_age;
-    n.bearing_age += dt;
-    let since = n.bearing_age;
-    // S18: 0 ≤ τ < T_h (false for −∞, "never").
-    n.fresh = since >= T::zero() && since < limits.bearing_hold;
-    if !n.fresh {
-        n.range = None;
-        return;
-    }
-    if let Some(t) = tracking {
-        if before == T::zero() {
-            // The first tick without it: nothing of an earlier gap is left to subtract
-            // (a bearing with a measured rate bypasses the tracker's update).
-            n.track.predicted = T::zero();
+    for n in neighbours.iter_mut().filter(|n| !n.fresh) {
+        let since = n.bearing_age;
+        // S18: 0 ≤ τ < T_h (false for −∞, "never").
+        n.fresh = since >= T::zero() && since < hold;
+        if !n.fresh {
+            n.range = None;
+            continue;
         }
-        // The same relative velocities as `take_bearing` gives the tracker (SPEC §11).
-        let dv = RelativeVelocity {
-            moved: n.velocity - t.v_before,
-            now: n.velocity - t.v,
-        };
-        n.rate = n.track.predict(&mut n.s, &dv, since, t.c, &t.limits);
+        if let Some(t) = tracking {
+            // The same relative velocities as `take_bearing` gives the tracker (SPEC §11).
+            let dv = RelativeVelocity {
+                moved: n.velocity - t.v_before,
+                now: n.velocity - t.v,
+            };
+            n.rate = n.track.predict(&mut n.s, &dv, since, t.c, &t.limits);
+        }
     }
 }
