@@ -38,7 +38,8 @@ pub struct ph_bearing {
 pub struct ph_measurements {
     /// Time, s (for the `v*`, `z*` schedules).
     pub time: f32,
-    /// Seconds since the previous step (0 on the first).
+    /// Seconds since the previous step (0 on the first; negative: the safe output with
+    /// `PH_FAULT_NEGATIVE_DT`).
     pub dt: f32,
     /// Own velocity, m/s (world frame).
     pub velocity: [f32; 2],
