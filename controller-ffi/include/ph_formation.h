@@ -757,7 +757,8 @@ typedef struct {
    */
   float time;
   /**
-   * Seconds since the previous step (0 on the first).
+   * Seconds since the previous step (0 on the first; negative: the safe output with
+   * `PH_FAULT_NEGATIVE_DT`).
    */
   float dt;
   /**

@@ -25,8 +25,10 @@ fn config(id: u8, hold: f32) -> ph_config {
         a.damping = 0.5;
         a.estimator_gain = 1.0;
     }
-    c.bearing_filter.kind =
-        controller_ffi::config::ph_filter_kind::PH_FILTER_FINITE_DIFFERENCE as u8;
+    c.bearing_filter = controller_ffi::config::ph_bearing_filter {
+        kind: controller_ffi::config::ph_filter_kind::PH_FILTER_FINITE_DIFFERENCE as u8,
+        ..Default::default()
+    };
     c.limits.bearing_hold = hold;
     c
 }
