@@ -114,6 +114,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         if m.bearings.len() < self.neighbours.len() {
             hold_missing(
                 self.neighbours.as_mut_slice(),
+                dt,
                 self.config.limits.bearing_hold,
                 how,
             );
@@ -323,12 +324,7 @@ fn take_bearing<T: Real, const MT: usize>(
 ) {
     let interval = n.bearing_age + dt;
     let (s, rate) = match (b.rate, tracking) {
-        (Some(rate), None) => (b.bearing, rate),
-        // A measured rate bypasses the tracker: nothing of a gap was predicted since.
-        (Some(rate), Some(_)) => {
-            n.track.predicted = T::zero();
-            (b.bearing, rate)
-        }
+        (Some(rate), _) => (b.bearing, rate),
         // Finite difference of successive bearings (SPEC §2), over the time since the
         // previous bearing (a missed tick widens the interval). Without a previous
         // bearing the interval is −∞: zero rate.
@@ -375,6 +371,7 @@ fn no_bearing<T: Real, const MT: usize>(n: &mut Neighbour<T, MT>, dt: T) {
 #[inline(never)]
 fn hold_missing<T: Real, const MT: usize>(
     neighbours: &mut [Neighbour<T, MT>],
+    dt: T,
     hold: T,
     tracking: Option<&Tracking<'_, T>>,
 ) {
@@ -387,6 +384,12 @@ fn hold_missing<T: Real, const MT: usize>(
             continue;
         }
         if let Some(t) = tracking {
+            if since - dt <= T::zero() {
+                // The first tick of the gap (the bearing was measured at the last one):
+                // nothing of an earlier gap is left to subtract (a bearing with a
+                // measured rate bypasses the tracker's update, which clears it).
+                n.track.predicted = T::zero();
+            }
             // The same relative velocities as `take_bearing` gives the tracker (SPEC §11).
             let dv = RelativeVelocity {
                 moved: n.velocity - t.v_before,
