@@ -230,6 +230,7 @@ fn apex_part<T: Real, const MT: usize>(
     let (Some(nv), Some(nw)) = (nbs.get(a.slots[1]), nbs.get(a.slots[2])) else {
         return Err(Fault::Internal);
     };
+    // S19: both bearings measured or held (S18), else the angle cannot be formed.
     if !(nv.fresh && nw.fresh) {
         let missing = if nv.fresh { nw.id } else { nv.id };
         return Err(Fault::MissingBearing(missing));
