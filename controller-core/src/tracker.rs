@@ -57,7 +57,8 @@ const MAX_REJECTED: u8 = 3;
 impl<T: Real> Track<T> {
     /// Takes bearing `z` (unit) measured `dt` seconds after the previous one, which gave
     /// `s` (`ŝ`, updated in place), with the relative velocity `dv`. Returns `ṡ̂`
-    /// (S15–S17). A
+    /// (S15–S17). The prediction spans `dt` less what [`Track::predict`] propagated over
+    /// since the previous bearing (SPEC §12). A
     /// non-positive or non-finite `dt` (the first bearing: the agent passes `−∞`), a
     /// bearing more than 90° from the prediction, or three gated-out bearings in a row
     /// (re)start the track at `z` with zero covariance cross term. Not inlined: the
