@@ -221,6 +221,12 @@ pub struct Limits<T> {
     /// `cos` of the angle margin (default 5°): a current angle with `|cos α|` above this
     /// is reported as degenerate (the output is still computed).
     pub margin_cos: T,
+    /// `T_h ≥ 0` (s): a neighbour's bearing missing from the measurements is still used
+    /// while the last one measured is younger than this: held (finite differences) or
+    /// predicted (the bearing tracker), SPEC §12 (S18). Past it the bearing is missing
+    /// and the output is the safe one (S19). Default 0: a bearing missing for one tick
+    /// is missing (no hold).
+    pub bearing_hold: T,
 }
 
 impl<T: Real> Default for Limits<T> {
@@ -231,6 +237,7 @@ impl<T: Real> Default for Limits<T> {
             safe_damping: T::lit(1.0),
             bearing_tolerance: T::lit(1.0e-3),
             margin_cos: T::lit(0.996_194_698_091_745_5), // cos 5°
+            bearing_hold: T::zero(),
         }
     }
 }

@@ -21,8 +21,8 @@ pub const MAX_LINK_BEARINGS: usize = 12;
 /// Largest encoded link message (before COBS), in bytes.
 pub const MAX_LINK_MSG: usize = 512;
 /// Link protocol version, sent in [`TargetMsg::Ready`] (3: the configuration carries
-/// the bearing filter of SPEC §11).
-pub const LINK_VERSION: u8 = 3;
+/// the bearing filter of SPEC §11; 4: its limits the bearing hold of SPEC §12).
+pub const LINK_VERSION: u8 = 4;
 
 /// One bearing measurement on the link (see [`crate::BearingMeasurement`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

@@ -27,6 +27,10 @@ pub struct Track<T: Real> {
     pub p: [T; 3],
     /// Measurements in a row that failed the gate (S16).
     pub rejected: u8,
+    /// Seconds of the interval since the last bearing that [`Track::predict`] has
+    /// already propagated `ŝ`, `ρ̂` and `P` over (SPEC §12, S18): the next
+    /// [`Track::update`] predicts over the rest only.
+    pub predicted: T,
 }
 
 /// What the tracker needs besides its configuration: the agent-wide constants.
@@ -53,10 +57,11 @@ const MAX_REJECTED: u8 = 3;
 impl<T: Real> Track<T> {
     /// Takes bearing `z` (unit) measured `dt` seconds after the previous one, which gave
     /// `s` (`ŝ`, updated in place), with the relative velocity `dv`. Returns `ṡ̂`
-    /// (S15–S17). A
-    /// non-positive or non-finite `dt` (the first bearing: the agent passes `−∞`), a
-    /// bearing more than 90° from the prediction, or three gated-out bearings in a row
-    /// (re)start the track at `z` with zero covariance cross term. Not inlined: the
+    /// (S15–S17). The prediction spans `dt` less what [`Track::predict`] propagated over
+    /// since the previous bearing (SPEC §12). A
+    /// non-positive or non-finite `dt` (the first bearing: the agent passes `−∞`) or three
+    /// gated-out bearings in a row (a bearing more than 90° from the prediction is gated
+    /// out) (re)start the track at `z` with zero covariance cross term. Not inlined: the
     /// agent's neighbour loop stays small on the finite-difference path.
     #[inline(never)]
     pub fn update(
@@ -69,35 +74,23 @@ impl<T: Real> Track<T> {
         lim: &TrackLimits<T>,
     ) -> Vec2<T> {
         let r = c.bearing_noise * c.bearing_noise;
+        // SPEC §12: what `predict` propagated over already is not predicted again.
+        let dt = dt - core::mem::take(&mut self.predicted);
         let (moved, dv) = (&dv.moved, &dv.now);
         if !(dt > T::zero() && dt.finite()) {
             self.start(s, z, r, lim);
             return rate(s, self.rho, dv);
         }
-        // S15: prediction along the bearing kinematics (S2, S3) with ρ̂ for 1/r.
-        let t = perp(s);
-        let (a, b) = (t.dot(moved), s.dot(moved));
-        let delta = dt * self.rho * a;
-        let s_pred = unit(&(*s + t * delta));
-        let rho_pred = clamp(self.rho - dt * self.rho * self.rho * b, lim.rho_max);
-        let f01 = dt * a;
-        let f11 = T::one() - T::lit(2.0) * dt * self.rho * b;
-        let [p00, p01, p11] = self.p;
-        let p11f = p11 * f01;
-        let p00 = p00 + f01 * (p01 + p01 + p11f) + c.rate_noise * c.rate_noise * dt;
-        let p01 = f11 * (p01 + p11f);
-        let p11 = f11 * f11 * p11 + c.inverse_range_noise * c.inverse_range_noise * dt;
+        let (s_pred, rho_pred, [p00, p01, p11]) = self.s15(s, moved, dt, c, lim);
         // S16: the bearing as a measurement of the tangent angle, e = (Jŝ)ᵀz ≈ δθ.
         let tp = perp(&s_pred);
         let (e, along) = (tp.dot(z), s_pred.dot(z));
-        if along <= T::zero() {
-            self.start(s, z, r, lim);
-            return rate(s, self.rho, dv);
-        }
         let sv = p00 + r;
         let gate = c.gate * c.gate * sv;
-        // False for a NaN innovation as for an outlier.
-        let inside = e * e <= gate;
+        // False for a NaN innovation as for an outlier; a bearing more than 90° from the
+        // prediction (where `e`, a sine, is small again) is an outlier too (a camera's
+        // wrong bearing points anywhere).
+        let inside = along > T::zero() && e * e <= gate;
         if !inside {
             // An outlier (or a NaN): predict only.
             self.rejected = self.rejected.saturating_add(1);
@@ -119,6 +112,56 @@ impl<T: Real> Track<T> {
         rate(s, self.rho, dv)
     }
 
+    /// No bearing this tick, `since` seconds after the last one (SPEC §12, S18): S15
+    /// alone (no update) over the part of `since` not yet predicted, `ŝ` (`s`, in place),
+    /// `ρ̂` and `P` brought to date. Returns `ṡ̂` (S17). Nothing moves for a `since` not
+    /// above what was predicted already (or not finite).
+    #[inline(never)]
+    pub fn predict(
+        &mut self,
+        s: &mut Vec2<T>,
+        dv: &RelativeVelocity<T>,
+        since: T,
+        c: &TrackerConfig<T>,
+        lim: &TrackLimits<T>,
+    ) -> Vec2<T> {
+        let dt = since - self.predicted;
+        if dt > T::zero() && dt.finite() {
+            let (s_pred, rho_pred, p) = self.s15(s, &dv.moved, dt, c, lim);
+            *s = s_pred;
+            self.rho = rho_pred;
+            self.p = p;
+            self.predicted = since;
+        }
+        rate(s, self.rho, &dv.now)
+    }
+
+    /// S15: the prediction over `dt` along the bearing kinematics (S2, S3) with `ρ̂` for
+    /// `1/r`, driven by the relative velocity `moved`: `(ŝ⁻, ρ̂⁻, P⁻)`.
+    #[inline(always)]
+    fn s15(
+        &self,
+        s: &Vec2<T>,
+        moved: &Vec2<T>,
+        dt: T,
+        c: &TrackerConfig<T>,
+        lim: &TrackLimits<T>,
+    ) -> (Vec2<T>, T, [T; 3]) {
+        let t = perp(s);
+        let (a, b) = (t.dot(moved), s.dot(moved));
+        let delta = dt * self.rho * a;
+        let s_pred = unit(&(*s + t * delta));
+        let rho_pred = clamp(self.rho - dt * self.rho * self.rho * b, lim.rho_max);
+        let f01 = dt * a;
+        let f11 = T::one() - T::lit(2.0) * dt * self.rho * b;
+        let [p00, p01, p11] = self.p;
+        let p11f = p11 * f01;
+        let p00 = p00 + f01 * (p01 + p01 + p11f) + c.rate_noise * c.rate_noise * dt;
+        let p01 = f11 * (p01 + p11f);
+        let p11 = f11 * f11 * p11 + c.inverse_range_noise * c.inverse_range_noise * dt;
+        (s_pred, rho_pred, [p00, p01, p11])
+    }
+
     /// (Re)starts the track at bearing `z` with `ρ̂(0)`: variance `R` on the angle, `ρ̂(0)²`
     /// (100 %) on the inverse distance.
     fn start(&mut self, s: &mut Vec2<T>, z: &Vec2<T>, r: T, lim: &TrackLimits<T>) {
@@ -128,6 +171,7 @@ impl<T: Real> Track<T> {
             rho,
             p: [r, T::zero(), rho * rho],
             rejected: 0,
+            predicted: T::zero(),
         };
     }
 }

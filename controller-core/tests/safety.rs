@@ -153,9 +153,14 @@ fn bad_measurements_give_typed_faults_and_finite_safe_output() {
         Status::Safe(Fault::Measurement(MeasurementError::NonFinite))
     );
     assert_eq!(out.force, Vec2::zeros());
-    // Negative dt.
+    // Negative dt: its own error (issue 29); an infinite one is not finite.
     let mut m = meas(&f, &s, 1, &good, -0.01);
     m.dt = -0.01;
+    assert_eq!(
+        a.step(&m).status,
+        Status::Safe(Fault::Measurement(MeasurementError::NegativeDt))
+    );
+    m.dt = f64::NEG_INFINITY;
     assert_eq!(
         a.step(&m).status,
         Status::Safe(Fault::Measurement(MeasurementError::NonFinite))

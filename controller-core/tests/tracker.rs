@@ -211,6 +211,16 @@ fn an_outlier_is_gated_out_and_a_lost_track_restarts() {
     tr.update(&mut sh, &s, &dv, DT, &c, &LIMITS);
     assert!((sh - s).norm() < 1e-9);
     assert_eq!(tr.rejected, 0);
+    // A wrong bearing behind the track (where the innovation's sine is small again) is
+    // an outlier too, not a restart.
+    let behind = rotate(&s, 179f64.to_radians());
+    tr.update(&mut sh, &behind, &dv, DT, &c, &LIMITS);
+    assert!(
+        (sh - s).norm() < 1e-9,
+        "a bearing behind moved the track: {sh:?}"
+    );
+    assert_eq!(tr.rejected, 1);
+    tr.update(&mut sh, &s, &dv, DT, &c, &LIMITS);
     // Three in a row: the neighbour really is elsewhere; the track restarts there.
     for _ in 0..3 {
         tr.update(&mut sh, &wrong, &dv, DT, &c, &LIMITS);

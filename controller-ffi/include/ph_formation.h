@@ -63,7 +63,8 @@
 
 /**
  * Version of this C ABI (the header's structs and functions; 3: `ph_config` gained
- * `bearing_filter`; 4: `ph_actuator` and `ph_actuator_init` gained the lead). Compare the header's
+ * `bearing_filter`; 4: `ph_limits` gained `bearing_hold`, `ph_fault` gained
+ * `PH_FAULT_NEGATIVE_DT`, `ph_actuator` and `ph_actuator_init` the lead). Compare the header's
  * value with `ph_abi_version()` of the library you link.
  */
 #define PH_ABI_VERSION 4
@@ -78,14 +79,14 @@
 /**
  * Bytes of agent memory (`sizeof` the agent, for 32-bit targets such as Cortex-M).
  */
-#define PH_AGENT_SIZE 3664
+#define PH_AGENT_SIZE 3716
 #endif
 
 #if defined(PH_PTR64)
 /**
  * Bytes of agent memory (`sizeof` the agent, for 64-bit hosts).
  */
-#define PH_AGENT_SIZE 4000
+#define PH_AGENT_SIZE 4104
 #endif
 
 #if defined(PH_PTR32)
@@ -341,7 +342,7 @@ enum ph_fault
    */
   PH_FAULT_NONE = 0,
   /**
-   * Time, dt (< 0), velocity or partner offset not finite.
+   * Time, dt, velocity or partner offset not finite.
    */
   PH_FAULT_NON_FINITE_MEASUREMENT = 1,
   /**
@@ -389,6 +390,10 @@ enum ph_fault
    * An internal inconsistency the agent's construction rules out (a bug: report it).
    */
   PH_FAULT_INTERNAL = 12,
+  /**
+   * `dt` is negative (time ran backwards).
+   */
+  PH_FAULT_NEGATIVE_DT = 13,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -613,6 +618,12 @@ typedef struct {
    * degenerate.
    */
   float margin_cos;
+  /**
+   * `T_h ≥ 0` (s): a missing bearing is held (finite differences) or predicted (the
+   * tracker) while the last one measured is younger than this; past it, the safe
+   * output (SPEC §12). 0: no hold.
+   */
+  float bearing_hold;
 } ph_limits;
 
 /**
@@ -752,7 +763,8 @@ typedef struct {
    */
   float time;
   /**
-   * Seconds since the previous step (0 on the first).
+   * Seconds since the previous step (0 on the first; negative: the safe output with
+   * `PH_FAULT_NEGATIVE_DT`).
    */
   float dt;
   /**

@@ -21,7 +21,8 @@
 //! and [`BLOB_VERSION`] must change with it (`tests/blob.rs` pins the bytes of one blob).
 //! Version 3: the integrity may be `auth`, with its 128-bit key (a secret: a blob of an
 //! `auth` configuration must be stored and transported like the key itself). Version 4:
-//! the bearing filter (SPEC §11) after the limits.
+//! the bearing filter (SPEC §11) after the limits. Version 5: the limits end with the
+//! bearing hold (SPEC §12).
 
 use crc::{Crc, NoTable, CRC_32_ISO_HDLC};
 
@@ -32,7 +33,7 @@ use crate::{FfiAgent, FfiConfig};
 /// The first four bytes of a blob.
 pub const BLOB_MAGIC: [u8; 4] = *b"PHCF";
 /// The blob format version this library writes and reads.
-pub const BLOB_VERSION: u8 = 4;
+pub const BLOB_VERSION: u8 = 5;
 /// Bytes before the payload.
 pub const BLOB_HEADER_LEN: usize = 8;
 /// Bytes of the trailing checksum.

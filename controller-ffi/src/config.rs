@@ -155,6 +155,10 @@ pub struct ph_limits {
     /// `cos` of the angle margin: a current angle with `|cos α|` above it is reported as
     /// degenerate.
     pub margin_cos: f32,
+    /// `T_h ≥ 0` (s): a missing bearing is held (finite differences) or predicted (the
+    /// tracker) while the last one measured is younger than this; past it, the safe
+    /// output (SPEC §12). 0: no hold.
+    pub bearing_hold: f32,
 }
 
 /// One agent's configuration. Start from `ph_config_default` (the SPEC defaults), then
@@ -321,6 +325,7 @@ fn limits_to_core(l: &ph_limits) -> Limits<f32> {
         safe_damping,
         bearing_tolerance,
         margin_cos,
+        bearing_hold,
     } = *l;
     Limits {
         max_force,
@@ -328,6 +333,7 @@ fn limits_to_core(l: &ph_limits) -> Limits<f32> {
         safe_damping,
         bearing_tolerance,
         margin_cos,
+        bearing_hold,
     }
 }
 
@@ -338,6 +344,7 @@ fn limits_from_core(l: &Limits<f32>) -> ph_limits {
         safe_damping,
         bearing_tolerance,
         margin_cos,
+        bearing_hold,
     } = *l;
     ph_limits {
         max_force,
@@ -345,6 +352,7 @@ fn limits_from_core(l: &Limits<f32>) -> ph_limits {
         safe_damping,
         bearing_tolerance,
         margin_cos,
+        bearing_hold,
     }
 }
 

@@ -38,7 +38,8 @@ pub struct ph_bearing {
 pub struct ph_measurements {
     /// Time, s (for the `v*`, `z*` schedules).
     pub time: f32,
-    /// Seconds since the previous step (0 on the first).
+    /// Seconds since the previous step (0 on the first; negative: the safe output with
+    /// `PH_FAULT_NEGATIVE_DT`).
     pub dt: f32,
     /// Own velocity, m/s (world frame).
     pub velocity: [f32; 2],
@@ -70,7 +71,7 @@ pub enum ph_output_status {
 pub enum ph_fault {
     /// No fault (nominal output).
     PH_FAULT_NONE = 0,
-    /// Time, dt (< 0), velocity or partner offset not finite.
+    /// Time, dt, velocity or partner offset not finite.
     PH_FAULT_NON_FINITE_MEASUREMENT = 1,
     /// The bearing to `fault_neighbour` is not a finite unit vector (or its rate is not
     /// finite).
@@ -95,6 +96,8 @@ pub enum ph_fault {
     PH_FAULT_NON_FINITE_FORCE = 11,
     /// An internal inconsistency the agent's construction rules out (a bug: report it).
     PH_FAULT_INTERNAL = 12,
+    /// `dt` is negative (time ran backwards).
+    PH_FAULT_NEGATIVE_DT = 13,
 }
 
 /// The result of `ph_step`. `force` is always finite and at most `max_force` long.
@@ -192,6 +195,7 @@ fn fault(status: &Status) -> (ph_output_status, ph_fault, i16) {
         Status::Safe(f) => match f {
             Fault::Measurement(m) => match m {
                 MeasurementError::NonFinite => (PH_FAULT_NON_FINITE_MEASUREMENT, None),
+                MeasurementError::NegativeDt => (PH_FAULT_NEGATIVE_DT, None),
                 MeasurementError::BadBearing(id) => (PH_FAULT_BAD_BEARING, Some(id)),
                 MeasurementError::UnknownNeighbour(id) => (PH_FAULT_UNKNOWN_NEIGHBOUR, Some(id)),
                 MeasurementError::DuplicateBearing(id) => (PH_FAULT_DUPLICATE_BEARING, Some(id)),

@@ -54,6 +54,9 @@ pub struct StepConfig {
     /// Every agent differentiates its bearings (SPEC §2) instead of running the bearing
     /// tracker (SPEC §11, the default): the `_fd` rows, the wire's own cost.
     pub finite_difference: bool,
+    /// The bearing to the last rim agent is missing in the measured tick and held
+    /// ([`controller_core::Limits::bearing_hold`], SPEC §12): the `_held` rows.
+    pub held: bool,
 }
 
 /// The `auth` configurations' key: the public placeholder (see [`crate::keys`]).
@@ -62,67 +65,92 @@ const AUTH: Integrity = Integrity::Auth(crate::keys::PLACEHOLDER_SWARM_KEY);
 /// The configurations measured by the `measure` binary, in order: `crc16`
 /// integrity (`triN`), `link` (`triN_link`: no trailer, the radio checks its own
 /// CRC), `auth` (`triN_auth`), and `crc16` with finite-difference bearing rates
-/// instead of the bearing tracker (`triN_fd`).
-pub const STEP_CONFIGS: [StepConfig; 10] = [
+/// instead of the bearing tracker (`triN_fd`); `_held`: one bearing missing in the
+/// measured tick and held or predicted (SPEC §12).
+pub const STEP_CONFIGS: [StepConfig; 12] = [
     StepConfig {
         name: "tri1",
         triangles: 1,
         integrity: Integrity::Crc16,
         finite_difference: false,
+        held: false,
     },
     StepConfig {
         name: "tri2",
         triangles: 2,
         integrity: Integrity::Crc16,
         finite_difference: false,
+        held: false,
     },
     StepConfig {
         name: "tri4",
         triangles: 4,
         integrity: Integrity::Crc16,
         finite_difference: false,
+        held: false,
     },
     StepConfig {
         name: "tri8",
         triangles: 8,
         integrity: Integrity::Crc16,
         finite_difference: false,
+        held: false,
     },
     StepConfig {
         name: "tri2_link",
         triangles: 2,
         integrity: Integrity::Link,
         finite_difference: false,
+        held: false,
     },
     StepConfig {
         name: "tri8_link",
         triangles: 8,
         integrity: Integrity::Link,
         finite_difference: false,
+        held: false,
     },
     StepConfig {
         name: "tri2_auth",
         triangles: 2,
         integrity: AUTH,
         finite_difference: false,
+        held: false,
     },
     StepConfig {
         name: "tri8_auth",
         triangles: 8,
         integrity: AUTH,
         finite_difference: false,
+        held: false,
     },
     StepConfig {
         name: "tri2_fd",
         triangles: 2,
         integrity: Integrity::Crc16,
         finite_difference: true,
+        held: false,
     },
     StepConfig {
         name: "tri8_fd",
         triangles: 8,
         integrity: Integrity::Crc16,
         finite_difference: true,
+        held: false,
+    },
+    StepConfig {
+        name: "tri2_held",
+        triangles: 2,
+        integrity: Integrity::Crc16,
+        finite_difference: false,
+        held: true,
+    },
+    StepConfig {
+        name: "tri2_fd_held",
+        triangles: 2,
+        integrity: Integrity::Crc16,
+        finite_difference: true,
+        held: true,
     },
 ];
 
@@ -327,6 +355,7 @@ struct Fan {
     k: usize,
     integrity: Integrity,
     finite_difference: bool,
+    held: bool,
 }
 
 impl Fan {
@@ -336,6 +365,7 @@ impl Fan {
                 k,
                 integrity: cfg.integrity,
                 finite_difference: cfg.finite_difference,
+                held: cfg.held,
             }),
             _ => Err(BenchError::Triangles),
         }
@@ -436,6 +466,10 @@ impl Fan {
         c.integrity = self.integrity;
         if self.finite_difference {
             c.bearing_filter = controller_core::BearingFilter::FiniteDifference;
+        }
+        if self.held {
+            // Five ticks (SPEC §12).
+            c.limits.bearing_hold = 5.0 * DT;
         }
         c
     }
@@ -564,6 +598,11 @@ impl Bench {
             }
         }
         self.inputs = fan.inputs(0, WARMUP_TICKS as f32 * DT);
+        if fan.held {
+            // The camera lost the last rim agent this tick: the centre holds or
+            // predicts its bearing (SPEC §12, S18) and stays nominal.
+            self.inputs.bearings.pop();
+        }
         Ok(())
     }
 }

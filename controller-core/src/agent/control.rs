@@ -333,6 +333,7 @@ fn far_law<T: Real, const MT: usize>(
     sum: &mut LawSum<T>,
 ) -> Result<(), Fault> {
     let n = nbs.get(a.slots[0]).ok_or(Fault::Internal)?;
+    // S19: the bearing to the apex measured or held (S18).
     let (s_ku, _) = n.bearing()?;
     if !within(age, cx.timeout) {
         return Err(Fault::MissingData(a.apex));

@@ -106,8 +106,9 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         &self.stats
     }
 
-    /// The bearing to `neighbour` measured this tick and its rate (measured, or the finite
-    /// difference of SPEC §2), if there is one.
+    /// The bearing to `neighbour` the law uses this tick and its rate (measured, the finite
+    /// difference of SPEC §2 or the tracker's of §11; held or predicted within
+    /// [`crate::Limits::bearing_hold`] when none was measured, §12), if there is one.
     pub fn bearing(&self, neighbour: AgentId) -> Option<(Vec2<T>, Vec2<T>)> {
         self.neighbours
             .iter()

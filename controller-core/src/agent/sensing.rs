@@ -43,7 +43,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     pub(super) fn sense_own(&mut self, m: &Measurements<'_, T>) -> Result<(), Fault> {
         let dt = m.dt;
         if !(finite(dt) && dt >= T::zero()) {
-            return Err(Fault::Measurement(MeasurementError::NonFinite));
+            return Err(Fault::Measurement(bad_dt(dt)));
         }
         // The checks read nothing that aging changes: age after them.
         let in_order = match self.check_measurements(m) {
@@ -109,6 +109,16 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             }
         }
         self.oldest = Some(oldest);
+        // The bearings are to distinct neighbours (checked): fewer than the neighbours
+        // means some are missing, and only then does the hold run (SPEC §12, S18).
+        if m.bearings.len() < self.neighbours.len() {
+            hold_missing(
+                self.neighbours.as_mut_slice(),
+                dt,
+                self.config.limits.bearing_hold,
+                how,
+            );
+        }
         Ok(())
     }
 
@@ -167,6 +177,17 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     }
 }
 
+/// Why a `dt` that is not finite and non-negative was refused.
+#[cold]
+#[inline(never)]
+fn bad_dt<T: Real>(dt: T) -> MeasurementError {
+    if finite(dt) {
+        MeasurementError::NegativeDt
+    } else {
+        MeasurementError::NonFinite
+    }
+}
+
 /// One angle's part of [`Agent::sense`] after the own measurements were taken: the apex
 /// computes its kernel ([`apex_part`]) and keeps it, or the fault, for the law; a far
 /// vertex ages what it last received by `dt`.
@@ -209,6 +230,7 @@ fn apex_part<T: Real, const MT: usize>(
     let (Some(nv), Some(nw)) = (nbs.get(a.slots[1]), nbs.get(a.slots[2])) else {
         return Err(Fault::Internal);
     };
+    // S19: both bearings measured or held (S18), else the angle cannot be formed.
     if !(nv.fresh && nw.fresh) {
         let missing = if nv.fresh { nw.id } else { nv.id };
         return Err(Fault::MissingBearing(missing));
@@ -331,10 +353,50 @@ fn take_bearing<T: Real, const MT: usize>(
     n.fresh = true;
 }
 
-/// No bearing to this neighbour this tick.
+/// No bearing to this neighbour this tick: it ages ([`hold_missing`] decides then
+/// whether it is held).
 #[inline(always)]
 fn no_bearing<T: Real, const MT: usize>(n: &mut Neighbour<T, MT>, dt: T) {
     n.bearing_age += dt;
     n.fresh = false;
-    n.range = None;
+}
+
+/// The neighbours without a bearing this tick (SPEC §12). S18: the last one is still
+/// used while it is younger than the hold `T_h` ([`crate::Limits::bearing_hold`]; never
+/// for a neighbour not yet measured, whose age is −∞): with the finite difference the
+/// bearing, its rate and its range are held as they were; with the tracker `ŝ` and `ρ̂`
+/// are predicted (S15 without S16) and the rate is S17 on the prediction; the range is
+/// held. Past the hold it is missing (S19: the angles that need it cannot be formed).
+/// Out of the neighbour loop's way: a bearing is rarely missing.
+#[cold]
+#[inline(never)]
+fn hold_missing<T: Real, const MT: usize>(
+    neighbours: &mut [Neighbour<T, MT>],
+    dt: T,
+    hold: T,
+    tracking: Option<&Tracking<'_, T>>,
+) {
+    for n in neighbours.iter_mut().filter(|n| !n.fresh) {
+        let since = n.bearing_age;
+        // S18: 0 ≤ τ < T_h (false for −∞, "never").
+        n.fresh = since >= T::zero() && since < hold;
+        if !n.fresh {
+            n.range = None;
+            continue;
+        }
+        if let Some(t) = tracking {
+            if since - dt <= T::zero() {
+                // The first tick of the gap (the bearing was measured at the last one):
+                // nothing of an earlier gap is left to subtract (a bearing with a
+                // measured rate bypasses the tracker's update, which clears it).
+                n.track.predicted = T::zero();
+            }
+            // The same relative velocities as `take_bearing` gives the tracker (SPEC §11).
+            let dv = RelativeVelocity {
+                moved: n.velocity - t.v_before,
+                now: n.velocity - t.v,
+            };
+            n.rate = n.track.predict(&mut n.s, &dv, since, t.c, &t.limits);
+        }
+    }
 }

@@ -136,7 +136,9 @@ fn check_parameters<T: Real, const MT: usize>(c: &AgentConfig<T, MT>) -> Result<
         && l.bearing_tolerance > zero
         && l.margin_cos.finite()
         && l.margin_cos > zero
-        && l.margin_cos < T::one();
+        && l.margin_cos < T::one()
+        && l.bearing_hold.finite()
+        && l.bearing_hold >= zero;
     if !ok {
         return Err(ConfigError::BadParameter);
     }

@@ -111,10 +111,13 @@ pub(super) struct Neighbour<T: Real, const MT: usize> {
     pub s: Vec2<T>,
     /// The bearing rate `ṡ` that goes with `s`.
     pub rate: Vec2<T>,
-    /// Seconds since `s` was measured (finite-difference interval); −∞ while there is none.
+    /// Seconds since a bearing to it was last measured (the finite-difference interval,
+    /// and `τ` of the hold, SPEC §12); −∞ while there is none.
     pub bearing_age: T,
+    /// The range measured with the bearing (held with it, S18).
     pub range: Option<T>,
-    /// `s` was measured this tick.
+    /// `s` and `rate` can be used this tick: measured, or held or predicted within the
+    /// bearing hold (S18).
     pub fresh: bool,
     /// The bearing tracker of this neighbour (SPEC §11; unused with the finite difference).
     pub track: crate::tracker::Track<T>,
@@ -139,7 +142,8 @@ impl<T: Real, const MT: usize> Neighbour<T, MT> {
         }
     }
 
-    /// The fresh bearing and rate, or [`Fault::MissingBearing`].
+    /// The bearing and rate of this tick (measured, held or predicted: S18), or
+    /// [`Fault::MissingBearing`].
     #[inline]
     pub(super) fn bearing(&self) -> Result<(Vec2<T>, Vec2<T>), Fault> {
         if self.fresh {

@@ -25,11 +25,14 @@ pub struct Measurements<'a, T: Real> {
     /// Time in seconds (for the `v*`, `z*` schedules).
     pub time: T,
     /// Seconds since the previous step (the estimator's `Δt`, finite differences and
-    /// neighbour ages). Zero is allowed (no time passes).
+    /// neighbour ages). Zero is allowed (no time passes); a negative one is refused
+    /// ([`MeasurementError::NegativeDt`]).
     pub dt: T,
     /// Own velocity `v_n` (world frame).
     pub velocity: Vec2<T>,
-    /// Bearings to the neighbours (every triangle neighbour, every tick).
+    /// Bearings to the neighbours (every triangle neighbour, every tick; one missing is
+    /// held or predicted for up to [`Limits::bearing_hold`](crate::Limits::bearing_hold),
+    /// SPEC §12).
     pub bearings: &'a [BearingMeasurement<T>],
     /// Leaders only: the partner's position minus this agent's (relative-position sensor).
     pub partner_offset: Option<Vec2<T>>,
@@ -39,8 +42,10 @@ pub struct Measurements<'a, T: Real> {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum MeasurementError {
-    /// Time, `Δt` (negative), velocity or partner offset is NaN or infinite.
+    /// Time, `Δt`, velocity or partner offset is NaN or infinite.
     NonFinite,
+    /// `Δt` is finite but negative (time ran backwards).
+    NegativeDt,
     /// The bearing to this neighbour is not a finite unit vector (or its rate is not finite).
     BadBearing(AgentId),
     /// The bearing's neighbour is not a neighbour of this agent.
@@ -57,7 +62,8 @@ pub enum MeasurementError {
 pub enum Fault {
     /// The measurements were refused.
     Measurement(MeasurementError),
-    /// No bearing to this triangle neighbour this tick.
+    /// No bearing to this triangle neighbour this tick, nor one measured less than
+    /// [`Limits::bearing_hold`](crate::Limits::bearing_hold) ago (SPEC §12, S19).
     MissingBearing(AgentId),
     /// Nothing heard from this neighbour for longer than the timeout (or ever).
     Stale(AgentId),
@@ -80,10 +86,8 @@ pub enum Fault {
 impl core::fmt::Display for MeasurementError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
-            Self::NonFinite => write!(
-                f,
-                "time, dt, velocity or partner offset is not finite (or dt < 0)"
-            ),
+            Self::NonFinite => write!(f, "time, dt, velocity or partner offset is not finite"),
+            Self::NegativeDt => write!(f, "dt is negative"),
             Self::BadBearing(id) => write!(
                 f,
                 "bearing to agent {id} is not a finite unit vector (or its rate is not finite)"
@@ -101,7 +105,12 @@ impl core::fmt::Display for Fault {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
             Self::Measurement(e) => write!(f, "measurement refused: {e}"),
-            Self::MissingBearing(id) => write!(f, "no bearing to agent {id} this tick"),
+            Self::MissingBearing(id) => {
+                write!(
+                    f,
+                    "no bearing to agent {id} this tick, nor one within the hold"
+                )
+            }
             Self::Stale(id) => write!(f, "agent {id} not heard within the timeout"),
             Self::MissingData(id) => write!(f, "agent {id}'s frames lack data this step needs"),
             Self::MissingPartnerOffset => {

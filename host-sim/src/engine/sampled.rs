@@ -493,20 +493,22 @@ impl Engine for SampledSim<'_> {
         self.plant_steps(steps);
     }
 
+    /// Every control period of the common clock (the radio delivers, the camera takes in
+    /// the state), and with own clocks every step at which some agent ticks.
     fn ticks_at(&self, model: &Model, k: usize) -> bool {
+        let common = k.is_multiple_of(model.steps_per_tick.max(1));
         match &self.world.clocks {
-            Some(c) => c.any_due(k),
-            None => k.is_multiple_of(model.steps_per_tick.max(1)),
+            Some(c) => common || c.any_due(k),
+            None => common,
         }
     }
 
     fn next_tick_after(&self, model: &Model, k: usize) -> usize {
+        let spt = model.steps_per_tick.max(1);
+        let common = (k / spt + 1) * spt;
         match &self.world.clocks {
-            Some(c) => c.next_after(k),
-            None => {
-                let spt = model.steps_per_tick.max(1);
-                (k / spt + 1) * spt
-            }
+            Some(c) => c.next_after(k).min(common),
+            None => common,
         }
     }
 

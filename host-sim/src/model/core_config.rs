@@ -139,6 +139,7 @@ impl Model {
             safe_damping: f(c.limits.safe_damping),
             bearing_tolerance: f(c.limits.bearing_tolerance),
             margin_cos: f(c.limits.margin_cos),
+            bearing_hold: f(c.limits.bearing_hold),
         };
         t.bearing_filter = match c.bearing_filter {
             BearingFilter::FiniteDifference => BearingFilter::FiniteDifference,

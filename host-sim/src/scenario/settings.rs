@@ -39,6 +39,9 @@ pub struct ControllerSpec {
     pub max_force: f64,
     /// A neighbour silent for longer than this (s) triggers the safe output.
     pub neighbour_timeout: f64,
+    /// A missing bearing is held or predicted for up to this long (s; SPEC §12, S18);
+    /// 0: none.
+    pub bearing_hold_s: f64,
     /// Safe output gain: `U = −safe_damping · v`.
     pub safe_damping: f64,
     /// Margin (degrees) that desired and current angles must keep from 0 and 180°.
@@ -61,6 +64,7 @@ impl Default for ControllerSpec {
             min_estimate: 0.1,
             max_force: 1e3,
             neighbour_timeout: 0.1,
+            bearing_hold_s: 0.0,
             safe_damping: 1.0,
             angle_margin_deg: 5.0,
             comm_rate_hz: None,

@@ -87,6 +87,7 @@ fn check(
     let limits = Limits {
         max_force: ctl.max_force,
         neighbour_timeout: ctl.neighbour_timeout,
+        bearing_hold: ctl.bearing_hold_s,
         safe_damping: ctl.safe_damping,
         margin_cos: margin.cos(),
         ..Limits::default()

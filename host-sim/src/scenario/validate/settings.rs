@@ -101,6 +101,11 @@ pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile) -> Timing {
             );
         }
     }
+    c.non_negative(
+        InvalidValue,
+        "controller.bearing_hold_s",
+        ctl.bearing_hold_s,
+    );
     c.positive(InvalidValue, "controller.min_estimate", ctl.min_estimate);
     c.positive(
         InvalidValue,
