@@ -126,7 +126,7 @@ fn check(
             reordering: ra.reordering,
             reorder_delay,
             corruption: ra.corruption,
-            bandwidth: ra.bandwidth,
+            bandwidth: ra.bandwidth_bps,
             queue_limit: ra.queue_limit,
             channel,
         },
