@@ -23,7 +23,7 @@ pub use schema::{
 pub use settings::{ChannelSpec, ControllerSpec, Integration, RadioSpec, SensorSpec};
 pub use source::Source;
 pub use strip::strip_model;
-pub use validate::{validate, validate_text};
+pub use validate::{check_model, validate, validate_text};
 
 use crate::model::Model;
 
