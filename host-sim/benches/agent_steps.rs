@@ -34,7 +34,7 @@ const STRIPS: [(usize, usize); 4] = [(100, 1000), (1000, 100), (10_000, 10), (10
 
 /// The strip of `n` agents with noisy sensors (every measurement draws random numbers).
 fn noisy_strip(n: usize) -> Model {
-    let mut m = strip_model(n, 1000.0);
+    let mut m = strip_model(n, 1000.0).expect("the strip is a valid model");
     m.sensors.bearing_noise = 0.5f64.to_radians();
     m.sensors.velocity_noise = 0.01;
     m
@@ -85,7 +85,7 @@ fn agent_steps(c: &mut Criterion) {
     let mut group = c.benchmark_group("agent_steps");
     bench(&mut group, "paper_n4", paper, 4, 1000, Some(&one));
     for (n, ticks) in STRIPS {
-        let strip = || strip_model(n, 1000.0);
+        let strip = || strip_model(n, 1000.0).expect("the strip is a valid model");
         bench(
             &mut group,
             &format!("strip_n{n}"),
@@ -102,7 +102,7 @@ fn agent_steps(c: &mut Criterion) {
     group.finish();
     let mut group = c.benchmark_group("agent_steps_parallel");
     for (n, ticks) in STRIPS.into_iter().skip(2) {
-        let strip = || strip_model(n, 1000.0);
+        let strip = || strip_model(n, 1000.0).expect("the strip is a valid model");
         bench(&mut group, &format!("strip_n{n}"), strip, n, ticks, None);
     }
     for (n, ticks) in STRIPS.into_iter().skip(2) {

@@ -40,7 +40,7 @@ fn case(args: &[String]) -> Result<u64, String> {
         Some("strip") => {
             let (n, warm, ticks) = (number(1, "N")?, number(2, "WARM")?, number(3, "TICKS")?);
             let (n, warm, ticks) = (n as usize, warm as usize, ticks as usize);
-            let model = strip_model(n, 1000.0);
+            let model = strip_model(n, 1000.0).expect("the strip is a valid model");
             let mut sim = SampledSim::new(&model).map_err(|e| e.to_string())?;
             sim.advance_ticks(0.0, warm);
             let start = warm as f64 * model.control_period();

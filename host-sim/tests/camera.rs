@@ -220,7 +220,7 @@ fn an_all_seeing_camera_changes_no_bit() {
 #[test]
 fn a_camera_run_with_occlusion_gives_the_same_bits_on_1_and_4_threads() {
     let n = PARALLEL_MIN_AGENTS + 300;
-    let mut m = strip_model(n, 1.0);
+    let mut m = strip_model(n, 1.0).unwrap();
     // Every fifth agent moved onto the segment between its two neighbours of the other
     // row: it hides one from the other (spacing 0.5 m, bodies of 0.2 m).
     let h = 3f64.sqrt() / 2.0;

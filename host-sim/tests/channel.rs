@@ -97,7 +97,7 @@ fn comm_rate_and_channel_mistakes_name_the_field() {
         "{e}"
     );
     let e = refused("paper", &["radio.channel.access=tdma"]);
-    assert!(e.contains("`radio.channel.bit_rate`"), "{e}");
+    assert!(e.contains("`radio.channel.bit_rate_bps`"), "{e}");
     let e = refused(
         "paper",
         &[
@@ -117,14 +117,46 @@ fn comm_rate_and_channel_mistakes_name_the_field() {
     assert!(e.contains("`radio.channel.slot`"), "{e}");
     let e = refused(
         "paper",
-        &["radio.channel.preset=crazyflie", "radio.bandwidth=1000"],
+        &["radio.channel.preset=crazyflie", "radio.bandwidth_bps=8000"],
     );
-    assert!(e.contains("`radio.bandwidth`"), "{e}");
+    assert!(e.contains("`radio.bandwidth_bps`"), "{e}");
     let e = refused(
         "paper",
         &["radio.channel.preset=crazyflie", "radio.channel.range=-1"],
     );
     assert!(e.contains("`radio.channel.range`"), "{e}");
+}
+
+#[test]
+fn the_old_bandwidth_keys_are_refused_naming_the_new_ones() {
+    // `--set` (and sweep axes, which are `--set` keys).
+    let e = refused("paper", &["radio.bandwidth=20000"]);
+    assert!(
+        e.contains("`radio.bandwidth`")
+            && e.contains("renamed `bandwidth_bps`")
+            && e.contains("bits per second")
+            && e.contains("multiply the old value by 8"),
+        "{e}"
+    );
+    let e = refused("paper", &["radio.channel.bit_rate=1e6"]);
+    assert!(
+        e.contains("`radio.channel.bit_rate`") && e.contains("renamed `bit_rate_bps`"),
+        "{e}"
+    );
+    // In a file: the file, the line and the field.
+    let text = include_str!("../scenarios/paper-lossy.toml")
+        .replace("bandwidth_bps = 160000.0", "bandwidth = 20000.0");
+    let e = host_sim::load_toml(&text, "old.toml", &[])
+        .expect_err("old key accepted")
+        .to_string();
+    assert!(
+        e.contains("old.toml")
+            && e.contains("field `radio.bandwidth`")
+            && e.contains("(line 84")
+            && e.contains("renamed `bandwidth_bps`")
+            && e.contains("multiply the old value by 8"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -151,6 +183,7 @@ fn the_crazyflie_preset_and_the_summary() {
     let ch = &s["channel"];
     assert_eq!(ch["access"], "tdma");
     assert_eq!(ch["preset"], "crazyflie");
+    assert_eq!(ch["bit_rate_bps"], 2e6);
     assert_eq!(ch["collided_copies"], 0);
     assert!(ch["air_time_s"].as_f64().expect("air") > 0.0);
     assert!(ch["utilisation"].as_f64().expect("util") > 0.0);

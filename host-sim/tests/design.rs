@@ -4,7 +4,7 @@
 use host_sim::design::{
     adjacency_from_triangles, check_distance2, compare, construct, distance2_colouring,
     render_scenario, verify, Construction, DesignError, DesignOptions, Generator, Perturbation,
-    Point, Scale, ScenarioOptions, Template,
+    Point, Scale, ScenarioOptions, Template, VerifyError,
 };
 use std::f64::consts::PI;
 
@@ -178,6 +178,23 @@ fn capacity_is_respected_when_tight() {
     let c = construct(&p, &opts).unwrap();
     check(&p, &c, &opts, "MT = 4, NB = 5");
     assert_eq!(c.figures.max_triangles_per_agent, 4);
+}
+
+#[test]
+fn verify_names_the_broken_triangle_or_point() {
+    let p = Generator::Strip { n: 6, spacing: 1.0 }.points().unwrap();
+    let opts = DesignOptions::default();
+    let c = construct(&p, &opts).unwrap();
+    verify(&p, &c, &opts).unwrap();
+    let mut bad = c.clone();
+    bad.leader = [0, 5];
+    let e = verify(&p, &bad, &opts).unwrap_err();
+    assert_eq!(e, VerifyError::LeaderNotAnEdge([0, 5]));
+    assert_eq!(e.to_string(), "leader edge [0, 5] is not an edge");
+    let mut bad = c;
+    bad.triangles.pop();
+    let e = verify(&p, &bad, &opts).unwrap_err();
+    assert_eq!(e.to_string(), "6 points need 4 triangles, got 3");
 }
 
 #[test]

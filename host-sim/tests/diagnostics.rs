@@ -45,5 +45,5 @@ fn a_reused_diagnostics_sums_only_what_it_was_given_on_two_threads() {
         .num_threads(2)
         .build()
         .expect("pool");
-    pool.install(|| reused_equals_fresh(&strip_model(3000, 10.0)));
+    pool.install(|| reused_equals_fresh(&strip_model(3000, 10.0).unwrap()));
 }

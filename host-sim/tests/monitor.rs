@@ -77,7 +77,7 @@ fn an_estimate_held_at_r_min_for_the_collapse_time_collapses_from_when_it_reache
 #[test]
 #[ignore = "slow lane: `cargo xtask test` runs it (phase \"slow tests\")"]
 fn the_collapse_rule_holds_for_a_large_formation_on_any_number_of_threads() {
-    let model = strip_model(3000, 10.0);
+    let model = strip_model(3000, 10.0).unwrap();
     let n = SampledSim::new(&model).expect("sim").estimate_info().len();
     assert!(n > 10_000, "{n} estimates");
     let roles = [n / 3, n - 1, 7, n / 2];

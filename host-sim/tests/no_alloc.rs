@@ -59,7 +59,7 @@ fn faulty_paper(mode: &str) -> Model {
         "radio.duplication=0.1",
         "radio.reordering=0.1",
         "radio.corruption=0.05",
-        "radio.bandwidth=20000",
+        "radio.bandwidth_bps=160000",
         "sensors.bearing_noise_deg=0.05",
         "sensors.velocity_noise=0.01",
         "sensors.offset_noise=0.01",
@@ -149,7 +149,7 @@ fn sampled_and_continuous_loops_do_not_allocate() {
 
     // Strips (ideal radio: frames straight from the senders' outboxes), one thread.
     for n in [300, 1000] {
-        let m = strip_model(n, 10.0);
+        let m = strip_model(n, 10.0).unwrap();
         assert!(host_sim::engine::direct_radio(&m));
         let mut sim = SampledSim::new(&m).expect("sim");
         sim.advance_ticks(0.0, 20);

@@ -13,7 +13,7 @@ use host_sim::scenario::strip_model;
 /// simulator once computed `−safe_damping · v` itself, without the core's guard).
 #[test]
 fn continuous_mode_never_outputs_a_non_finite_force() {
-    let mut model = strip_model(4, 1.0);
+    let mut model = strip_model(4, 1.0).unwrap();
     model.mode = Mode::Continuous;
     for v in [[f64::NAN, 0.0], [0.0, f64::INFINITY]] {
         model.agents[1].velocity = v;
@@ -45,7 +45,7 @@ fn continuous_mode_never_outputs_a_non_finite_force() {
 /// count.
 #[test]
 fn the_radio_shortcut_follows_the_one_classification() {
-    let base = strip_model(6, 0.2);
+    let base = strip_model(6, 0.2).unwrap();
     let half = 0.5 * base.control_period();
     type Set = fn(&mut RadioModel);
     // (field, change, direct delivery kept, is_faulty)

@@ -21,7 +21,7 @@ use host_sim::scenario::strip_model;
 
 /// Frames broadcast, copies sent and copies delivered per agent-tick over `ticks` ticks.
 fn work_per_agent_tick(n: usize, ticks: usize) -> [f64; 3] {
-    let m = strip_model(n, 10.0);
+    let m = strip_model(n, 10.0).unwrap();
     let mut sim = SampledSim::new(&m).expect("sim");
     sim.advance_ticks(0.0, ticks);
     let c = sim.frame_counts();
@@ -52,7 +52,7 @@ type Snapshot = (Vec<u64>, [u64; 4], ControlStats);
 
 /// A snapshot after `ticks` ticks of a strip of `n` agents on `threads` threads.
 fn state(n: usize, ticks: usize, threads: usize) -> Snapshot {
-    on_threads(&strip_model(n, 10.0), ticks, threads)
+    on_threads(&strip_model(n, 10.0).unwrap(), ticks, threads)
 }
 
 /// A snapshot after `ticks` ticks of `m` on `threads` threads.
@@ -103,7 +103,7 @@ fn a_large_run_on_two_threads_is_bit_identical_to_one() {
 /// moved.
 #[test]
 fn the_estimates_a_run_shows_are_the_controllers_values() {
-    let m = strip_model(PARALLEL_MIN_AGENTS + 100, 1.0);
+    let m = strip_model(PARALLEL_MIN_AGENTS + 100, 1.0).unwrap();
     for threads in [1, 2] {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -174,7 +174,7 @@ fn noisy_and_quiet_large_runs_on_two_threads_are_bit_identical_to_one() {
 #[test]
 fn direct_delivery_is_what_the_queue_delivers() {
     let run = |latency: f64| {
-        let mut m = strip_model(60, 10.0);
+        let mut m = strip_model(60, 10.0).unwrap();
         m.radio.latency = latency;
         let direct = host_sim::engine::direct_radio(&m);
         let (bits, counts, _) = snapshot(&m, 200);
@@ -202,7 +202,7 @@ fn designed(g: Generator) -> host_sim::Model {
 #[test]
 fn the_capacity_class_of_an_agent_never_changes_a_result() {
     let models = [
-        strip_model(30, 10.0),
+        strip_model(30, 10.0).unwrap(),
         designed(Generator::TriangularLattice {
             n: 40,
             spacing: 1.0,
@@ -258,7 +258,7 @@ fn every_agents_bearings_reach_its_core_in_slot_order() {
         n: 40,
         spacing: 1.0,
     });
-    for (m, reordered) in [(lattice, true), (strip_model(40, 1.0), false)] {
+    for (m, reordered) in [(lattice, true), (strip_model(40, 1.0).unwrap(), false)] {
         let wire: Vec<u8> = m.agents.iter().map(|a| a.id).collect();
         let measured =
             |i: usize| -> Vec<u8> { m.graph.triangle.of(i).iter().map(|&j| wire[j]).collect() };

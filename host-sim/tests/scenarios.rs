@@ -207,9 +207,28 @@ fn same_seed_same_csv_other_seed_other_csv() {
 
 #[test]
 fn generated_strip_settles() {
-    let m = strip_model(30, 40.0);
+    let m = strip_model(30, 40.0).unwrap();
     let r = run(&m);
     assert_eq!(r.outcome, Outcome::Converged, "{}", r.reason);
+}
+
+#[test]
+fn a_file_with_two_neighbours_sharing_an_id_is_refused_naming_both() {
+    // A file's ids name its agents (triangles, leader, attacks refer to them), so they are
+    // unique; the wire ids made from them may repeat only beyond two hops (the strip).
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/invalid/duplicate_id.toml"
+    );
+    let e = load(path, &[]).expect_err("duplicate id accepted");
+    assert!(e.has(host_sim::scenario::ErrorKind::DuplicateId), "{e}");
+    let e = e.to_string();
+    assert!(
+        e.contains("duplicate_id.toml")
+            && e.contains("field `agents[3].id`")
+            && e.contains("id 2 is already used by agents[1]"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -166,7 +166,7 @@ fn heading_errors_turn_the_leader_edge() {
 /// correlation `e^{−h/τ}` one step apart, over many agents.
 #[test]
 fn gusts_have_their_variance_and_correlation() {
-    let m = host_sim::scenario::strip_model(400, 1.0);
+    let m = host_sim::scenario::strip_model(400, 1.0).unwrap();
     let w = WindModel {
         mean: [0.0; 2],
         gust: 0.3,

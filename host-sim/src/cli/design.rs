@@ -103,18 +103,27 @@ pub struct DesignArgs {
 }
 
 /// Parses `A,B`.
-fn pair<T: std::str::FromStr>(s: &str) -> Result<[T; 2], String> {
+fn pair<T: std::str::FromStr>(s: &str) -> Result<[T; 2], PairError> {
     let parse = |x: &str| {
         x.trim()
             .parse::<T>()
-            .map_err(|_| format!("`{}` is not a number", x.trim()))
+            .map_err(|_| PairError::NotANumber(x.trim().to_owned()))
     };
     match s.split_once(',') {
         Some((a, b)) => Ok([parse(a)?, parse(b)?]),
-        None => Err(format!(
-            "expected two numbers separated by a comma, got `{s}`"
-        )),
+        None => Err(PairError::NotAPair(s.to_owned())),
     }
+}
+
+/// Why a `A,B` flag value is refused (clap prints it after the flag's name).
+#[derive(Debug, thiserror::Error)]
+enum PairError {
+    /// One of the two is not a number.
+    #[error("`{0}` is not a number")]
+    NotANumber(String),
+    /// No comma.
+    #[error("expected two numbers separated by a comma, got `{0}`")]
+    NotAPair(String),
 }
 
 impl DesignArgs {

@@ -19,7 +19,50 @@ use controller_ffi::blob::{encode_blob, PH_MAX_BLOB_LEN};
 use controller_ffi::PH_MAX_TRIANGLES;
 use std::fmt::Write as _;
 use std::io::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+/// Why an agent cannot be exported, or its files cannot be written.
+#[derive(Debug, thiserror::Error)]
+pub(super) enum ExportError {
+    /// The agent's `f32` configuration cannot be built.
+    #[error("agent {agent}: {source}")]
+    Config {
+        /// The agent's id.
+        agent: String,
+        /// Why.
+        source: crate::model::ModelError,
+    },
+    /// The C API's encoder refuses the configuration.
+    #[error("agent {agent}: the C API refuses this agent's configuration: {error:?}")]
+    Blob {
+        /// The agent's id.
+        agent: String,
+        /// The encoder's reason.
+        error: controller_ffi::blob::BlobError,
+    },
+    /// `--all` without `-o DIR`.
+    #[error("--all writes several files: give the directory with -o DIR")]
+    NoDirectory,
+    /// A directory cannot be created.
+    #[error("cannot create {}: {source}", path.display())]
+    CreateDir {
+        /// The directory.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// A file cannot be written.
+    #[error("cannot write {}: {source}", path.display())]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// Standard output cannot be written.
+    #[error("cannot write to stdout: {0}")]
+    Stdout(std::io::Error),
+}
 
 /// One agent's blob.
 struct Exported {
@@ -75,7 +118,7 @@ pub(super) fn export_command(args: &ExportArgs, quiet: bool) -> u8 {
     let written = if args.all {
         match &args.out {
             Some(dir) => write_all(dir, &exported, &model.source),
-            None => Err("--all writes several files: give the directory with -o DIR".into()),
+            None => Err(ExportError::NoDirectory),
         }
     } else {
         write_one(args, &exported, &model.source)
@@ -104,7 +147,7 @@ pub(super) fn export_command(args: &ExportArgs, quiet: bool) -> u8 {
 }
 
 /// Agent `i`'s blob, checked by the C API's encoder.
-fn export_agent(model: &Model, i: usize) -> Result<Exported, String> {
+fn export_agent(model: &Model, i: usize) -> Result<Exported, ExportError> {
     let name = model
         .agents
         .get(i)
@@ -112,10 +155,14 @@ fn export_agent(model: &Model, i: usize) -> Result<Exported, String> {
         .unwrap_or_default();
     let config = model
         .agent_config_f32::<PH_MAX_TRIANGLES>(i)
-        .map_err(|reason| format!("agent {name}: {reason}"))?;
+        .map_err(|source| ExportError::Config {
+            agent: name.clone(),
+            source,
+        })?;
     let mut buf = [0u8; PH_MAX_BLOB_LEN];
-    let n = encode_blob(&config, &mut buf).map_err(|e| {
-        format!("agent {name}: the C API refuses this agent's configuration: {e:?}")
+    let n = encode_blob(&config, &mut buf).map_err(|error| ExportError::Blob {
+        agent: name.clone(),
+        error,
     })?;
     Ok(Exported {
         name,
@@ -126,7 +173,7 @@ fn export_agent(model: &Model, i: usize) -> Result<Exported, String> {
 }
 
 /// `--agent ID`: the blob (or with `--c-array` its C source) to `-o FILE` or stdout.
-fn write_one(args: &ExportArgs, exported: &[Exported], source: &str) -> Result<(), String> {
+fn write_one(args: &ExportArgs, exported: &[Exported], source: &str) -> Result<(), ExportError> {
     let Some(e) = exported.first() else {
         return Ok(());
     };
@@ -136,20 +183,25 @@ fn write_one(args: &ExportArgs, exported: &[Exported], source: &str) -> Result<(
         e.blob.clone()
     };
     match &args.out {
-        Some(path) => std::fs::write(path, &bytes)
-            .map_err(|err| format!("cannot write {}: {err}", path.display())),
+        Some(path) => std::fs::write(path, &bytes).map_err(|source| ExportError::Write {
+            path: path.clone(),
+            source,
+        }),
         None => std::io::stdout()
             .write_all(&bytes)
-            .map_err(|err| format!("cannot write to stdout: {err}")),
+            .map_err(ExportError::Stdout),
     }
 }
 
 /// `--all -o DIR`: `agent<ID>.blob` per agent, `ph_blobs.c` and `ph_blobs.h`.
-fn write_all(dir: &Path, exported: &[Exported], source: &str) -> Result<(), String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+fn write_all(dir: &Path, exported: &[Exported], source: &str) -> Result<(), ExportError> {
+    std::fs::create_dir_all(dir).map_err(|source| ExportError::CreateDir {
+        path: dir.to_path_buf(),
+        source,
+    })?;
     let write = |name: &str, bytes: &[u8]| {
         let path = dir.join(name);
-        std::fs::write(&path, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))
+        std::fs::write(&path, bytes).map_err(|source| ExportError::Write { path, source })
     };
     for e in exported {
         write(&format!("agent{}.blob", e.name), &e.blob)?;

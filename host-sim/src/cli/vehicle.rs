@@ -4,7 +4,7 @@
 //! for accelerations up to `max_force / m`, and the reference velocity `v*` is a speed
 //! it must fly. Each figure is sourced from the vehicle's firmware (docs/crazyflie.md).
 
-use crate::model::Model;
+use crate::model::{Model, ModelError};
 use clap::ValueEnum;
 
 /// A vehicle whose limits `export` checks.
@@ -61,45 +61,103 @@ impl Vehicle {
     /// Checks agents `indices` of `model` against the vehicle: the force limit over the
     /// agent's mass and every step of the reference velocity. The error names the agent,
     /// the scenario field, the figure and its source.
-    pub fn check(self, model: &Model, indices: &[usize]) -> Result<(), String> {
+    pub fn check(self, model: &Model, indices: &[usize]) -> Result<(), VehicleError> {
         let l = self.limits();
         for &i in indices {
             let Some(agent) = model.agents.get(i) else {
                 continue;
             };
-            let config = model.agent_config(i).map_err(|e| e.to_string())?;
+            let config = model.agent_config(i)?;
             let force = config.limits.max_force;
             let acceleration = force / agent.mass;
             if acceleration.is_nan() || acceleration > l.max_acceleration {
-                return Err(format!(
-                    "--vehicle: {}: agent {}: controller.max_force = {force} N on its {} kg \
-                     virtual mass asks up to {acceleration:.3} m/s², more than {} reaches \
-                     ({:.2} m/s², {}); set controller.max_force to at most {:.2} \
-                     (e.g. --set controller.max_force={:.2})",
-                    model.source,
-                    agent.name,
-                    agent.mass,
-                    l.name,
-                    l.max_acceleration,
-                    l.acceleration_source,
-                    l.max_acceleration * agent.mass,
-                    (l.max_acceleration * agent.mass * 100.0).floor() / 100.0,
-                ));
+                return Err(VehicleError::Force {
+                    source_file: model.source.clone(),
+                    agent: agent.name.clone(),
+                    force,
+                    mass: agent.mass,
+                    acceleration,
+                    vehicle: l.name,
+                    max_acceleration: l.max_acceleration,
+                    figure_source: l.acceleration_source,
+                });
             }
             for step in &config.velocity_reference.steps {
                 let [x, y] = step.value;
                 let speed = x.hypot(y);
                 if speed.is_nan() || speed > l.max_speed {
-                    return Err(format!(
-                        "--vehicle: {}: velocity_reference = ({x}, {y}) from t = {} s is \
-                         {speed:.3} m/s, faster than {} flies ({} m/s, {})",
-                        model.source, step.from, l.name, l.max_speed, l.speed_source,
-                    ));
+                    return Err(VehicleError::Speed {
+                        source_file: model.source.clone(),
+                        velocity: [x, y],
+                        from: step.from,
+                        speed,
+                        vehicle: l.name,
+                        max_speed: l.max_speed,
+                        figure_source: l.speed_source,
+                    });
                 }
             }
         }
         Ok(())
     }
+}
+
+/// Why a configuration does not fit the vehicle of `--vehicle`.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum VehicleError {
+    /// The agent's configuration cannot be built.
+    #[error("--vehicle: {0}")]
+    Model(#[from] ModelError),
+    /// The force limit asks for more acceleration than the vehicle has.
+    #[error(
+        "--vehicle: {source_file}: agent {agent}: controller.max_force = {force} N on its \
+         {mass} kg virtual mass asks up to {acceleration:.3} m/s², more than {vehicle} \
+         reaches ({max_acceleration:.2} m/s², {figure_source}); set controller.max_force to \
+         at most {:.2} (e.g. --set controller.max_force={:.2})",
+        .max_acceleration * .mass,
+        (.max_acceleration * .mass * 100.0).floor() / 100.0
+    )]
+    Force {
+        /// The scenario.
+        source_file: String,
+        /// The agent's id.
+        agent: String,
+        /// `controller.max_force` (N).
+        force: f64,
+        /// The agent's mass (kg).
+        mass: f64,
+        /// `force / mass` (m/s²).
+        acceleration: f64,
+        /// The vehicle's name.
+        vehicle: &'static str,
+        /// Its largest acceleration (m/s²).
+        max_acceleration: f64,
+        /// Where that figure comes from.
+        figure_source: &'static str,
+    },
+    /// A reference velocity faster than the vehicle flies.
+    #[error(
+        "--vehicle: {source_file}: velocity_reference = ({}, {}) from t = {from} s is \
+         {speed:.3} m/s, faster than {vehicle} flies ({max_speed} m/s, {figure_source})",
+        .velocity[0],
+        .velocity[1]
+    )]
+    Speed {
+        /// The scenario.
+        source_file: String,
+        /// The step's velocity (m/s).
+        velocity: [f64; 2],
+        /// When the step starts (s).
+        from: f64,
+        /// Its speed (m/s).
+        speed: f64,
+        /// The vehicle's name.
+        vehicle: &'static str,
+        /// Its largest speed (m/s).
+        max_speed: f64,
+        /// Where that figure comes from.
+        figure_source: &'static str,
+    },
 }
 
 #[cfg(test)]

@@ -22,16 +22,28 @@ fn browser() -> Option<String> {
 
 /// The page of `dir`, written from its `timeseries.csv` and `summary.json` if missing; for
 /// a sweep's directory (`points.csv`, no `timeseries.csv`), `sweep.html`, written afresh.
-fn page(dir: &Path) -> Result<PathBuf, String> {
+fn page(dir: &Path) -> Result<PathBuf, PageError> {
     if dir.join("points.csv").is_file() && !dir.join("timeseries.csv").is_file() {
-        return crate::report::replay::write_sweep_page(dir)
-            .map_err(|e| format!("cannot write {}: {e}", dir.join("sweep.html").display()));
+        return crate::report::replay::write_sweep_page(dir).map_err(|source| PageError {
+            path: dir.join("sweep.html"),
+            source,
+        });
     }
     let path = dir.join("replay.html");
     if path.is_file() {
         return Ok(path);
     }
-    crate::report::write_replay(dir).map_err(|e| format!("cannot write {}: {e}", path.display()))
+    crate::report::write_replay(dir).map_err(|source| PageError { path, source })
+}
+
+/// A page that cannot be written.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot write {}: {source}", path.display())]
+struct PageError {
+    /// The page.
+    path: PathBuf,
+    /// Why.
+    source: crate::report::plot::PlotError,
 }
 
 pub(super) fn view_command(dir: &Path, no_open: bool) -> u8 {

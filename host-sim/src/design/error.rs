@@ -82,6 +82,106 @@ pub enum DesignError {
     Initial(String),
 }
 
+/// Why [`super::verify`] finds a construction wrong: the first problem found, by triangle
+/// (its index in the construction) and point (zero-based index).
+#[derive(Clone, Debug, PartialEq, Error)]
+pub enum VerifyError {
+    /// Not `N − 2` triangles.
+    #[error("{points} points need {} triangles, got {triangles}", .points.saturating_sub(2))]
+    TriangleCount {
+        /// Points.
+        points: usize,
+        /// Triangles in the construction.
+        triangles: usize,
+    },
+    /// A triangle's vertices are out of range or repeated.
+    #[error("triangle {k} {vertices:?} is not three distinct points")]
+    NotDistinct {
+        /// The triangle.
+        k: usize,
+        /// Its vertices.
+        vertices: [usize; 3],
+    },
+    /// A later triangle is not glued to an existing edge.
+    #[error("triangle {k} {vertices:?}: ({}, {}) is not an edge yet", .vertices[0], .vertices[1])]
+    NotOnAnEdge {
+        /// The triangle.
+        k: usize,
+        /// Its vertices (base edge first).
+        vertices: [usize; 3],
+    },
+    /// A triangle's new point was placed before.
+    #[error("triangle {k} {vertices:?}: point {} is already placed", .vertices[2])]
+    AlreadyPlaced {
+        /// The triangle.
+        k: usize,
+        /// Its vertices (new point last).
+        vertices: [usize; 3],
+    },
+    /// An interior angle within the margin.
+    #[error("triangle {k} {vertices:?} has an angle of {angle_deg}° (margin {margin_deg}°)")]
+    AngleWithinMargin {
+        /// The triangle.
+        k: usize,
+        /// Its vertices.
+        vertices: [usize; 3],
+        /// The angle (degrees).
+        angle_deg: f64,
+        /// The margin (degrees).
+        margin_deg: f64,
+    },
+    /// The controlled angles are not at two distinct vertices.
+    #[error("triangle {k}: apexes {first} and {second} are not two of its vertices")]
+    Apexes {
+        /// The triangle.
+        k: usize,
+        /// The first apex.
+        first: usize,
+        /// The second apex.
+        second: usize,
+    },
+    /// A desired angle the points do not realise, or within the margin.
+    #[error(
+        "triangle {k}: angle at {apex} is {actual_deg}° in the points, desired {desired_deg}°"
+    )]
+    DesiredAngle {
+        /// The triangle.
+        k: usize,
+        /// The apex.
+        apex: usize,
+        /// The angle in the points (degrees).
+        actual_deg: f64,
+        /// The desired angle (degrees).
+        desired_deg: f64,
+    },
+    /// The two controlled angles leave no room for the third.
+    #[error("triangle {k}: controlled angles leave no third angle beyond the margin")]
+    NoThirdAngle {
+        /// The triangle.
+        k: usize,
+    },
+    /// A point in no triangle.
+    #[error("point {0} is in no triangle")]
+    Unplaced(usize),
+    /// A point over the capacity.
+    #[error("point {point} has {triangles} triangles and {neighbours} neighbours (capacity {max_triangles} and {max_neighbours})")]
+    Capacity {
+        /// The point.
+        point: usize,
+        /// Its triangles.
+        triangles: usize,
+        /// Its neighbours.
+        neighbours: usize,
+        /// Triangles allowed.
+        max_triangles: usize,
+        /// Neighbours allowed.
+        max_neighbours: usize,
+    },
+    /// The leader pair is not an edge.
+    #[error("leader edge {0:?} is not an edge")]
+    LeaderNotAnEdge([usize; 2]),
+}
+
 /// `"3 and 17 (agents 4 and 18)"`-style list of pairs.
 fn duplicate_message(pairs: &[[usize; 2]], at: &[Point]) -> String {
     let shown: Vec<String> = pairs

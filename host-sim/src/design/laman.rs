@@ -22,7 +22,7 @@
 //! triangles lie on the far side of the edge they are glued to and cover no other point
 //! whenever such a triangle exists.
 
-use super::error::DesignError;
+use super::error::{DesignError, VerifyError};
 use super::geometry::{angle_at, angles, dist, margin};
 use super::grow::{grow, Params};
 use super::neighbours::{check_points, delaunay_neighbours, point_tree};
@@ -276,14 +276,13 @@ fn figures(points: &[Point], triangles: &[DesignTriangle]) -> Figures {
 /// new agent to an existing edge), two controlled angles per triangle at distinct apexes
 /// with the desired values the points realise, every interior angle beyond the margin,
 /// capacities, and a leader edge that is an edge. Returns the first problem found.
-pub fn verify(points: &[Point], c: &Construction, opts: &DesignOptions) -> Result<(), String> {
+pub fn verify(points: &[Point], c: &Construction, opts: &DesignOptions) -> Result<(), VerifyError> {
     let n = points.len();
     if c.triangles.len() + 2 != n {
-        return Err(format!(
-            "{n} points need {} triangles, got {}",
-            n.saturating_sub(2),
-            c.triangles.len()
-        ));
+        return Err(VerifyError::TriangleCount {
+            points: n,
+            triangles: c.triangles.len(),
+        });
     }
     let key = |x: usize, y: usize| (x.min(y), x.max(y));
     let mut placed = vec![false; n];
@@ -292,27 +291,19 @@ pub fn verify(points: &[Point], c: &Construction, opts: &DesignOptions) -> Resul
     let margin_rad = opts.margin_deg.to_radians();
     for (k, t) in c.triangles.iter().enumerate() {
         let [a, b, v] = t.vertices;
+        let vertices = t.vertices;
         if t.vertices.iter().any(|&x| x >= n) || a == b || b == v || a == v {
-            return Err(format!(
-                "triangle {k} {:?} is not three distinct points",
-                t.vertices
-            ));
+            return Err(VerifyError::NotDistinct { k, vertices });
         }
         if k == 0 {
             placed[a] = true;
             placed[b] = true;
             edges.insert(key(a, b));
         } else if !(placed[a] && placed[b] && edges.contains(&key(a, b))) {
-            return Err(format!(
-                "triangle {k} {:?}: ({a}, {b}) is not an edge yet",
-                t.vertices
-            ));
+            return Err(VerifyError::NotOnAnEdge { k, vertices });
         }
         if placed[v] {
-            return Err(format!(
-                "triangle {k} {:?}: point {v} is already placed",
-                t.vertices
-            ));
+            return Err(VerifyError::AlreadyPlaced { k, vertices });
         }
         placed[v] = true;
         edges.insert(key(a, v));
@@ -325,19 +316,20 @@ pub fn verify(points: &[Point], c: &Construction, opts: &DesignOptions) -> Resul
             .into_iter()
             .find(|&th| th.is_nan() || th <= margin_rad)
         {
-            return Err(format!(
-                "triangle {k} {:?} has an angle of {}° (margin {}°)",
-                t.vertices,
-                th.to_degrees(),
-                opts.margin_deg
-            ));
+            return Err(VerifyError::AngleWithinMargin {
+                k,
+                vertices,
+                angle_deg: th.to_degrees(),
+                margin_deg: opts.margin_deg,
+            });
         }
         let [x, y] = t.angles;
         if x.apex == y.apex || !t.vertices.contains(&x.apex) || !t.vertices.contains(&y.apex) {
-            return Err(format!(
-                "triangle {k}: apexes {} and {} are not two of its vertices",
-                x.apex, y.apex
-            ));
+            return Err(VerifyError::Apexes {
+                k,
+                first: x.apex,
+                second: y.apex,
+            });
         }
         for ca in t.angles {
             let far: Vec<Point> = t
@@ -351,22 +343,20 @@ pub fn verify(points: &[Point], c: &Construction, opts: &DesignOptions) -> Resul
                 || margin(ca.desired).is_nan()
                 || margin(ca.desired) <= margin_rad
             {
-                return Err(format!(
-                    "triangle {k}: angle at {} is {}° in the points, desired {}°",
-                    ca.apex,
-                    actual.to_degrees(),
-                    ca.desired.to_degrees()
-                ));
+                return Err(VerifyError::DesiredAngle {
+                    k,
+                    apex: ca.apex,
+                    actual_deg: actual.to_degrees(),
+                    desired_deg: ca.desired.to_degrees(),
+                });
             }
         }
         if PI - x.desired - y.desired <= margin_rad {
-            return Err(format!(
-                "triangle {k}: controlled angles leave no third angle beyond the margin"
-            ));
+            return Err(VerifyError::NoThirdAngle { k });
         }
     }
     if let Some(i) = placed.iter().position(|p| !p) {
-        return Err(format!("point {i} is in no triangle"));
+        return Err(VerifyError::Unplaced(i));
     }
     let mut nbrs = vec![0usize; n];
     for &(x, y) in &edges {
@@ -376,13 +366,16 @@ pub fn verify(points: &[Point], c: &Construction, opts: &DesignOptions) -> Resul
     if let Some(i) =
         (0..n).find(|&i| tri_count[i] > opts.max_triangles || nbrs[i] > opts.max_neighbours)
     {
-        return Err(format!(
-            "point {i} has {} triangles and {} neighbours (capacity {} and {})",
-            tri_count[i], nbrs[i], opts.max_triangles, opts.max_neighbours
-        ));
+        return Err(VerifyError::Capacity {
+            point: i,
+            triangles: tri_count[i],
+            neighbours: nbrs[i],
+            max_triangles: opts.max_triangles,
+            max_neighbours: opts.max_neighbours,
+        });
     }
     if !edges.contains(&key(c.leader[0], c.leader[1])) {
-        return Err(format!("leader edge {:?} is not an edge", c.leader));
+        return Err(VerifyError::LeaderNotAnEdge(c.leader));
     }
     Ok(())
 }

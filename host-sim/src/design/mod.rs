@@ -36,7 +36,7 @@ pub use crate::model::shape;
 pub use colouring::{
     adjacency_from_triangles, check_distance2, distance2_colouring, ColouringError,
 };
-pub use error::DesignError;
+pub use error::{DesignError, VerifyError};
 pub use initial::{initial_positions, Initial, Perturbation, Scale};
 pub use laman::{
     construct, verify, Construction, ControlledAngle, DesignOptions, DesignTriangle, Figures,

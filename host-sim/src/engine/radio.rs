@@ -283,7 +283,8 @@ impl Radio {
                 self.stats.queue_dropped += copies;
                 return;
             }
-            on_air = start + bytes.len() as f64 / self.model.bandwidth;
+            // Bits over bits per second (×8 and the old bytes/s ×8 give the same quotient).
+            on_air = start + bytes.len() as f64 * 8.0 / self.model.bandwidth;
             if let Some(b) = self.busy_until.get_mut(from) {
                 *b = on_air;
             }
@@ -431,7 +432,7 @@ mod tests {
     #[test]
     fn bandwidth_queue_drops() {
         let mut m = model();
-        m.bandwidth = 100.0; // 60-byte frames take 0.6 s each
+        m.bandwidth = 800.0; // bits/s: 60-byte frames take 0.6 s each
         m.queue_limit = 1.0;
         let mut r = Radio::new(&m, 2, 7, 16);
         for _ in 0..5 {

@@ -79,7 +79,7 @@ pub struct ChannelModel {
     pub preset: String,
     /// Access scheme.
     pub access: Access,
-    /// Bit rate on the air (bit/s).
+    /// Bit rate on the air in bits per second (scenario key `radio.channel.bit_rate_bps`).
     pub bit_rate: f64,
     /// Bytes each frame carries besides the controller's payload (preamble, address,
     /// packet control, link CRC, link header); may be fractional (bits / 8).

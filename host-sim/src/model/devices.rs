@@ -140,7 +140,8 @@ pub struct RadioModel {
     pub reorder_delay: f64,
     /// Corruption (one bit flip) probability per link copy.
     pub corruption: f64,
-    /// Sender air time in bytes/s (0 = unlimited).
+    /// Sender air-time limit in bits per second (0 = unlimited; scenario key
+    /// `radio.bandwidth_bps`).
     pub bandwidth: f64,
     /// Longest transmit-queue wait before a drop (s).
     pub queue_limit: f64,

@@ -30,7 +30,7 @@ pub(super) fn add_json(obj: &mut Map<String, Value>, m: &Model, r: &RunResult) {
     let mut channel = json!({
             "preset": c.preset,
             "access": c.access.as_str(),
-            "bit_rate": fin(c.bit_rate),
+            "bit_rate_bps": fin(c.bit_rate),
             "overhead_bytes": fin(c.overhead_bytes),
             "turnaround_s": fin(c.turnaround),
             "range_m": c.range.map_or(Value::Null, fin),

@@ -24,7 +24,7 @@ pub use schema::{
 pub use settings::{CameraSpec, ChannelSpec, ControllerSpec, Integration, RadioSpec, SensorSpec};
 pub use source::Source;
 pub use strip::strip_model;
-pub use validate::{validate, validate_text};
+pub use validate::{check_model, validate, validate_text};
 pub use world::{ClockSpec, HeadingSpec, PlantKind, PlantSpec, WindSpec, PRESETS};
 
 use crate::model::Model;

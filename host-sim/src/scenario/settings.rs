@@ -209,8 +209,9 @@ pub struct RadioSpec {
     pub reorder_delay: Option<f64>,
     /// Probability that a link copy has one random bit flipped.
     pub corruption: f64,
-    /// Sender air-time limit in bytes per second (0 = unlimited).
-    pub bandwidth: f64,
+    /// Sender air-time limit in bits per second (0 = unlimited). Key `bandwidth_bps`; the
+    /// old `bandwidth` (bytes/s) is refused with a message naming this one.
+    pub bandwidth_bps: f64,
     /// Longest wait in a sender's transmit queue before a frame is dropped (s).
     pub queue_limit: f64,
     /// `[radio.channel]`: one shared medium (optional; `docs/radio.md`).
@@ -226,8 +227,9 @@ pub struct ChannelSpec {
     pub preset: Option<String>,
     /// `aloha` or `tdma`.
     pub access: Access,
-    /// Bit rate on the air (bit/s); required without a preset.
-    pub bit_rate: Option<f64>,
+    /// Bit rate on the air (bits per second); required without a preset. Key
+    /// `bit_rate_bps`; the old `bit_rate` is refused with a message naming this one.
+    pub bit_rate_bps: Option<f64>,
     /// Per-frame overhead on the air besides the payload (bytes, may be fractional).
     pub overhead_bytes: Option<f64>,
     /// Transmitter settling time before each frame (s).
@@ -252,7 +254,7 @@ impl Default for RadioSpec {
             reordering: 0.0,
             reorder_delay: None,
             corruption: 0.0,
-            bandwidth: 0.0,
+            bandwidth_bps: 0.0,
             queue_limit: 0.05,
             channel: None,
         }

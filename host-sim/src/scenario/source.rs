@@ -5,7 +5,7 @@ use super::builtin::{builtin, Builtin, BUILTINS};
 use super::error::{ErrorKind, ScenarioError};
 use super::schema::ScenarioFile;
 use super::toml_text::{
-    did_you_mean, field_at, line_col, one_line, parse_override_value, set_path,
+    did_you_mean, field_at, line_col, one_line, parse_override_value, renamed_key, set_path,
 };
 use super::world::{self, PRESETS};
 use std::path::Path;
@@ -197,7 +197,11 @@ impl Source {
     }
 }
 
-/// `"; did you mean `loss`?"` for an unknown field near a known one, else empty.
+/// `"; did you mean `loss`?"` for an unknown field near a known one, or what became of a
+/// renamed key, else empty.
 fn suggestion(message: &str) -> String {
+    if let Some(renamed) = renamed_key(message) {
+        return format!("; {renamed}");
+    }
     did_you_mean(message).map_or_else(String::new, |c| format!("; did you mean `{c}`?"))
 }

@@ -2,19 +2,23 @@
 //! `(i, i+1, i+2)` (for the benchmark and scaling tests).
 //!
 //! Wire ids are one byte, so with more than 256 agents they repeat (`id = i mod 256`).
-//! That is enough for the controllers: an agent only talks to agents at most two places
-//! away along the strip, whose ids are distinct. Such a model is built here directly; the
-//! file validation would refuse the repeated ids.
+//! That is enough for the controllers: an agent only hears agents at most two places
+//! away along the strip and is named in frames only with agents at most four places away,
+//! whose ids are distinct. The model is built here directly (a file names its agents by
+//! unique ids) and then passes the checks every model passes
+//! ([`crate::scenario::check_model`]: the graph, the capacity, wire ids distinct within
+//! two hops, the core's checks), so a bad strip is refused rather than run.
 
 use crate::model::graph::{strip_triangles, Graph};
 use crate::model::{AgentModel, AngleModel, Model, RadioModel, SensorModel, TriangleModel};
 use crate::model::{BearingRate, Criteria, Estimator, IntegrityMode, Mode, Target};
+use crate::scenario::{check_model, ScenarioErrors};
 use controller_core::{Limits, Schedule};
 
 /// A strip of `n ≥ 3` agents, printed-paper gains (c = 10, d = 1, c_e = 10), desired
-/// angles 60°, initial positions perturbed from the equilateral strip, no maneuvers.
-pub fn strip_model(n: usize, duration: f64) -> Model {
-    let n = n.max(3);
+/// angles 60°, initial positions perturbed from the equilateral strip, no maneuvers;
+/// checked as every model is ([`check_model`]: fewer than 3 agents are refused, for one).
+pub fn strip_model(n: usize, duration: f64) -> Result<Model, ScenarioErrors> {
     let h = 3f64.sqrt() / 2.0;
     let agents = (0..n)
         .map(|i| {
@@ -50,7 +54,7 @@ pub fn strip_model(n: usize, duration: f64) -> Model {
         })
         .collect();
     let dt = 1e-3;
-    Model {
+    let model = Model {
         name: format!("strip-{n}"),
         source: "generated:strip".to_owned(),
         description: format!("triangulated strip of {n} agents"),
@@ -84,5 +88,51 @@ pub fn strip_model(n: usize, duration: f64) -> Model {
                 .collect(),
             from_file: false,
         },
+    };
+    check_model(&model)?;
+    Ok(model)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::ErrorKind;
+
+    #[test]
+    fn a_strip_of_1000_agents_with_repeated_ids_validates() {
+        let m = strip_model(1000, 1.0).expect("valid");
+        assert_eq!(m.n(), 1000);
+        // Ids repeat beyond two hops: agents 3 and 259 share id 3.
+        assert_eq!(m.agents[3].id, m.agents[259].id);
+    }
+
+    #[test]
+    fn fewer_than_three_agents_are_refused() {
+        let e = strip_model(2, 1.0).expect_err("two agents");
+        assert!(e.has(ErrorKind::NotLaman), "{e}");
+    }
+
+    #[test]
+    fn an_id_repeated_within_two_hops_is_refused_naming_both_agents() {
+        let base = strip_model(12, 1.0).expect("valid");
+        // Agents 3 and 5 are neighbours (triangle (3, 4, 5)); 3 and 7 are both neighbours
+        // of 5; 3 and 8 are three hops apart.
+        for (other, how) in [(5, "are neighbours"), (7, "are neighbours of agent 5")] {
+            let mut m = base.clone();
+            m.agents[other].id = m.agents[3].id;
+            let e = check_model(&m).expect_err("clash accepted").to_string();
+            assert!(
+                e.contains("generated:strip")
+                    && e.contains(&format!("field `agents[{other}]`"))
+                    && e.contains("agents 3 (agents[3])")
+                    && e.contains(&format!("{other} (agents[{other}])"))
+                    && e.contains("share wire id 3")
+                    && e.contains(how),
+                "{e}"
+            );
+        }
+        let mut m = base;
+        m.agents[8].id = m.agents[3].id;
+        check_model(&m).expect("an id repeated three hops apart is unambiguous");
     }
 }

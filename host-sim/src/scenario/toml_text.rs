@@ -17,14 +17,55 @@ pub(super) fn parse_override_value(raw: &str) -> toml::Value {
     }
 }
 
+/// Why a `--set` key cannot be set (the messages name the key and the part of it).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum SetPathError {
+    /// An empty part (`radio..loss`, a leading or trailing dot).
+    #[error("bad key `{key}`")]
+    BadKey {
+        /// The key.
+        key: String,
+    },
+    /// A part inside an array that is not a number.
+    #[error("`{part}` in `{key}` must be an array index")]
+    NotAnIndex {
+        /// The part.
+        part: String,
+        /// The key.
+        key: String,
+    },
+    /// An array index beyond the array.
+    #[error("index {index} in `{key}` is out of range (length {len})")]
+    OutOfRange {
+        /// The index.
+        index: usize,
+        /// The key.
+        key: String,
+        /// The array's length.
+        len: usize,
+    },
+    /// A part below a value that is neither a table nor an array.
+    #[error("`{part}` in `{key}` is inside a value that is not a table")]
+    NotATable {
+        /// The part.
+        part: String,
+        /// The key.
+        key: String,
+    },
+}
+
+/// Sets the dotted `key` (array indices as numbers) of `root` to `value`, creating tables
+/// on the way.
 pub(super) fn set_path(
     root: &mut toml::Value,
     key: &str,
     value: toml::Value,
-) -> Result<(), String> {
+) -> Result<(), SetPathError> {
     let parts: Vec<&str> = key.split('.').collect();
     if parts.iter().any(|p| p.is_empty()) {
-        return Err(format!("bad key `{key}`"));
+        return Err(SetPathError::BadKey {
+            key: key.to_owned(),
+        });
     }
     let mut cur = root;
     for (i, part) in parts.iter().enumerate() {
@@ -39,12 +80,15 @@ pub(super) fn set_path(
                     .or_insert_with(|| toml::Value::Table(toml::Table::new()))
             }
             toml::Value::Array(a) => {
-                let idx: usize = part
-                    .parse()
-                    .map_err(|_| format!("`{part}` in `{key}` must be an array index"))?;
+                let index: usize = part.parse().map_err(|_| SetPathError::NotAnIndex {
+                    part: (*part).to_owned(),
+                    key: key.to_owned(),
+                })?;
                 let len = a.len();
-                let slot = a.get_mut(idx).ok_or_else(|| {
-                    format!("index {idx} in `{key}` is out of range (length {len})")
+                let slot = a.get_mut(index).ok_or_else(|| SetPathError::OutOfRange {
+                    index,
+                    key: key.to_owned(),
+                    len,
                 })?;
                 if last {
                     *slot = value;
@@ -53,9 +97,10 @@ pub(super) fn set_path(
                 slot
             }
             _ => {
-                return Err(format!(
-                    "`{part}` in `{key}` is inside a value that is not a table"
-                ))
+                return Err(SetPathError::NotATable {
+                    part: (*part).to_owned(),
+                    key: key.to_owned(),
+                })
             }
         };
     }
@@ -138,6 +183,31 @@ pub fn did_you_mean(message: &str) -> Option<String> {
         .map(|(_, c)| c.to_owned())
 }
 
+/// Keys that were renamed: the old name, the new one, and what changed besides the name.
+/// serde refuses the old name as an unknown field; [`renamed_key`] explains it.
+pub const RENAMED_KEYS: &[(&str, &str, &str)] = &[
+    (
+        "bandwidth",
+        "bandwidth_bps",
+        "it is now in bits per second, the old key was bytes per second: multiply the old \
+         value by 8 (bandwidth = 20000 → bandwidth_bps = 160000)",
+    ),
+    (
+        "bit_rate",
+        "bit_rate_bps",
+        "same unit (bits per second), only the name changed",
+    ),
+];
+
+/// For serde's "unknown field `x`, expected … `x_new` …" where `x` is a renamed key
+/// ([`RENAMED_KEYS`]): the sentence that names the new key and the unit change.
+pub fn renamed_key(message: &str) -> Option<String> {
+    let (old, new, change) = RENAMED_KEYS.iter().find(|(old, new, _)| {
+        message.contains(&format!("unknown field `{old}`")) && message.contains(&format!("`{new}`"))
+    })?;
+    Some(format!("`{old}` was renamed `{new}`: {change}"))
+}
+
 /// 1-based line of the header of the `k`-th (0-based) `[[table]]` entry in `text`, when
 /// the array is written as headers (not inline).
 pub fn array_entry_line(text: &str, table: &str, k: usize) -> Option<usize> {
@@ -168,6 +238,21 @@ mod suggestion_tests {
             None
         );
         assert_eq!(did_you_mean("invalid type: string"), None);
+    }
+
+    #[test]
+    fn a_renamed_key_names_its_new_name_and_unit() {
+        let m = "unknown field `bandwidth`, expected one of `loss`, `bandwidth_bps`, `channel`";
+        let r = renamed_key(m).unwrap();
+        assert!(
+            r.contains("`bandwidth_bps`") && r.contains("multiply"),
+            "{r}"
+        );
+        // The same leaf name in another table (no `bandwidth_bps` expected) is not it.
+        assert_eq!(
+            renamed_key("unknown field `bandwidth`, expected `loss` or `mass`"),
+            None
+        );
     }
 
     #[test]

@@ -35,17 +35,17 @@ pub struct FakeBehaviour {
 
 /// Starts a fake target that connects to `127.0.0.1:port` (as QEMU does); the thread
 /// ends when the host closes the connection or sends `Finish`.
-pub fn spawn(port: u16, behaviour: FakeBehaviour) -> JoinHandle<Result<(), String>> {
+pub fn spawn(port: u16, behaviour: FakeBehaviour) -> JoinHandle<std::io::Result<()>> {
     std::thread::spawn(move || {
-        let stream = TcpStream::connect(("127.0.0.1", port)).map_err(|e| e.to_string())?;
+        let stream = TcpStream::connect(("127.0.0.1", port))?;
         serve(stream, behaviour)
     })
 }
 
 /// Serves one connection (see [`spawn`]) with the firmware's session.
-pub fn serve(stream: TcpStream, behaviour: FakeBehaviour) -> Result<(), String> {
-    stream.set_nodelay(true).map_err(|e| e.to_string())?;
-    let writer = stream.try_clone().map_err(|e| e.to_string())?;
+pub fn serve(stream: TcpStream, behaviour: FakeBehaviour) -> std::io::Result<()> {
+    stream.set_nodelay(true)?;
+    let writer = stream.try_clone()?;
     let mut session = Session::new(FakePort {
         reader: BufReader::new(stream),
         writer,

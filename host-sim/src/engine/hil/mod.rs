@@ -38,7 +38,7 @@ pub use stats::LinkStats;
 
 use crate::engine::controller::{local_core, AgentController};
 use crate::engine::{drive, Recorder, RunError, RunResult, SampledSim};
-use crate::model::{resolve_estimates, Model};
+use crate::model::{resolve_estimates, Model, ModelError};
 use controller::{EstimateSlot, HilController, TargetHandle};
 use qemu_harness::{Qemu, Serial};
 use std::net::TcpListener;
@@ -119,10 +119,10 @@ type TargetOrder = (
 );
 
 /// [`TargetOrder`] of agent `i`.
-fn target_order(model: &Model, i: usize) -> Result<TargetOrder, String> {
-    let core = model.core_agent(i).map_err(|e| e.to_string())?;
+fn target_order(model: &Model, i: usize) -> Result<TargetOrder, ModelError> {
+    let core = model.core_agent(i)?;
     let layout: Vec<_> = core.owned_estimates().collect();
-    let infos = resolve_estimates(model, i, &layout).map_err(|e| e.to_string())?;
+    let infos = resolve_estimates(model, i, &layout)?;
     let slots = layout
         .iter()
         .zip(&infos)
@@ -181,11 +181,10 @@ pub fn controllers(
     for ((&i, config), (link, target, started, startup)) in
         indices.iter().zip(&configs).zip(launched)
     {
-        let (layout, slots, order) =
-            target_order(model, i).map_err(|reason| HilError::Refused {
-                agent: model.agents[i].name.clone(),
-                reason,
-            })?;
+        let (layout, slots, order) = target_order(model, i).map_err(|e| HilError::Refused {
+            agent: model.agents[i].name.clone(),
+            reason: e.to_string(),
+        })?;
         hil.push(Some(
             HilController::configure(
                 config,

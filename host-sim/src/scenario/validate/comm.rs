@@ -68,10 +68,10 @@ pub(super) fn comm_every(c: &mut Checker<'_>, s: &ScenarioFile, period: f64) -> 
 /// The shared medium of `[radio.channel]`, if any; `period` is the control period (s).
 pub(super) fn channel(c: &mut Checker<'_>, s: &ScenarioFile, period: f64) -> Option<ChannelModel> {
     let ch = s.radio.channel.as_ref()?;
-    if s.radio.bandwidth != 0.0 {
+    if s.radio.bandwidth_bps != 0.0 {
         c.err(
             InvalidValue,
-            "radio.bandwidth",
+            "radio.bandwidth_bps",
             "not used with [radio.channel] (the channel's bit rate limits the air time); remove one",
         );
     }
@@ -93,13 +93,13 @@ pub(super) fn channel(c: &mut Checker<'_>, s: &ScenarioFile, period: f64) -> Opt
             "custom"
         }
     };
-    let bit_rate = match ch.bit_rate.or(bit_rate) {
+    let bit_rate = match ch.bit_rate_bps.or(bit_rate) {
         Some(b) => b,
         None => {
             c.err(
                 InvalidValue,
-                "radio.channel.bit_rate",
-                "required (bit/s) unless a preset gives it (preset = \"crazyflie\")",
+                "radio.channel.bit_rate_bps",
+                "required (bits per second) unless a preset gives it (preset = \"crazyflie\")",
             );
             return None;
         }
@@ -115,7 +115,7 @@ pub(super) fn channel(c: &mut Checker<'_>, s: &ScenarioFile, period: f64) -> Opt
         slot: 0.0,
     };
     let errors = c.errors.len();
-    c.positive(InvalidValue, "radio.channel.bit_rate", m.bit_rate);
+    c.positive(InvalidValue, "radio.channel.bit_rate_bps", m.bit_rate);
     c.non_negative(
         InvalidValue,
         "radio.channel.overhead_bytes",

@@ -9,6 +9,7 @@ mod camera;
 mod checker;
 mod comm;
 mod graph;
+mod model;
 mod references;
 mod settings;
 mod target;
@@ -16,10 +17,11 @@ mod triangles;
 mod world;
 
 use crate::model::{Graph, Model, RadioModel, SensorModel};
-use crate::scenario::error::{ErrorKind::InvalidValue, ScenarioError, ScenarioErrors};
+use crate::scenario::error::ScenarioErrors;
 use crate::scenario::ScenarioFile;
 use checker::Checker;
 use controller_core::{BearingFilter, Limits, TrackerConfig};
+pub use model::check_model;
 
 /// Validates a parsed scenario file. `file` labels errors; `default_name` is used when the
 /// file has no `name`.
@@ -132,7 +134,7 @@ fn check(
             reordering: ra.reordering,
             reorder_delay,
             corruption: ra.corruption,
-            bandwidth: ra.bandwidth,
+            bandwidth: ra.bandwidth_bps,
             queue_limit: ra.queue_limit,
             channel,
         },
@@ -142,22 +144,19 @@ fn check(
         target,
         world,
     };
-    // Last line of defence: the core's own checks (should agree with the above).
-    let mut core_errors = Vec::new();
-    for i in 0..model.n() {
-        if let Err(e) = model.core_agent(i) {
-            core_errors.push(ScenarioError::new(
-                InvalidValue,
-                file,
-                &format!("agents[{i}]"),
-                e.to_string(),
-            ));
-        }
-    }
-    if core_errors.is_empty() {
+    // Last line of defence, shared with generated models (`model::check_model`): wire
+    // ids a receiver can tell apart, and the core's own checks (should agree with the
+    // above).
+    let mut c = Checker {
+        file,
+        text,
+        errors: Vec::new(),
+    };
+    model::built(&mut c, &model);
+    if c.errors.is_empty() {
         Ok(model)
     } else {
-        Err(ScenarioErrors(core_errors))
+        Err(ScenarioErrors(c.errors))
     }
 }
 

@@ -177,7 +177,7 @@ pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile) -> Timing {
     c.probability("radio.duplication", ra.duplication);
     c.probability("radio.reordering", ra.reordering);
     c.probability("radio.corruption", ra.corruption);
-    c.non_negative(InvalidValue, "radio.bandwidth", ra.bandwidth);
+    c.non_negative(InvalidValue, "radio.bandwidth_bps", ra.bandwidth_bps);
     c.non_negative(InvalidValue, "radio.queue_limit", ra.queue_limit);
     let period = dt * steps_per_tick as f64;
     let reorder_delay = ra.reorder_delay.unwrap_or(2.0 * period);

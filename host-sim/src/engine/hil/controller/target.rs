@@ -10,7 +10,7 @@ pub enum TargetHandle {
     /// `qemu-system-arm` with the firmware (killed on drop).
     Qemu(QemuProcess),
     /// The host-side stand-in of `engine::hil::fake` (tests).
-    Fake(Option<JoinHandle<Result<(), String>>>),
+    Fake(Option<JoinHandle<std::io::Result<()>>>),
 }
 
 impl TargetHandle {
