@@ -147,6 +147,25 @@ impl DesignArgs {
     }
 }
 
+/// Why a designed scenario or its figure could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum WriteError {
+    /// The scenario file or standard output.
+    #[error("cannot write {to}: {source}")]
+    Io {
+        /// Where.
+        to: String,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The written scenario does not load (a bug: `design` checked it).
+    #[error("{0}")]
+    Scenario(#[from] crate::scenario::ScenarioErrors),
+    /// The formation figure.
+    #[error("{0}")]
+    Plot(#[from] crate::report::plot::PlotError),
+}
+
 /// Runs `host-sim design`; returns the exit code.
 pub fn design_command(args: &DesignArgs, quiet: bool) -> u8 {
     match design(args) {
@@ -155,13 +174,18 @@ pub fn design_command(args: &DesignArgs, quiet: bool) -> u8 {
                 eprint!("{figures}");
             }
             let written = match &args.output {
-                Some(path) => std::fs::write(path, &text)
-                    .map_err(|e| format!("cannot write {}: {e}", path.display())),
+                Some(path) => std::fs::write(path, &text).map_err(|source| WriteError::Io {
+                    to: path.display().to_string(),
+                    source,
+                }),
                 None => {
                     use std::io::Write;
                     std::io::stdout()
                         .write_all(text.as_bytes())
-                        .map_err(|e| format!("cannot write to stdout: {e}"))
+                        .map_err(|source| WriteError::Io {
+                            to: "stdout".to_owned(),
+                            source,
+                        })
                 }
             };
             let written = written.and_then(|()| match &args.plot {

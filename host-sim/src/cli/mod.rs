@@ -251,9 +251,13 @@ pub(crate) fn load(scenario: &str, set: &[String]) -> Result<crate::model::Model
 }
 
 /// Draws the formation of the scenario `text` into `file`.
-fn plot_formation_of(text: &str, name: &str, file: &std::path::Path) -> Result<(), String> {
-    let m = crate::api::load_toml(text, name, &[]).map_err(|e| e.to_string())?;
-    crate::report::plot::plot_formation(&m, file).map_err(|e| e.to_string())
+fn plot_formation_of(
+    text: &str,
+    name: &str,
+    file: &std::path::Path,
+) -> Result<(), design::WriteError> {
+    let m = crate::api::load_toml(text, name, &[])?;
+    Ok(crate::report::plot::plot_formation(&m, file)?)
 }
 
 fn validate_command(
