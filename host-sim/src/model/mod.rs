@@ -26,6 +26,7 @@ pub use channel::{Access, ChannelModel, IntegrityMode};
 pub use core_config::{CoreAgent, MT, NB};
 pub use criteria::Criteria;
 pub use devices::{CameraModel, RadioDepartures, RadioModel, SensorDepartures, SensorModel};
+pub use devices::PositionsModel;
 pub use error::ModelError;
 pub use estimates::{estimate_layout, resolve_estimates, EstimateInfo};
 pub use formation::{AgentModel, AngleModel, LeaderModel, TriangleModel};

@@ -22,6 +22,7 @@ pub use schema::{
     ScheduleSpec, StepSpec, TargetSpec, TriangleSpec,
 };
 pub use settings::{CameraSpec, ChannelSpec, ControllerSpec, Integration, RadioSpec, SensorSpec};
+pub use settings::{BearingSource, PositionsSpec};
 pub use source::Source;
 pub use strip::strip_model;
 pub use validate::{validate, validate_text};
