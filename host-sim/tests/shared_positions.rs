@@ -157,7 +157,7 @@ fn sigma_zero_with_an_ideal_radio_converges_like_the_ideal_sensor() {
     // the ideal sensor's: the settle time within a few percent.
     let (sa, sb) = (sa.expect("settled"), sb.expect("settled"));
     assert!((sb - sa).abs() < 0.05 * sa, "{sb} s vs {sa} s");
-    // With every position packet lost, nothing is measured and nothing converges.
+    // With every packet lost (positions and frames), nothing is measured: no convergence.
     let lost = shared("formation-only", &["duration=20", "radio.loss=1"]);
     assert_ne!(outcome(&lost).0, "Converged");
 }
