@@ -259,6 +259,13 @@ fn bad_world_values_are_refused_with_their_field() {
         (&["clock.offset_s=-1"], "clock.offset_s"),
         (&["world=mars"], "world"),
         (&["mode=continuous", "clock.ppm=10"], "mode"),
+        (
+            &[
+                "heading.error_deg=1",
+                "sensors.bearing_source=shared_positions",
+            ],
+            "heading",
+        ),
     ];
     for (overrides, field) in cases {
         let e = refused(overrides);

@@ -37,11 +37,15 @@ use tick::{world_force, AgentSlots, AgentTick, Walk};
 
 /// Whether every frame of a tick arrives, unchanged and in sender order, at the next tick:
 /// nothing in the radio alters frames ([`RadioModel::departures`](crate::model::RadioModel::departures),
-/// the one classification of its fields), a latency under half a control period, and no
-/// attacker.
+/// the one classification of its fields), a latency under half a control period, no
+/// attacker, and no position packets (`sensors.bearing_source = "shared_positions"`).
 pub fn direct_radio(model: &Model) -> bool {
     let d = model.radio.departures();
-    !d.alters_frames && d.latency < 0.5 * model.control_period() && model.attacks.is_empty()
+    !d.alters_frames
+        && d.latency < 0.5 * model.control_period()
+        && model.attacks.is_empty()
+        // Position packets (`sensors/shared_positions.rs`) go through the radio's queue.
+        && model.sensors.positions.is_none()
 }
 
 /// The sampled-data simulator.
@@ -172,7 +176,7 @@ impl<'m> SampledSim<'m> {
             world: WorldState::new(model),
             senses: Senses {
                 sensors: Sensors::new(&model.sensors, model.seed),
-                bearing: bearing_sensor(&model.sensors, n, period),
+                bearing: bearing_sensor(model, period),
                 ids: model.agents.iter().map(|a| a.id).collect(),
                 partner: model.partners(),
             },
@@ -347,6 +351,10 @@ impl SampledSim<'_> {
                     .overhear(t, i, f.as_bytes(), self.plant.q(), model, &mut self.radio);
             }
         }
+        // Its position packet, after its frames (`sensors/shared_positions.rs`).
+        if let Some(p) = self.senses.bearing.as_mut().and_then(|s| s.positions()) {
+            self.radio.broadcast_frame(t, i, receivers, p.packet(i));
+        }
     }
 
     /// Copies agent `i`'s current estimates into its slots of `estimates`
@@ -395,6 +403,9 @@ impl Engine for SampledSim<'_> {
                     .tick(t, period, self.plant.q(), model, &mut self.radio);
             }
             self.radio.deliver(t, &mut self.inboxes);
+            if let Some(p) = self.senses.bearing.as_mut().and_then(|s| s.positions()) {
+                p.hear(t, self.ticks, self.plant.q(), &mut self.inboxes);
+            }
         }
         // At every control period of the common clock (with own clocks, the agents that
         // tick in between see the camera's history and occlusions of the last one).
@@ -728,7 +739,8 @@ impl<'a> Scene<'a> {
             }
         }
         let velocity = draws.velocity(&v[i]);
-        (velocity, s.partner[i].map(|p| draws.offset(&q[i], &q[p])))
+        let offset = s.partner[i].and_then(|p| sensor.partner_offset(&world, i, p, &mut draws));
+        (velocity, offset)
     }
 }
 

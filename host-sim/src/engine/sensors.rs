@@ -8,15 +8,17 @@
 //! order and give the same bits.
 //!
 //! Which bearings are seen: every neighbour's, at once, unless a bearing sensor
-//! ([`BearingSensor`], the seam in `sensors/source.rs`; today the [`Camera`]) says
-//! otherwise.
+//! ([`BearingSensor`], the seam in `sensors/source.rs`; the [`Camera`], or the
+//! [`SharedPositions`] heard over the radio) says otherwise.
 
 mod camera;
 mod latency;
 mod occlusion;
+mod shared_positions;
 mod source;
 
 pub use camera::Camera;
+pub use shared_positions::{SharedPositions, POSITION_VERSION};
 pub use source::{bearing_sensor, BearingKind, BearingSensor, World};
 
 use crate::model::SensorModel;
@@ -161,6 +163,12 @@ impl Draws<'_> {
         let s = self.model.velocity_noise;
         let noise = [self.gauss(s), self.gauss(s)];
         velocity_with(self.model, v, noise)
+    }
+
+    /// A Gaussian draw of standard deviation `sigma` (0, and no draw, when `sigma` is 0).
+    #[inline]
+    pub fn normal(&mut self, sigma: f64) -> f64 {
+        self.gauss(sigma)
     }
 
     /// A uniform draw in `[0, 1)` (a bearing sensor's chances: detection, outliers).

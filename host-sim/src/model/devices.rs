@@ -25,6 +25,9 @@ pub struct SensorModel {
     /// The camera that limits which neighbours are seen (`[sensors.camera]`); `None`:
     /// every neighbour's bearing is seen, at once (the omnidirectional ideal sensor).
     pub camera: Option<CameraModel>,
+    /// Bearings from positions shared over the radio (`sensors.bearing_source =
+    /// "shared_positions"`); `None`: the agents' own bearing sensor.
+    pub positions: Option<PositionsModel>,
 }
 
 impl SensorModel {
@@ -40,6 +43,7 @@ impl SensorModel {
             offset_noise: 0.0,
             range_noise: 0.0,
             camera: None,
+            positions: None,
         }
     }
 
@@ -60,6 +64,9 @@ impl SensorModel {
             // which neighbours are seen and when: the engine's bearing sensor
             // (`engine/sensors/camera.rs`), which draws from the streams on its own
             camera: _,
+            // the position noise and the packets' staleness: the engine's bearing sensor
+            // (`engine/sensors/shared_positions.rs`), which draws from streams of its own
+            positions: _,
         } = self;
         SensorDepartures {
             noise: *bearing_noise != 0.0 || *velocity_noise != 0.0 || *offset_noise != 0.0,
@@ -109,6 +116,19 @@ impl CameraModel {
             latency: 0.0,
         }
     }
+}
+
+/// Bearings from positions shared over the radio (`[sensors.positions]`, docs/sensors.md):
+/// each agent's position estimate is the true position plus white Gaussian noise, and it
+/// broadcasts that estimate in a packet of its own at every tick. SI units.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PositionsModel {
+    /// Standard deviation of the position noise per axis (m).
+    pub noise: f64,
+    /// A neighbour's position heard longer ago than this gives no bearing (s).
+    pub max_age: f64,
+    /// Size of one position packet on the radio (bytes, 10 to 60).
+    pub packet_bytes: usize,
 }
 
 /// How a [`SensorModel`] departs from ideal sensors ([`SensorModel::departures`]).

@@ -25,6 +25,7 @@ pub use attack::{AttackKind, AttackModel};
 pub use channel::{Access, ChannelModel, IntegrityMode};
 pub use core_config::{CoreAgent, MT, NB};
 pub use criteria::Criteria;
+pub use devices::PositionsModel;
 pub use devices::{CameraModel, RadioDepartures, RadioModel, SensorDepartures, SensorModel};
 pub use error::ModelError;
 pub use estimates::{estimate_layout, resolve_estimates, EstimateInfo};

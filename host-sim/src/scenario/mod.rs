@@ -21,6 +21,7 @@ pub use schema::{
     AgentDefaults, AgentId, AgentSpec, AngleSpec, Diagonal, GainsSpec, LeaderSpec, ScenarioFile,
     ScheduleSpec, StepSpec, TargetSpec, TriangleSpec,
 };
+pub use settings::{BearingSource, PositionsSpec};
 pub use settings::{CameraSpec, ChannelSpec, ControllerSpec, Integration, RadioSpec, SensorSpec};
 pub use source::Source;
 pub use strip::strip_model;

@@ -99,6 +99,56 @@ pub struct SensorSpec {
     /// `[sensors.camera]`: the camera every agent sees its neighbours through (optional;
     /// absent: every neighbour's bearing is seen, at once).
     pub camera: Option<CameraSpec>,
+    /// Where the bearings come from: `onboard` (the agents' own bearing sensor, ideal or
+    /// `[sensors.camera]`) or `shared_positions` (from positions broadcast over the radio,
+    /// `[sensors.positions]`).
+    #[serde(skip_serializing_if = "BearingSource::is_onboard")]
+    pub bearing_source: BearingSource,
+    /// `[sensors.positions]`: the positioning system and its packets
+    /// (`bearing_source = "shared_positions"` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub positions: Option<PositionsSpec>,
+}
+
+/// `sensors.bearing_source`: where every agent's bearings come from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BearingSource {
+    /// The agents' own bearing sensor: the omnidirectional ideal one, or the camera.
+    #[default]
+    Onboard,
+    /// Bearings computed from the agents' positions, each broadcast in a packet of its
+    /// own over the radio (a positioning-system flight, docs/crazyflie.md).
+    SharedPositions,
+}
+
+impl BearingSource {
+    /// Whether this is the default, [`BearingSource::Onboard`].
+    pub fn is_onboard(&self) -> bool {
+        *self == Self::Onboard
+    }
+}
+
+/// `[sensors.positions]`: each agent's position estimate and its packets (docs/sensors.md).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PositionsSpec {
+    /// Standard deviation of the white position noise per axis (m).
+    pub noise_m: f64,
+    /// A neighbour's position heard longer ago than this (s) gives no bearing.
+    pub max_age_s: f64,
+    /// Size of one position packet on the radio (bytes).
+    pub packet_bytes: usize,
+}
+
+impl Default for PositionsSpec {
+    fn default() -> Self {
+        Self {
+            noise_m: 0.0,
+            max_age_s: 0.1,
+            packet_bytes: 10,
+        }
+    }
 }
 
 /// `[sensors.camera]`: every agent's camera (docs/sensors.md). Each field defaults to the
@@ -146,6 +196,8 @@ impl Default for SensorSpec {
             offset_noise: 0.0,
             range_noise: 0.0,
             camera: None,
+            bearing_source: BearingSource::Onboard,
+            positions: None,
         }
     }
 }

@@ -13,13 +13,18 @@
 //!    agent's own stream of the tick ([`Draws`]): a sensor that draws the same numbers in
 //!    the same order for the same state gives the same bits on any number of threads.
 //!
+//! The shared positions ([`SharedPositions`]) are a bearing sensor whose data comes over
+//! the radio: the simulator hands it the delivered inboxes and sends its packets
+//! ([`BearingSensor::positions`]).
+//!
 //! A new bearing sensor is one file beside this one that implements the trait, and one
 //! line in [`bearing_sensor`] that picks it from the [`SensorModel`] (docs/architecture.md,
 //! "Add a sensor").
 
 use super::camera::Camera;
+use super::shared_positions::SharedPositions;
 use super::Draws;
-use crate::model::SensorModel;
+use crate::model::Model;
 use controller_core::{BearingMeasurement, Vec2};
 
 /// The true state of every agent at a control tick, as a bearing sensor reads it (world
@@ -60,15 +65,34 @@ pub trait BearingSensor: Send + Sync + std::fmt::Debug {
         kind: BearingKind,
         draws: &mut Draws<'_>,
     ) -> Option<BearingMeasurement<f64>>;
+
+    /// A leader `i`'s offset `q_p − q_i` of its partner `p` at this tick, drawn from
+    /// `draws` after its bearings (`None`: not measured). By default the sensors' own
+    /// offset of the true state ([`Draws::offset`]).
+    fn partner_offset(
+        &self,
+        world: &World<'_>,
+        i: usize,
+        p: usize,
+        draws: &mut Draws<'_>,
+    ) -> Option<Vec2<f64>> {
+        Some(draws.offset(&world.q[i], &world.q[p]))
+    }
+
+    /// The shared positions, when this sensor is theirs (the simulator then carries their
+    /// packets over the radio).
+    fn positions(&mut self) -> Option<&mut SharedPositions> {
+        None
+    }
 }
 
-/// The bearing sensor of a run of `n` agents with control period `period` (s): `None`
-/// for the omnidirectional ideal sensor (no `[sensors.camera]`).
-pub fn bearing_sensor(
-    model: &SensorModel,
-    n: usize,
-    period: f64,
-) -> Option<Box<dyn BearingSensor>> {
-    let camera = model.camera.as_ref()?;
-    Some(Box::new(Camera::new(camera, n, period)))
+/// The bearing sensor of `model`'s run with control period `period` (s): the shared
+/// positions (`sensors.bearing_source = "shared_positions"`), the camera, or `None` for
+/// the omnidirectional ideal sensor.
+pub fn bearing_sensor(model: &Model, period: f64) -> Option<Box<dyn BearingSensor>> {
+    if let Some(p) = &model.sensors.positions {
+        return Some(Box::new(SharedPositions::new(model, p)));
+    }
+    let camera = model.sensors.camera.as_ref()?;
+    Some(Box::new(Camera::new(camera, model.n(), period)))
 }

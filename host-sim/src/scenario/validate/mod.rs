@@ -10,6 +10,7 @@ mod checker;
 mod comm;
 mod graph;
 mod model;
+mod positions;
 mod references;
 mod settings;
 mod target;
@@ -65,6 +66,7 @@ fn check(
     let world = world::check(&mut c, s, period);
     let (mut agents, index) = agents::check(&mut c, s);
     let camera = camera::check(&mut c, s, &agents);
+    let positions = positions::check(&mut c, s);
     let (triangles, ids_ok) = triangles::check(&mut c, s, &index, margin);
     let order = graph::check(&mut c, s, &agents, &triangles, ids_ok, margin);
     let leader = references::leader(&mut c, s, &index);
@@ -125,6 +127,7 @@ fn check(
             offset_noise: se.offset_noise,
             range_noise: se.range_noise,
             camera,
+            positions,
         },
         radio: RadioModel {
             latency: ra.latency,

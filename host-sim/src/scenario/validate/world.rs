@@ -118,6 +118,16 @@ pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile, period: f64) -> World
             world.clock = Some(m);
         }
     }
+    if world.heading.is_some()
+        && s.sensors.bearing_source == crate::scenario::settings::BearingSource::SharedPositions
+    {
+        c.err(
+            InvalidValue,
+            "heading",
+            "bearings from shared positions are computed in the positioning system's frame, \
+             not the body frame: remove [heading] (or use sensors.bearing_source = \"onboard\")",
+        );
+    }
     if s.mode == Mode::Continuous && !world.is_ideal() {
         c.err(
             InvalidValue,

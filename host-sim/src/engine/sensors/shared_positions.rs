@@ -1,0 +1,212 @@
+//! Bearings from positions shared over the radio (`sensors.bearing_source =
+//! "shared_positions"`, docs/sensors.md): the simulator's model of the Crazyflie app's
+//! positioning-system flight (`crazyflie-app/src/formation.c`, docs/crazyflie.md).
+//!
+//! At every control tick `k`, before any agent is measured ([`SharedPositions::hear`]):
+//!
+//! 1. every position packet the radio delivered is taken out of its receiver's inbox (the
+//!    controllers never see it, so their frame counters are those of the formation frames
+//!    alone), and the receiver keeps the position and the time it heard it, for the sender
+//!    among its radio neighbours whose wire id the packet carries;
+//! 2. every agent's own position estimate is its true position plus white Gaussian noise
+//!    `σ` per axis, drawn from its own stream of the tick (a stream of this sensor,
+//!    independent of the bearing sensors'), rounded to `f32` as the packet carries it.
+//!
+//! Agent `i`'s bearing of neighbour `j` ([`BearingSensor::bearing`]) is S2's
+//! `(q̂_j − q̂_i)/‖q̂_j − q̂_i‖` with `q̂_i` its own estimate and `q̂_j` the last position it
+//! heard from `j`; none when it heard nothing from `j` or longer than `max_age` ago
+//! (formation.c's `fresh`: `now − heard ≤ max_age`). The sensors' bearing rotation noise,
+//! bias and range noise still apply on top ([`Draws::bearing`], zero by default). A
+//! leader's partner offset is `q̂_p − q̂_i` the same way (plus the offset noise).
+//!
+//! After its tick each agent broadcasts its estimate through the radio
+//! ([`SharedPositions::packet`]): a frame of `packet_bytes` bytes with the layout of
+//! docs/core.md "Position packets" (version 1, sender id, `x`, `y` as little-endian `f32`,
+//! zeros after), a packet of its own on the radio model and the shared channel (loss,
+//! latency, air time, collisions). It is told from a formation frame by its length and
+//! first byte (a formation frame's mode byte is `0x80` or more, and it is at least 12
+//! bytes long; the app sends it on a P2P port of its own).
+//!
+//! Everything is drawn from per-agent streams or from the radio's stream in agent order,
+//! and the table is written only between ticks: a run gives the same bits on any number
+//! of threads.
+
+use super::source::{BearingKind, BearingSensor, World};
+use super::{Draws, Sensors, Sight};
+use crate::engine::radio::RadioFrame;
+use crate::model::{Model, PositionsModel};
+use controller_core::{BearingMeasurement, Vec2};
+
+/// The first byte of a position packet: its layout version (formation.h's
+/// `FORMATION_POSITION_VERSION`).
+pub const POSITION_VERSION: u8 = 1;
+/// Tag mixed into the run's seed for the position noise's streams (independent of the
+/// sensors' and the radio's).
+const POSITION_STREAM: u64 = 0x5053_4e00; // "PSN"
+/// Tolerance on the age of a heard position (s).
+const AGE_EPS: f64 = 1e-9;
+
+/// One radio neighbour as a receiver knows it: its wire id, index, and the last
+/// position heard from it with the time it was heard.
+#[derive(Clone, Copy, Debug)]
+struct Peer {
+    id: u8,
+    index: usize,
+    heard: Option<(Vec2<f64>, f64)>,
+}
+
+/// Every agent's position estimate and the positions it heard.
+#[derive(Debug)]
+pub struct SharedPositions {
+    model: PositionsModel,
+    /// The position noise's per-agent streams (a [`Sensors`] of its own key).
+    streams: Sensors,
+    /// Every agent's wire id.
+    ids: Vec<u8>,
+    /// Each agent's own estimate of this tick (as broadcast).
+    own: Vec<Vec2<f64>>,
+    /// Each agent's radio neighbours and what it heard from them.
+    peers: Vec<Vec<Peer>>,
+    /// The time of this tick (s).
+    now: f64,
+    /// Position packets taken out of the inboxes (each a copy the radio delivered).
+    heard: u64,
+}
+
+impl SharedPositions {
+    /// The shared positions of `model`'s agents, with `positions` its settings.
+    pub fn new(model: &Model, positions: &PositionsModel) -> Self {
+        let ids: Vec<u8> = model.agents.iter().map(|a| a.id).collect();
+        let peers = (0..model.n())
+            .map(|i| {
+                let of = model.graph.radio.of(i);
+                of.iter()
+                    .map(|&j| Peer {
+                        id: ids[j],
+                        index: j,
+                        heard: None,
+                    })
+                    .collect()
+            })
+            .collect();
+        Self {
+            model: positions.clone(),
+            streams: Sensors::new(&model.sensors, model.seed ^ POSITION_STREAM),
+            ids,
+            own: vec![Vec2::zeros(); model.n()],
+            peers,
+            now: f64::NEG_INFINITY,
+            heard: 0,
+        }
+    }
+
+    /// Step 1 and 2 of the module's list at time `now`, control tick `tick`, with the true
+    /// positions `q`: the position packets leave `inboxes` for the table, and every
+    /// agent's own estimate is drawn.
+    pub fn hear(&mut self, now: f64, tick: u64, q: &[Vec2<f64>], inboxes: &mut [Vec<RadioFrame>]) {
+        self.now = now;
+        let len = self.model.packet_bytes;
+        for (inbox, peers) in inboxes.iter_mut().zip(&mut self.peers) {
+            inbox.retain(|f| {
+                let b = f.as_bytes();
+                if b.len() != len || b.first() != Some(&POSITION_VERSION) {
+                    return true;
+                }
+                self.heard += 1;
+                if let Some(p) = decode(b) {
+                    if let Some(peer) = peers.iter_mut().find(|x| x.id == b[1]) {
+                        peer.heard = Some((p, now));
+                    }
+                }
+                false
+            });
+        }
+        let sigma = self.model.noise;
+        for (i, (own, q)) in self.own.iter_mut().zip(q).enumerate() {
+            let mut draws = self.streams.stream(i, tick);
+            let noise = Vec2::new(draws.normal(sigma), draws.normal(sigma));
+            *own = as_f32(&(q + noise));
+        }
+    }
+
+    /// Agent `i`'s position packet of this tick (its estimate, tagged with its id).
+    pub fn packet(&self, i: usize) -> RadioFrame {
+        let mut bytes = [0u8; controller_core::MAX_FRAME_LEN];
+        let p = self.own.get(i).copied().unwrap_or_else(Vec2::zeros);
+        bytes[0] = POSITION_VERSION;
+        bytes[1] = self.ids.get(i).copied().unwrap_or(0);
+        bytes[2..6].copy_from_slice(&(p.x as f32).to_le_bytes());
+        bytes[6..10].copy_from_slice(&(p.y as f32).to_le_bytes());
+        let len = self.model.packet_bytes.clamp(10, bytes.len());
+        RadioFrame::checked(&bytes[..len], None)
+    }
+
+    /// Position packets taken out of the inboxes so far (link copies delivered).
+    pub fn packets_heard(&self) -> u64 {
+        self.heard
+    }
+
+    /// The position agent `i` last heard from agent `j`, if it is fresh (heard no more
+    /// than `max_age` ago).
+    fn fresh(&self, i: usize, j: usize) -> Option<Vec2<f64>> {
+        let peer = self.peers.get(i)?.iter().find(|p| p.index == j)?;
+        let (p, at) = peer.heard?;
+        (self.now - at <= self.model.max_age + AGE_EPS).then_some(p)
+    }
+}
+
+/// The position a packet carries, `None` if a coordinate is not finite (formation.c's
+/// `formation_position_received`).
+fn decode(b: &[u8]) -> Option<Vec2<f64>> {
+    let f = |k: usize| -> Option<f64> {
+        let w: [u8; 4] = b.get(k..k + 4)?.try_into().ok()?;
+        let x = f64::from(f32::from_le_bytes(w));
+        x.is_finite().then_some(x)
+    };
+    Some(Vec2::new(f(2)?, f(6)?))
+}
+
+/// `p` rounded to `f32` per axis (what the packet and the app's `float`s hold).
+fn as_f32(p: &Vec2<f64>) -> Vec2<f64> {
+    Vec2::new(f64::from(p.x as f32), f64::from(p.y as f32))
+}
+
+impl BearingSensor for SharedPositions {
+    fn prepare(&mut self, _world: &World<'_>) {}
+
+    fn bearing(
+        &self,
+        world: &World<'_>,
+        ids: &[u8],
+        i: usize,
+        j: usize,
+        kind: BearingKind,
+        draws: &mut Draws<'_>,
+    ) -> Option<BearingMeasurement<f64>> {
+        let other = self.fresh(i, j)?;
+        let sight = Sight {
+            neighbour: ids[j],
+            q_self: &self.own[i],
+            q_other: &other,
+            v_self: &world.v[i],
+            v_other: &world.v[j],
+        };
+        // Validation refuses exact rates with shared positions.
+        draws.bearing(&sight, false, kind.with_range)
+    }
+
+    fn partner_offset(
+        &self,
+        _world: &World<'_>,
+        i: usize,
+        p: usize,
+        draws: &mut Draws<'_>,
+    ) -> Option<Vec2<f64>> {
+        let other = self.fresh(i, p)?;
+        Some(draws.offset(&self.own[i], &other))
+    }
+
+    fn positions(&mut self) -> Option<&mut SharedPositions> {
+        Some(self)
+    }
+}
