@@ -221,6 +221,13 @@ fn a_reference_above_the_speed_limit_is_named() {
     let says = |s: &str| s.contains("v* = (3, 3)") && s.contains("plant.max_speed = 1");
     assert!(r.warnings.iter().any(|w| says(w)), "{:?}", r.warnings);
     assert!(says(&r.reason), "{}", r.reason);
+    // `host-sim validate` says it before any run.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args(["validate", "paper", "--set", "world=crazyflie"])
+        .output()
+        .expect("host-sim validate");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && says(&err), "{err}");
 }
 
 /// Every new field is checked with its name and the reason.

@@ -287,6 +287,10 @@ fn validate_command(
                     m.duration
                 );
             }
+            // Printed even with --quiet, as warnings are.
+            if let Some(w) = crate::engine::speed_limit_note(&m) {
+                eprintln!("warning: {w}");
+            }
             exit_code::CONVERGED
         }
         Err(e) => report(&e),

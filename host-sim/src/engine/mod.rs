@@ -28,7 +28,7 @@ pub mod world;
 
 pub use continuous::ContinuousSim;
 pub use controller::{local_core, AgentController, LocalCore, LOCAL_CAPACITIES};
-pub use driver::{drive, run, Engine};
+pub use driver::{drive, run, speed_limit_note, Engine};
 pub use error::{RunError, SetupError};
 pub use record::{NullRecorder, Recorder, Row};
 pub use result::RunResult;
