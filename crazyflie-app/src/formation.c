@@ -60,6 +60,7 @@ ph_status formation_config(uint8_t id, ph_config *c)
     constant(&c->velocity_reference, 0.0f, 0.0f);
     c->limits.max_force = 2.0f;
     c->limits.neighbour_timeout = 0.1f; /* 10 ticks without a frame: safe output */
+    c->limits.bearing_hold = 0.05f;     /* a missing bearing predicted for 5 ticks (SPEC §12) */
     if (id <= 3) { /* triangle {1, 2, 3}: theta1 = 90 deg at 1, phi1 = 45 deg at 3 */
         ph_triangle *t = &c->triangles[c->triangle_count++];
         t->vertices[0] = 1;
