@@ -3,11 +3,12 @@
 //! in runs: an all-seeing camera changes no bit of a run, a camera run gives the same bits
 //! on 1 and 4 threads, and bad settings are refused with file, field and reason.
 
+mod support;
 use controller_core::Vec2;
 use host_sim::engine::sensors::{BearingKind, BearingSensor, Camera, Sensors, World};
-use host_sim::engine::{Engine, SampledSim, PARALLEL_MIN_AGENTS};
+use host_sim::engine::PARALLEL_MIN_AGENTS;
 use host_sim::load;
-use host_sim::model::{BearingRate, CameraModel, Model, SensorModel};
+use host_sim::model::{BearingRate, CameraModel, SensorModel};
 use host_sim::scenario::strip_model;
 
 const PERIOD: f64 = 0.01;
@@ -187,24 +188,7 @@ fn latency_gives_the_bearing_of_the_state_latency_ago() {
     assert_eq!(late_bearing(0.1, 5), unit(moving(0)));
 }
 
-/// The bits of positions, velocities and estimates after `ticks` ticks of `m` on
-/// `threads` threads.
-fn bits(m: &Model, ticks: usize, threads: usize) -> Vec<u64> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("pool");
-    pool.install(|| {
-        let mut sim = SampledSim::new(m).expect("sim");
-        sim.advance_ticks(0.0, ticks);
-        let (q, v, est) = sim.view();
-        q.iter()
-            .chain(v)
-            .flat_map(|p| [p.x.to_bits(), p.y.to_bits()])
-            .chain(est.iter().map(|e| e.to_bits()))
-            .collect()
-    })
-}
+use support::bits;
 
 #[test]
 fn an_all_seeing_camera_changes_no_bit() {

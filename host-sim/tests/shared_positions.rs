@@ -4,6 +4,7 @@
 //! packets' share of the shared channel, the same bits on 1 and 4 threads), and bad
 //! settings refused with file, field and reason.
 
+mod support;
 use controller_core::Vec2;
 use host_sim::engine::radio::RadioFrame;
 use host_sim::engine::sensors::{
@@ -214,24 +215,7 @@ fn the_position_packets_are_load_on_the_shared_channel() {
     }
 }
 
-/// The bits of positions, velocities and estimates after `ticks` ticks of `m` on
-/// `threads` threads.
-fn bits(m: &Model, ticks: usize, threads: usize) -> Vec<u64> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("pool");
-    pool.install(|| {
-        let mut sim = SampledSim::new(m).expect("sim");
-        sim.advance_ticks(0.0, ticks);
-        let (q, v, est) = sim.view();
-        q.iter()
-            .chain(v)
-            .flat_map(|p| [p.x.to_bits(), p.y.to_bits()])
-            .chain(est.iter().map(|e| e.to_bits()))
-            .collect()
-    })
-}
+use support::bits;
 
 #[test]
 fn a_shared_positions_run_gives_the_same_bits_on_1_and_4_threads() {
