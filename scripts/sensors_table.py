@@ -8,22 +8,18 @@ interval (from points.csv, as `host-sim sweep` computed it), the median settle t
 the converged runs, and the median and largest final angle error (from runs.csv).
 """
 
-import csv
 import statistics
 import sys
 from pathlib import Path
+
+from sweep_rows import angle_errors_deg, converged, load, settle_times
 
 
 def main() -> int:
     if len(sys.argv) != 2:
         print(__doc__, file=sys.stderr)
         return 2
-    d = Path(sys.argv[1])
-    points = list(csv.DictReader(open(d / "points.csv", newline="")))
-    runs = list(csv.DictReader(open(d / "runs.csv", newline="")))
-    by_point: dict[str, list[dict]] = {}
-    for r in runs:
-        by_point.setdefault(r["point"], []).append(r)
+    points, by_point = load(Path(sys.argv[1]))
     print(
         "| bearing noise | radio loss | runs | converged (95 % interval) "
         "| settle median (s) | final angle error median / max (°) |"
@@ -31,18 +27,8 @@ def main() -> int:
     print("|---|---|---|---|---|---|")
     for p in points:
         rs = by_point.get(p["point"], [])
-        settle = [
-            float(r["settle_time"])
-            for r in rs
-            if r["outcome"] == "converged" and r["settle_time"]
-        ]
-        err = [
-            float(r["final_max_angle_error"]) * 180.0 / 3.141592653589793
-            for r in rs
-            if r["final_max_angle_error"] not in ("", "NaN", "nan")
-        ]
-        frac = float(p["converged"])
-        lo, hi = float(p["converged_lo"]), float(p["converged_hi"])
+        settle, err = settle_times(rs), angle_errors_deg(rs)
+        frac, lo, hi = converged(p)
         settle_s = f"{statistics.median(settle):.2f}" if settle else "–"
         err_s = (
             f"{statistics.median(err):.3f} / {max(err):.3f}" if err else "–"

@@ -9,27 +9,23 @@ runs, the median final angle error, and the outcomes of the runs that did not co
 The last line names the deployment envelope: the points where at least 95 % converged.
 """
 
-import csv
 import statistics
 import sys
 from collections import Counter
 from pathlib import Path
+
+from sweep_rows import angle_errors_deg, converged, load, settle_times
 
 
 def main() -> int:
     if len(sys.argv) != 2:
         print(__doc__, file=sys.stderr)
         return 2
-    d = Path(sys.argv[1])
-    points = list(csv.DictReader(open(d / "points.csv", newline="")))
-    runs = list(csv.DictReader(open(d / "runs.csv", newline="")))
+    points, by_point = load(Path(sys.argv[1]))
     axis = [k for k in points[0].keys() if k.startswith("axis:")] or [
         k for k in points[0].keys() if "." in k
     ]
     key = axis[0] if axis else "point"
-    by_point: dict[str, list[dict]] = {}
-    for r in runs:
-        by_point.setdefault(r["point"], []).append(r)
     name = key.removeprefix("axis:")
     print(
         f"| `{name}` | runs | converged (95 % interval) | settle median (s) "
@@ -39,18 +35,8 @@ def main() -> int:
     inside = []
     for p in points:
         rs = by_point.get(p["point"], [])
-        settle = [
-            float(r["settle_time"])
-            for r in rs
-            if r["outcome"] == "converged" and r["settle_time"]
-        ]
-        err = [
-            float(r["final_max_angle_error"]) * 180.0 / 3.141592653589793
-            for r in rs
-            if r["final_max_angle_error"] not in ("", "NaN", "nan")
-        ]
-        frac = float(p["converged"])
-        lo, hi = float(p["converged_lo"]), float(p["converged_hi"])
+        settle, err = settle_times(rs), angle_errors_deg(rs)
+        frac, lo, hi = converged(p)
         others = Counter(r["outcome"] for r in rs if r["outcome"] != "converged")
         other_s = ", ".join(f"{k} {v}" for k, v in sorted(others.items())) or "–"
         settle_s = f"{statistics.median(settle):.1f}" if settle else "–"

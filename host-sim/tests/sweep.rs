@@ -11,26 +11,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 /// 2 × 2 points, 3 runs each, 2 s of formation-only with bearing noise, radio loss and a
 /// random initial shape: every run's figures depend on its seed.
-const TINY: &str = r#"
-name = "tiny"
-seed = 7
-runs = 3
-
-[base]
-scenario = "formation-only"
-set = ["duration=2", "sensors.bearing_noise_deg=0.5"]
-
-[perturbation]
-rotate = true
-
-[[axes]]
-key = "perturbation"
-values = [0.1, 0.4]
-
-[[axes]]
-key = "radio.loss"
-values = [0.0, 0.3]
-"#;
+const TINY: &str = include_str!("../sweeps/tiny.toml");
 
 fn plan(text: &str) -> Result<Plan, SweepError> {
     Plan::from_source(&SweepSource::from_text("test.toml", text), None)

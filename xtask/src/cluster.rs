@@ -37,26 +37,8 @@ exec "$HOST_SIM" -q sweep "$SWEEP" --jobs "${SLURM_CPUS_PER_TASK:-1}" --no-plots
 "#;
 
 /// The sweep of step 1: 2 × 2 points, 3 runs each, 2 s of formation-only with noise, loss
-/// and random initial shapes (the tests' `TINY`).
-const SWEEP: &str = r#"name = "cluster-tiny"
-seed = 7
-runs = 3
-
-[base]
-scenario = "formation-only"
-set = ["duration=2", "sensors.bearing_noise_deg=0.5"]
-
-[perturbation]
-rotate = true
-
-[[axes]]
-key = "perturbation"
-values = [0.1, 0.4]
-
-[[axes]]
-key = "radio.loss"
-values = [0.0, 0.3]
-"#;
+/// and random initial shapes (the sweep tests' file).
+const SWEEP: &str = include_str!("../../host-sim/sweeps/tiny.toml");
 
 /// Shards of the array.
 const K: u32 = 3;

@@ -293,7 +293,6 @@ impl SampledSim<'_> {
             footprints: &self.footprints,
             copy_estimates: self.viewed,
         };
-        let clocked = self.world.clocks.is_some();
         let each = self
             .controllers
             .iter_mut()
@@ -302,10 +301,8 @@ impl SampledSim<'_> {
             .zip(&mut self.forces)
             .zip(&mut self.outputs);
         for (i, ((((controller, inbox), outbox), force), output)) in each.enumerate() {
-            let at = match (clocked, self.world.due.get(i)) {
-                (false, _) => at,
-                (true, Some(Some(own))) => *own,
-                (true, _) => continue,
+            let Some(at) = self.world.tick_of(i, at) else {
+                continue;
             };
             let (a, b) = (self.est_start[i], self.est_start[i + 1]);
             let mut slots = AgentSlots {
@@ -444,10 +441,8 @@ impl Engine for SampledSim<'_> {
         }
         let clocked = self.world.clocks.is_some();
         for i in 0..model.n() {
-            let at = match (clocked, self.world.due.get(i)) {
-                (false, _) => at,
-                (true, Some(Some(own))) => *own,
-                (true, _) => continue,
+            let Some(at) = self.world.tick_of(i, at) else {
+                continue;
             };
             let out = match self.outputs[i].take() {
                 Some(out) => out,
@@ -602,15 +597,24 @@ struct WorldState {
 impl WorldState {
     fn new(model: &Model) -> Self {
         let w = &model.world;
+        let headings = w.heading.as_ref().map(|h| Headings::new(model, h));
         Self {
-            headings: w.heading.as_ref().map(|h| Headings::new(model, h)),
+            truth: headings
+                .as_ref()
+                .map_or_else(|| vec![0.0; model.n()], |h| h.truth.clone()),
+            headings,
             clocks: w.clock.as_ref().map(|c| Clocks::new(model, c)),
             wind: w.wind.as_ref().map(|x| Wind::new(model, x)),
             due: Vec::new(),
-            truth: match &w.heading {
-                Some(h) => Headings::new(model, h).truth,
-                None => vec![0.0; model.n()],
-            },
+        }
+    }
+
+    /// When agent `i` ticks at this step: at the common tick `common`, or with own clocks
+    /// at its own tick if it is due (`None`: not this step).
+    fn tick_of(&self, i: usize, common: AgentTick) -> Option<AgentTick> {
+        match &self.clocks {
+            None => Some(common),
+            Some(_) => self.due.get(i).copied().flatten(),
         }
     }
 }

@@ -21,11 +21,12 @@ pub use camera::Camera;
 pub use shared_positions::{SharedPositions, POSITION_VERSION};
 pub use source::{bearing_sensor, BearingKind, BearingSensor, World};
 
+use super::world::{stream, stream_key, Turn};
 use crate::model::SensorModel;
 use controller_core::{geometry, BearingMeasurement, Vec2};
-use rand::{Rng, RngCore, SeedableRng};
+use rand::Rng;
 use rand_distr::StandardNormal;
-use rand_xoshiro::{SplitMix64, Xoshiro256PlusPlus};
+use rand_xoshiro::Xoshiro256PlusPlus;
 
 /// Tag of the sensors' streams (mixed into the run's seed: the radio's faults draw from
 /// generators of their own).
@@ -81,7 +82,7 @@ pub struct Sensors {
 impl Sensors {
     /// Seeded sensors.
     pub fn new(model: &SensorModel, seed: u64) -> Self {
-        let key = SplitMix64::seed_from_u64(seed ^ SENSOR_STREAM).next_u64();
+        let key = stream_key(seed, SENSOR_STREAM);
         Self {
             model: model.clone(),
             key,
@@ -96,13 +97,13 @@ impl Sensors {
     /// Agent `agent`'s random stream at tick `tick` (draw its bearings in graph order,
     /// then its velocity, then its partner offset). A different generator for every
     /// agent index below 2³² and tick below 2³² (497 days at 100 Hz; ticks wrap after),
-    /// seeded by SplitMix64 from `key ^ (agent · 2³² + tick)`.
+    /// seeded by SplitMix64 from `key ^ (agent · 2³² + tick)` ([`stream`], the one scheme
+    /// of every per-agent stream).
     #[inline]
     pub fn stream(&self, agent: usize, tick: u64) -> Draws<'_> {
-        let word = ((agent as u64) << 32) | (tick & 0xFFFF_FFFF);
         Draws {
             model: &self.model,
-            rng: Xoshiro256PlusPlus::seed_from_u64(self.key ^ word),
+            rng: stream(self.key, agent, tick),
         }
     }
 
@@ -253,8 +254,7 @@ fn measured(
     let s_true = d / r;
     let angle = model.bearing_bias + noise.angle;
     let bearing = if angle != 0.0 {
-        let (sn, cs) = angle.sin_cos();
-        Vec2::new(cs * s_true.x - sn * s_true.y, sn * s_true.x + cs * s_true.y)
+        Turn::by(angle).apply(&s_true)
     } else {
         s_true
     };

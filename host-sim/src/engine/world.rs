@@ -22,7 +22,8 @@ pub fn stream_key(seed: u64, tag: u64) -> u64 {
 
 /// Agent `agent`'s stream number `index` (a tick, or a per-agent constant) under `key`:
 /// a different xoshiro256++ generator for every agent below 2³² and index below 2³²
-/// (the scheme of `Sensors::stream`).
+/// (every per-agent stream of the engine: the sensors', the world's).
+#[inline]
 pub fn stream(key: u64, agent: usize, index: u64) -> Xoshiro256PlusPlus {
     let word = ((agent as u64) << 32) | (index & 0xFFFF_FFFF);
     Xoshiro256PlusPlus::seed_from_u64(key ^ word)
@@ -41,6 +42,8 @@ const CONSTANTS: u64 = 0xFFFF_FFFF;
 pub struct Headings {
     /// True headings `ψ_i` (rad).
     pub truth: Vec<f64>,
+    /// `R(ψ_i)`, turned once.
+    truth_turn: Vec<Turn>,
     /// Initial estimate errors `e_i(0)` (rad).
     start: Vec<f64>,
     /// Drift rates `ω_i` (rad/s).
@@ -63,6 +66,7 @@ impl Headings {
             drift.push(h.drift * normal(&mut r));
         }
         Self {
+            truth_turn: truth.iter().map(|&x| Turn::by(x)).collect(),
             truth,
             start,
             drift,
@@ -75,7 +79,7 @@ impl Headings {
     pub fn frames(&self, i: usize, t: f64, tick: u64) -> BodyFrame {
         let truth = self.truth.get(i).copied().unwrap_or(0.0);
         BodyFrame {
-            truth: Turn::by(truth),
+            truth: self.truth_turn.get(i).copied().unwrap_or(Turn::by(truth)),
             estimate: Turn::by(truth + self.error(i, t, tick)),
         }
     }
