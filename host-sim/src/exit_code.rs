@@ -22,6 +22,9 @@ pub const DIVERGED: u8 = 13;
 /// Every angle is within tolerance but the formation is not the target shape (a
 /// triangle folded across an edge, or the fitted shape off by more than the tolerance).
 pub const WRONG_SHAPE: u8 = 14;
+/// More than `criteria.safe_share` of the outputs in the steady window were the safe
+/// output: the agents were not in control.
+pub const NOT_IN_CONTROL: u8 = 15;
 /// `host-sim design` refused its input (points, options or template), naming why.
 pub const DESIGN_REFUSED: u8 = 29;
 /// Host-in-the-loop: `qemu-system-arm` not found.

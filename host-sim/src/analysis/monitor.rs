@@ -2,10 +2,9 @@
 //! and divergence (the run stops at a terminal failure), keeps the run's extremes, and
 //! gives the verdict at the end (`docs/outputs.md`, "Outcome").
 
-use super::noise::{MeanSquare, NoiseBands, NoiseReport};
 use super::outcome::{Event, Outcome};
-use super::shape_check::{folded_names, shape_check};
 use super::snapshot::{Diagnostics, Snapshot};
+use super::steady::{schedule_integral, Instant, Series};
 use crate::model::Model;
 use controller_core::Vec2;
 use rayon::prelude::*;
@@ -21,13 +20,11 @@ pub struct Monitor {
     pub max_rise: f64,
     /// When the largest rise peaked.
     pub max_rise_t: f64,
-    settle_candidate: Option<f64>,
-    /// The bands of a noisy run (`None`: noise-free, or not yet observed).
-    bands: Option<NoiseBands>,
-    /// Noisy runs: the angle errors since the settle candidate.
-    settled_ms: MeanSquare,
-    /// Noisy runs: the angle errors over the last quarter of the run.
-    tail_ms: MeanSquare,
+    pub(super) settle_candidate: Option<f64>,
+    /// Every observed instant's errors and pose (the steady window's verdict).
+    pub(super) series: Series,
+    /// The centroid at the first instant.
+    c0: Option<[f64; 2]>,
     /// Smallest estimate seen (`None` without estimates).
     pub min_estimate: Option<f64>,
     /// Smallest inter-agent distance seen, with time and pair.
@@ -57,9 +54,8 @@ impl Monitor {
             max_rise: 0.0,
             max_rise_t: 0.0,
             settle_candidate: None,
-            bands: None,
-            settled_ms: MeanSquare::default(),
-            tail_ms: MeanSquare::default(),
+            series: Series::default(),
+            c0: None,
             min_estimate: None,
             min_distance: (f64::INFINITY, 0.0, 0, 0),
             n_estimates,
@@ -71,30 +67,54 @@ impl Monitor {
         }
     }
 
-    /// The settle time: the first observed instant after which every angle error stayed
-    /// below the tolerance (`None` if the last one was above).
+    /// The noise-free settle time: the first observed instant after which every angle
+    /// error stayed below the tolerance (`None` if the last one was above).
     pub fn settle_time(&self) -> Option<f64> {
         self.settle_candidate
     }
 
-    /// The noise bands and the steady-state RMS angle error of a noisy run (`None` for
-    /// noise-free sensors).
-    pub fn noise_report(&self) -> Option<NoiseReport> {
-        let bands = self.bands?;
-        let window = if self.settle_candidate.is_some() {
-            &self.settled_ms
-        } else {
-            &self.tail_ms
-        };
-        Some(NoiseReport {
-            bands,
-            steady_rms_angle_error: window.rms(),
-            window_start: window.from,
-        })
+    /// The observed instants.
+    pub fn series(&self) -> &Series {
+        &self.series
     }
 
-    /// Observes one snapshot and the estimates; returns `true` when the run must stop.
-    pub fn observe(&mut self, model: &Model, d: &Diagnostics, est: &[f64]) -> bool {
+    /// Records the instant's errors and pose (`analysis::steady`).
+    fn record_instant(&mut self, model: &Model, s: &Snapshot, q: &[Vec2<f64>]) {
+        let n = q.len().max(1) as f64;
+        let sum = q.iter().fold([0.0, 0.0], |a, p| [a[0] + p.x, a[1] + p.y]);
+        let c = [sum[0] / n, sum[1] / n];
+        let c0 = *self.c0.get_or_insert(c);
+        let moved = schedule_integral(&model.velocity_reference, s.t);
+        let translation = (c[0] - c0[0] - moved[0]).hypot(c[1] - c0[1] - moved[1]);
+        let (mut scale, mut orientation) = (0.0, 0.0);
+        if let (Some(l), Some(zs)) = (model.leader.as_ref(), model.z_star(s.t)) {
+            if let (Some(a), Some(b)) = (q.get(l.a), q.get(l.b)) {
+                let z = [a.x - b.x, a.y - b.y];
+                scale = (z[0].hypot(z[1]) - zs[0].hypot(zs[1])).abs();
+                // The signed angle from z* to z.
+                orientation = (zs[0] * z[1] - zs[1] * z[0]).atan2(zs[0] * z[0] + zs[1] * z[1]);
+            }
+        }
+        self.series.push(Instant {
+            t: s.t,
+            angle: s.max_angle_err,
+            scale,
+            velocity: s.vel_err,
+            displacement: s.disp_err,
+            orientation,
+            translation,
+        });
+    }
+
+    /// Observes one snapshot of positions `q` and the estimates; returns `true` when the
+    /// run must stop.
+    pub fn observe(
+        &mut self,
+        model: &Model,
+        d: &Diagnostics,
+        q: &[Vec2<f64>],
+        est: &[f64],
+    ) -> bool {
         let s = &d.snap;
         let cr = &model.criteria;
         let name = |i: usize| model.agents.get(i).map_or("?", |a| a.name.as_str());
@@ -102,8 +122,8 @@ impl Monitor {
         let epoch = model.schedule_epoch(s.t);
         if self.v0.is_none() {
             self.v0 = Some(s.v);
-            self.bands = NoiseBands::of(model);
         }
+        self.record_instant(model, s, q);
         if epoch != self.epoch {
             self.epoch = epoch;
             self.run_min = f64::INFINITY;
@@ -116,23 +136,14 @@ impl Monitor {
                 self.max_rise_t = s.t;
             }
         }
-        // Settling (inside the noise band when the sensors are noisy).
-        let tolerance = self.bands.map_or(cr.angle_tolerance, |b| b.angle);
-        if s.max_angle_err < tolerance {
+        // Settling against the noise-free tolerance (a noisy run's settle time is the
+        // steady window's, `analysis::steady`).
+        if s.max_angle_err < cr.angle_tolerance {
             if self.settle_candidate.is_none() {
                 self.settle_candidate = Some(s.t);
-                self.settled_ms = MeanSquare::default();
             }
         } else {
             self.settle_candidate = None;
-        }
-        if self.bands.is_some() {
-            if self.settle_candidate.is_some() {
-                self.settled_ms.add(s.t, &s.angle_err);
-            }
-            if s.t >= 0.75 * model.duration {
-                self.tail_ms.add(s.t, &s.angle_err);
-            }
         }
         // Extremes.
         if s.min_dist < self.min_distance.0 {
@@ -285,120 +296,6 @@ impl Monitor {
         match self.v0 {
             Some(v0) if v0 > 0.0 => self.max_rise / v0,
             _ => 0.0,
-        }
-    }
-
-    /// The outcome and its reason, given the last snapshot.
-    ///
-    /// A terminal failure preceded by an estimate collapse is reported as the collapse (the
-    /// cause); a collapse in a run that still converged is only an event.
-    ///
-    /// A run whose angles, leader edge and velocity are within tolerance is `converged`
-    /// only if its final positions `q` also match the target shape within
-    /// `criteria.shape_tolerance` with no folded triangle, else `wrong_shape`.
-    pub fn verdict(&self, model: &Model, last: &Snapshot, q: &[Vec2<f64>]) -> (Outcome, String) {
-        let cr = &model.criteria;
-        let chain = || {
-            self.events
-                .iter()
-                .map(|e| format!("t = {:.3} s: {}", e.t, e.message))
-                .collect::<Vec<_>>()
-                .join("; then ")
-        };
-        let collapse = self
-            .events
-            .iter()
-            .find(|e| e.kind == Outcome::EstimateCollapse);
-        if self.terminal {
-            let kind = match (collapse, self.events.last()) {
-                (Some(c), Some(last)) if c.t <= last.t => Outcome::EstimateCollapse,
-                (_, Some(last)) => last.kind,
-                _ => Outcome::Diverged,
-            };
-            return (kind, chain());
-        }
-        let settled = self.settle_candidate.is_some();
-        let (angle_tol, disp_tol, vel_tol) = match self.bands {
-            Some(b) => (b.angle, b.displacement, b.velocity),
-            None => (
-                cr.angle_tolerance,
-                cr.displacement_tolerance,
-                cr.velocity_tolerance,
-            ),
-        };
-        let band = if self.bands.is_some() {
-            " (noise band)"
-        } else {
-            ""
-        };
-        let disp_ok = last.disp_err <= disp_tol;
-        let vel_ok = last.vel_err <= vel_tol;
-        if settled && disp_ok && vel_ok {
-            let mut why = format!(
-                "every angle error below {}{band} rad from t = {:.3} s; final |z − z*| = {:.2e} m, max |v − v*| = {:.2e} m/s",
-                angle_tol,
-                self.settle_candidate.unwrap_or(0.0),
-                last.disp_err,
-                last.vel_err
-            );
-            let pos: Vec<[f64; 2]> = q.iter().map(|p| [p.x, p.y]).collect();
-            if let Some(c) = shape_check(model, &pos) {
-                if !c.folded.is_empty() || c.fit.max_rel > cr.shape_tolerance {
-                    let folded = if c.folded.is_empty() {
-                        String::new()
-                    } else {
-                        format!(
-                            "{} folded across an edge ({}); ",
-                            if c.folded.len() == 1 {
-                                "triangle"
-                            } else {
-                                "triangles"
-                            },
-                            folded_names(model, &c.folded).join(", ")
-                        )
-                    };
-                    let why = format!(
-                        "every angle error below {}{band} rad from t = {:.3} s, but the formation is not the target shape: {folded}an agent is {:.3e} of the target's size from its target point (tolerance {})",
-                        angle_tol,
-                        self.settle_candidate.unwrap_or(0.0),
-                        c.fit.max_rel,
-                        cr.shape_tolerance
-                    );
-                    return (Outcome::WrongShape, why);
-                }
-            }
-            if !self.events.is_empty() {
-                why.push_str(&format!(" (despite: {})", chain()));
-            }
-            return (Outcome::Converged, why);
-        }
-        let mut missing = Vec::new();
-        if !settled {
-            missing.push(format!(
-                "max angle error {:.3e} rad ≥ {}{band} rad",
-                last.max_angle_err, angle_tol
-            ));
-        }
-        if !disp_ok {
-            missing.push(format!(
-                "|z − z*| = {:.3e} m > {}{band} m",
-                last.disp_err, disp_tol
-            ));
-        }
-        if !vel_ok {
-            missing.push(format!(
-                "max |v − v*| = {:.3e} m/s > {}{band} m/s",
-                last.vel_err, vel_tol
-            ));
-        }
-        let end = format!(
-            "not converged at t = {:.3} s: {}",
-            last.t,
-            missing.join(", ")
-        );
-        match collapse {
-            Some(_) => (Outcome::EstimateCollapse, format!("{}; {end}", chain())),
-            None => (Outcome::NotConverged, end),
         }
     }
 }

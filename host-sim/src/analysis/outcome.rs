@@ -19,6 +19,10 @@ pub enum Outcome {
     /// the formation is not the target shape (a triangle folded across an edge: the angles
     /// cannot tell a triangle from its mirror image).
     WrongShape,
+    /// More than `criteria.safe_share` of the controllers' outputs in the steady window
+    /// were the safe output: the agents were not in control (neighbours never seen,
+    /// bearings missing, positions stale, a neighbour silent), whatever the errors.
+    NotInControl,
 }
 
 impl Outcome {
@@ -31,6 +35,7 @@ impl Outcome {
         Outcome::Diverged,
         Outcome::NotConverged,
         Outcome::WrongShape,
+        Outcome::NotInControl,
     ];
 
     /// The name in `summary.json`.
@@ -42,6 +47,7 @@ impl Outcome {
             Outcome::Diverged => "diverged",
             Outcome::NotConverged => "not_converged",
             Outcome::WrongShape => "wrong_shape",
+            Outcome::NotInControl => "not_in_control",
         }
     }
 
@@ -55,6 +61,7 @@ impl Outcome {
             Outcome::Diverged => x::DIVERGED,
             Outcome::NotConverged => x::NOT_CONVERGED,
             Outcome::WrongShape => x::WRONG_SHAPE,
+            Outcome::NotInControl => x::NOT_IN_CONTROL,
         }
     }
 }
@@ -92,9 +99,10 @@ mod tests {
                 Outcome::Diverged => 3,
                 Outcome::NotConverged => 4,
                 Outcome::WrongShape => 5,
+                Outcome::NotInControl => 6,
             }
         }
-        const VARIANTS: usize = 6;
+        const VARIANTS: usize = 7;
         assert_eq!(Outcome::ALL.len(), VARIANTS);
         let mut seen = [false; VARIANTS];
         for &o in Outcome::ALL {

@@ -208,7 +208,7 @@ impl<'m> ContinuousSim<'m> {
                 est_start,
                 info,
                 sense_fault: vec![None; n],
-                stats: ControlStats::default(),
+                stats: ControlStats::with_window(crate::analysis::steady::Window::of(model).from),
             },
             k: [
                 vec![0.0; dim],

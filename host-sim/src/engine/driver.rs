@@ -11,6 +11,7 @@ use super::record::{Recorder, Row};
 use super::result::RunResult;
 use super::sampled::SampledSim;
 use super::stats::{ControlStats, FrameCounts};
+
 use crate::analysis::{Diagnostics, Monitor};
 use crate::model::{geometry, EstimateInfo, Mode, Model};
 use controller_core::Vec2;
@@ -134,9 +135,23 @@ pub fn run(
     }
 }
 
+/// A simulated run before its verdict: the monitor that watched it and the last state.
+pub(super) struct Simulated {
+    /// The failure monitor, with every observed instant.
+    pub(super) monitor: Monitor,
+    /// The diagnostics of the last instant.
+    pub(super) diag: Diagnostics,
+    /// RK4 steps taken.
+    pub(super) steps: usize,
+    /// Each triangle's signed area at the start.
+    area0: Vec<f64>,
+}
+
 /// The time loop: control ticks, RK4 steps, diagnostics at every control instant and
-/// every log instant, logging, failure detection. A controller failure
-/// ([`Engine::take_error`]) ends it with [`RunError::Hil`].
+/// every log instant, logging, failure detection; then the verdict, with the bands of a
+/// calibration run when the scenario's sensing or world is random
+/// ([`super::calibrate`]). A controller failure ([`Engine::take_error`]) ends it with
+/// [`RunError::Hil`].
 pub fn drive(
     model: &Model,
     engine: &mut dyn Engine,
@@ -145,16 +160,87 @@ pub fn drive(
     warnings: Vec<String>,
 ) -> Result<RunResult, RunError> {
     let started = Instant::now();
+    let sim = simulate(model, engine, recorder, progress)?;
+    let (q, _, est) = engine.view();
+    let bands = if model.sensing_noise().needs_calibration() && !sim.monitor.terminal {
+        Some(super::calibrate::bands(model, q, est))
+    } else {
+        None
+    };
+    let steady_control = engine.control_stats().window;
+    let (q, v, est) = engine.view();
+    let verdict = sim
+        .monitor
+        .verdict(model, &sim.diag.snap, q, &steady_control, bands.as_ref());
+    let mut reason = verdict.reason;
+    if verdict.outcome != crate::analysis::Outcome::Converged {
+        if let Some(note) = speed_limit_note(model) {
+            reason = format!("{reason}; {note}");
+        }
+    }
+    let tri = model.triangles.iter().map(|t| t.vertices);
+    let s = &sim.diag.snap;
+    let monitor = &sim.monitor;
+    Ok(RunResult {
+        outcome: verdict.outcome,
+        reason,
+        events: monitor.events.clone(),
+        final_time: s.t,
+        settle_time: verdict.settle_time,
+        steady: verdict.steady,
+        pose: verdict.pose,
+        safe_share: verdict.safe_share,
+        final_max_angle_error: s.max_angle_err,
+        final_displacement_error: s.disp_err,
+        final_velocity_error: s.vel_err,
+        min_estimate: monitor.min_estimate,
+        min_distance: monitor.min_distance,
+        v0: monitor.v0.unwrap_or(0.0),
+        v_final: s.v,
+        v_max_increase_rel: monitor.v_max_increase_rel(),
+        v_max_increase_t: monitor.max_rise_t,
+        final_positions: q.iter().map(|p| [p.x, p.y]).collect(),
+        final_velocities: v.iter().map(|p| [p.x, p.y]).collect(),
+        final_estimates: est
+            .iter()
+            .copied()
+            .zip(s.est_true.iter().copied())
+            .collect(),
+        orientation_kept: tri
+            .zip(&sim.area0)
+            .map(|(t, &a0)| signed_area(q, t).signum() == a0.signum())
+            .collect(),
+        frames: engine.frame_counts(),
+        control: engine.control_stats(),
+        channel: engine.channel_stats(),
+        attacks: engine.attack_counts(),
+        warnings,
+        steps: sim.steps,
+        wall_seconds: started.elapsed().as_secs_f64(),
+        hil: Vec::new(),
+    })
+}
+
+/// The time loop alone: the run up to its end or its terminal failure.
+pub(super) fn simulate(
+    model: &Model,
+    engine: &mut dyn Engine,
+    recorder: &mut dyn Recorder,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Simulated, RunError> {
     let total = model.total_steps();
     let spt = model.steps_per_tick.max(1);
     let log_every = model.log_every.max(1);
     let progress_every = (total / 200).max(1);
     let mut diag = Diagnostics::new(model, engine.estimate_info().to_vec());
     let mut monitor = Monitor::new(diag.estimates.len());
-    let tri: Vec<[usize; 3]> = model.triangles.iter().map(|t| t.vertices).collect();
     let area0: Vec<f64> = {
         let (q, _, _) = engine.view();
-        tri.iter().map(|&t| signed_area(q, t)).collect()
+        model
+            .triangles
+            .iter()
+            .map(|t| signed_area(q, t.vertices))
+            .collect()
     };
     let rows = recorder.wants_rows();
     let mut steps = 0;
@@ -180,7 +266,7 @@ pub fn drive(
             };
             let (q, v, est) = engine.view();
             diag.evaluate(model, t, q, v, est);
-            let stop = monitor.observe(model, &diag, est);
+            let stop = monitor.observe(model, &diag, q, est);
             if (log || stop) && rows {
                 recorder.record(&Row {
                     snap: &diag.snap,
@@ -210,50 +296,11 @@ pub fn drive(
     }
     recorder.finish()?;
     progress(diag.snap.t);
-    let (q, v, est) = engine.view();
-    let (outcome, mut reason) = monitor.verdict(model, &diag.snap, q);
-    if outcome != crate::analysis::Outcome::Converged {
-        if let Some(note) = speed_limit_note(model) {
-            reason = format!("{reason}; {note}");
-        }
-    }
-    let s = &diag.snap;
-    Ok(RunResult {
-        outcome,
-        reason,
-        events: monitor.events.clone(),
-        final_time: s.t,
-        settle_time: monitor.settle_time(),
-        noise: monitor.noise_report(),
-        final_max_angle_error: s.max_angle_err,
-        final_displacement_error: s.disp_err,
-        final_velocity_error: s.vel_err,
-        min_estimate: monitor.min_estimate,
-        min_distance: monitor.min_distance,
-        v0: monitor.v0.unwrap_or(0.0),
-        v_final: s.v,
-        v_max_increase_rel: monitor.v_max_increase_rel(),
-        v_max_increase_t: monitor.max_rise_t,
-        final_positions: q.iter().map(|p| [p.x, p.y]).collect(),
-        final_velocities: v.iter().map(|p| [p.x, p.y]).collect(),
-        final_estimates: est
-            .iter()
-            .copied()
-            .zip(s.est_true.iter().copied())
-            .collect(),
-        orientation_kept: tri
-            .iter()
-            .zip(&area0)
-            .map(|(&t, &a0)| signed_area(q, t).signum() == a0.signum())
-            .collect(),
-        frames: engine.frame_counts(),
-        control: engine.control_stats(),
-        channel: engine.channel_stats(),
-        attacks: engine.attack_counts(),
-        warnings,
+    Ok(Simulated {
+        monitor,
+        diag,
         steps,
-        wall_seconds: started.elapsed().as_secs_f64(),
-        hil: Vec::new(),
+        area0,
     })
 }
 

@@ -9,6 +9,7 @@
 //! reports or the command line (`docs/architecture.md`).
 
 pub mod attack;
+pub mod calibrate;
 pub mod channel;
 pub mod continuous;
 pub mod controller;

@@ -17,11 +17,15 @@ pub struct RunResult {
     pub events: Vec<Event>,
     /// Time of the last evaluated instant (s).
     pub final_time: f64,
-    /// See [`crate::analysis::Monitor::settle_time`].
+    /// When the formation settled ([`crate::analysis::Verdict::settle_time`]).
     pub settle_time: Option<f64>,
-    /// The noise bands and steady-state RMS angle error of a noisy run (`None` for
-    /// noise-free sensors).
-    pub noise: Option<crate::analysis::noise::NoiseReport>,
+    /// The steady window's bands and figures of a run judged with bands (`None` for a
+    /// noise-free run).
+    pub steady: Option<crate::analysis::SteadyReport>,
+    /// The pose over the steady window, reported apart from the shape.
+    pub pose: crate::analysis::PoseReport,
+    /// Share of the controllers' outputs in the steady window that were the safe output.
+    pub safe_share: Option<f64>,
     /// Final `max |α − α*|` (rad).
     pub final_max_angle_error: f64,
     /// Final `|z − z*|` (m).

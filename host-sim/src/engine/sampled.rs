@@ -196,7 +196,7 @@ impl<'m> SampledSim<'m> {
             info,
             last_tick: None,
             ticks: 0,
-            stats: ControlStats::default(),
+            stats: ControlStats::with_window(crate::analysis::steady::Window::of(model).from),
             direct,
             local: false,
         })

@@ -2,6 +2,7 @@
 
 use controller_core::FrameStats;
 
+use crate::analysis::control::WindowCounts;
 use controller_core::{Fault, Status};
 
 /// Cumulative frame counters of a run (link copies; see `docs/outputs.md`).
@@ -112,9 +113,23 @@ pub struct ControlStats {
     pub max_force: f64,
     /// The last fault after `t = 0`: time, agent index, fault.
     pub last_fault: Option<(f64, usize, Fault)>,
+    /// Where the steady window starts (s; [`Self::with_window`]); 0 by default.
+    pub window_from: f64,
+    /// The outputs at or after `window_from`.
+    pub window: WindowCounts,
+    /// Time of the last output recorded (s).
+    last_t: f64,
 }
 
 impl ControlStats {
+    /// Counters whose window starts at `from` (s).
+    pub fn with_window(from: f64) -> Self {
+        Self {
+            window_from: from,
+            ..Self::default()
+        }
+    }
+
     /// Counts one controller output at time `t` of agent `i`.
     pub fn record(
         &mut self,
@@ -126,11 +141,17 @@ impl ControlStats {
         force: f64,
     ) {
         self.ticks += 1;
+        self.last_t = t;
+        let in_window = t >= self.window_from;
+        self.window.ticks += u64::from(in_window);
         if let Status::Safe(f) = status {
             self.safe += 1;
             if t > 0.0 {
                 self.safe_after_start += 1;
                 self.last_fault = Some((t, i, f));
+                if in_window {
+                    self.window.safe.add(i, f);
+                }
             }
         }
         self.saturated += u64::from(saturated);
@@ -141,7 +162,8 @@ impl ControlStats {
     }
 
     /// Adds what was recorded in `later` (of outputs after these, as a parallel walk's
-    /// part): the same as recording them here, in order.
+    /// part, all at one instant or recorded with this window): the same as recording them
+    /// here, in order.
     pub fn merge(&mut self, later: &ControlStats) {
         self.ticks += later.ticks;
         self.safe += later.safe;
@@ -155,5 +177,51 @@ impl ControlStats {
         if later.last_fault.is_some() {
             self.last_fault = later.last_fault;
         }
+        if later.ticks > 0 {
+            // A part recorded with another window (a tick's per-agent sums, window 0)
+            // belongs to this one when its instant does.
+            if later.window_from == self.window_from || later.last_t >= self.window_from {
+                self.window.ticks += later.window.ticks;
+                self.window.safe.merge(&later.window.safe);
+            }
+            self.last_t = later.last_t;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use controller_core::Fault;
+
+    /// The window counts only outputs at or after its start, directly or through a
+    /// tick's merged per-agent sums; the examples name each agent once, in order.
+    #[test]
+    fn window_counts_follow_the_instant() {
+        let safe = |id| Status::Safe(Fault::MissingBearing(id));
+        let mut direct = ControlStats::with_window(1.0);
+        let mut merged = ControlStats::with_window(1.0);
+        for (t, i) in [(0.5, 0), (1.0, 1), (1.0, 2), (1.5, 1)] {
+            direct.record(t, i, safe(7), false, false, 0.0);
+            let mut part = ControlStats::default();
+            part.record(t, i, safe(7), false, false, 0.0);
+            merged.merge(&part);
+        }
+        for s in [&direct, &merged] {
+            assert_eq!(s.ticks, 4);
+            assert_eq!(s.window.ticks, 3);
+            assert_eq!(s.window.safe.total(), 3);
+            assert_eq!(s.window.safe.counts[1], 3);
+            let named: Vec<usize> = s
+                .window
+                .safe
+                .examples
+                .iter()
+                .flatten()
+                .map(|e| e.0)
+                .collect();
+            assert_eq!(named, [1, 2]);
+        }
+        assert_eq!(direct, merged);
     }
 }

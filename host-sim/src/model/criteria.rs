@@ -26,6 +26,20 @@ pub struct Criteria {
     /// (its RMS distance from the centroid) of its target point, and no triangle folded,
     /// to count as converged (`wrong_shape` otherwise).
     pub shape_tolerance: f64,
+    /// The steady window `W` (s) that a run with random sensing or a random world is
+    /// judged on: its last `W` seconds; 0 (the default) means a quarter of the run
+    /// (`analysis::steady`, docs/outputs.md "Outcome").
+    pub steady_window: f64,
+    /// Largest share of the controllers' outputs in the steady window that may be the
+    /// safe output; above it the run is `not_in_control` (every run, noisy or not).
+    pub safe_share: f64,
+    /// The largest angle band (rad) a calibration may set (default 1°): a scenario widens
+    /// it only by saying so here.
+    pub angle_band_cap: f64,
+    /// The largest scale band of the leader edge (m) a calibration may set.
+    pub scale_band_cap: f64,
+    /// The largest velocity band (m/s) a calibration may set.
+    pub velocity_band_cap: f64,
 }
 
 impl Default for Criteria {
@@ -39,6 +53,11 @@ impl Default for Criteria {
             displacement_tolerance: 1e-2,
             velocity_tolerance: 1e-2,
             shape_tolerance: 5e-2,
+            steady_window: 0.0,
+            safe_share: 0.05,
+            angle_band_cap: 1f64.to_radians(),
+            scale_band_cap: 5e-2,
+            velocity_band_cap: 5e-2,
         }
     }
 }

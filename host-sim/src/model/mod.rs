@@ -16,6 +16,7 @@ mod formation;
 pub mod geometry;
 pub mod graph;
 mod options;
+mod sensing;
 pub mod shape;
 pub mod target;
 pub mod wire_ids;
@@ -32,6 +33,7 @@ pub use estimates::{estimate_layout, resolve_estimates, EstimateInfo};
 pub use formation::{AgentModel, AngleModel, LeaderModel, TriangleModel};
 pub use graph::Graph;
 pub use options::{BearingRate, Estimator, Mode};
+pub use sensing::SensingNoise;
 pub use target::Target;
 pub use world::{ClockModel, HeadingModel, VehicleModel, VelocityTracking, WindModel, WorldModel};
 

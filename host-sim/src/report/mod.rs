@@ -12,6 +12,7 @@ pub mod replay;
 mod series;
 mod summary;
 mod table;
+mod verdict;
 mod world;
 
 pub use columns::{for_each_cell, header, Cell, BASE_COLUMNS};

@@ -56,15 +56,6 @@ pub fn summary_json(model: &Model, r: &RunResult, estimates: &[EstimateInfo]) ->
         .control
         .last_fault
         .map(|(t, i, f)| json!({ "t": t, "agent": id(i), "fault": format!("{f:?}") }));
-    let noise = r.noise.map(|n| {
-        json!({
-            "angle_band_rad": fin(n.bands.angle),
-            "displacement_band_m": fin(n.bands.displacement),
-            "velocity_band_m_s": fin(n.bands.velocity),
-            "steady_rms_angle_error_rad": opt(n.steady_rms_angle_error),
-            "steady_window_start_s": opt(n.window_start),
-        })
-    });
     let mut v = json!({
         "scenario": model.name,
         "source": model.source,
@@ -142,10 +133,9 @@ pub fn summary_json(model: &Model, r: &RunResult, estimates: &[EstimateInfo]) ->
         "steps": r.steps,
     });
     if let Some(obj) = v.as_object_mut() {
-        // Only when they apply, so that a noise-free run's summary is what it always was.
-        if let Some(n) = noise {
-            obj.insert("noise".to_owned(), n);
-        }
+        // Only when they apply, so that a noise-free run's summary is what it always was
+        // (but for `verdict` and `pose`).
+        super::verdict::add_json(obj, model, r);
         if let controller_core::BearingFilter::Tracker(t) = &model.sensors.bearing_filter {
             obj.insert(
                 "bearing_filter".to_owned(),

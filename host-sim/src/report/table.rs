@@ -40,10 +40,18 @@ pub fn summary_table(m: &Model, r: &RunResult, out: &Path, n_files: usize) -> St
         ),
         (
             "settle time",
-            r.settle_time.map_or(
-                "never (angle errors ≥ tolerance at the end)".to_owned(),
-                |t| format!("{} s", g(t)),
-            ),
+            match (r.settle_time, &r.steady) {
+                (None, None) => "never (angle errors ≥ tolerance at the end)".to_owned(),
+                (None, Some(_)) => {
+                    "never (outside a band at the end of the steady window)".to_owned()
+                }
+                (Some(t), None) => format!("{} s", g(t)),
+                (Some(t), Some(s)) => format!(
+                    "{} s (windowed errors in their bands for good; steady window from {} s)",
+                    g(t),
+                    g(s.window.from)
+                ),
+            },
         ),
         (
             "final max angle error",

@@ -7,7 +7,7 @@ use super::legend::{entry, with_legend, Key};
 use super::ranges::*;
 use super::style::*;
 use super::text::frame;
-use super::{DrawResult, ANGLE_FLOOR, ANGLE_THRESHOLD};
+use super::{DrawResult, ANGLE_FLOOR};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -68,8 +68,12 @@ where
     if run.n_angles == 0 {
         entries.push(entry("(no angle columns)", Key::None));
     }
+    let (line, window) = run.summary.angle_line();
     entries.push(entry(
-        format!("threshold {ANGLE_THRESHOLD:.0e} rad"),
+        match window {
+            None => format!("threshold {line:.0e} rad"),
+            Some(w) => format!("band {line:.2e} rad (steady window from {w:.1} s)"),
+        },
         Key::Dashed(LEADER, 2),
     ));
     entries.push(entry(
@@ -85,7 +89,7 @@ where
             .flatten()
             .chain(&max_series)
             .map(|p| p.1)
-            .chain([ANGLE_THRESHOLD, ANGLE_THRESHOLD * 10.0]),
+            .chain([line, line * 10.0]),
     );
     let mut chart = chart_on(&plot).build_cartesian_2d(t0..t1, (y0..y1).log_scale())?;
     styled_mesh(&mut chart.configure_mesh(), "|angle error| (rad)")
@@ -116,7 +120,8 @@ where
     }
     let area = chart.plotting_area();
     stroke(area, &max_series, DARK, 3, false, bitmap)?;
-    let threshold = [(t0, ANGLE_THRESHOLD), (t1, ANGLE_THRESHOLD)];
+    let from = window.map_or(t0, |w| w.clamp(t0, t1));
+    let threshold = [(from, line), (t1, line)];
     stroke(area, &threshold, LEADER, 2, true, bitmap)?;
     Ok(())
 }

@@ -60,6 +60,49 @@ pub(super) struct Summary {
     pub(super) mode: Option<serde_json::Value>,
     #[serde(default)]
     pub(super) estimator: Option<serde_json::Value>,
+    /// How the run was judged (absent in runs made before it existed).
+    #[serde(default)]
+    pub(super) verdict: Option<VerdictSummary>,
+    #[serde(default)]
+    pub(super) criteria: Option<CriteriaSummary>,
+}
+
+/// `summary.json`'s `verdict`: the bands and window a noisy run was judged on.
+#[derive(Debug, Deserialize)]
+pub(super) struct VerdictSummary {
+    #[serde(default)]
+    pub(super) bands: Option<BandsSummary>,
+    #[serde(default)]
+    pub(super) steady_window_s: Option<[f64; 2]>,
+}
+
+/// `summary.json`'s `verdict.bands`.
+#[derive(Debug, Deserialize)]
+pub(super) struct BandsSummary {
+    pub(super) angle_rad: f64,
+}
+
+/// `summary.json`'s `criteria`.
+#[derive(Debug, Deserialize)]
+pub(super) struct CriteriaSummary {
+    pub(super) angle_tolerance_rad: f64,
+}
+
+impl Summary {
+    /// The angle line the verdict used: the calibrated band with the steady window's
+    /// start, else the noise-free tolerance (else 1e-3 rad).
+    pub(super) fn angle_line(&self) -> (f64, Option<f64>) {
+        if let Some(v) = &self.verdict {
+            if let Some(b) = &v.bands {
+                return (b.angle_rad, v.steady_window_s.map(|w| w[0]));
+            }
+        }
+        let tol = self
+            .criteria
+            .as_ref()
+            .map_or(super::ANGLE_THRESHOLD, |c| c.angle_tolerance_rad);
+        (tol, None)
+    }
 }
 
 /// A labelled series aligned with [`Run::t`].

@@ -298,6 +298,23 @@ impl ReplayData {
         &self.ids
     }
 
+    /// The drawn agents (indices into [`Self::ids`]) that `summary.json`'s verdict names
+    /// as giving the safe output in the steady window.
+    fn safe_agents(&self) -> Vec<usize> {
+        let named = self.summary["verdict"]["safe_agents"].as_array();
+        let ids: Vec<String> = named
+            .into_iter()
+            .flatten()
+            .map(|a| match &a["agent"] {
+                serde_json::Value::String(s) => s.clone(),
+                other => other.to_string(),
+            })
+            .collect();
+        (0..self.ids.len())
+            .filter(|&k| ids.contains(&self.ids[k]))
+            .collect()
+    }
+
     /// The page's data as JSON text.
     pub fn to_json(&self) -> String {
         let s = &self.summary;
@@ -310,6 +327,9 @@ impl ReplayData {
             "estimator": s["estimator"],
             "settle_time_s": s["settle_time_s"],
             "angle_tolerance": s["criteria"]["angle_tolerance_rad"],
+            "angle_band": s["verdict"]["bands"]["angle_rad"],
+            "steady_from": s["verdict"]["steady_window_s"][0],
+            "safe_agents": self.safe_agents(),
             "ids": self.ids,
             "agent_index": self.agent_index,
             "n_agents": self.n_agents,

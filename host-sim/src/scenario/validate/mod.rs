@@ -96,7 +96,7 @@ fn check(
         margin_cos: margin.cos(),
         ..Limits::default()
     };
-    let model = Model {
+    let mut model = Model {
         name: s.name.clone().unwrap_or_else(|| default_name.to_owned()),
         source: file.to_owned(),
         description: s.description.clone().unwrap_or_default(),
@@ -121,7 +121,8 @@ fn check(
             bearing_noise: se.bearing_noise_deg.to_radians(),
             bearing_bias: se.bearing_bias_deg.to_radians(),
             bearing_rate: se.bearing_rate,
-            bearing_filter: bearing_filter(se),
+            // Resolved below from the whole model's effective sensing noise.
+            bearing_filter: BearingFilter::FiniteDifference,
             velocity_noise: se.velocity_noise,
             velocity_bias: se.velocity_bias,
             offset_noise: se.offset_noise,
@@ -147,6 +148,7 @@ fn check(
         target,
         world,
     };
+    model.sensors.bearing_filter = bearing_filter(se, &model.sensing_noise());
     // Last line of defence, shared with generated models (`model::check_model`): wire
     // ids a receiver can tell apart, and the core's own checks (should agree with the
     // above).
@@ -164,18 +166,24 @@ fn check(
 }
 
 /// The filter each controller runs, from `sensors.bearing_filter` (SPEC §11): `auto` is
-/// the tracker for noisy bearings and the finite difference for an ideal sensor.
-fn bearing_filter(se: &crate::scenario::settings::SensorSpec) -> BearingFilter<f64> {
+/// the tracker whenever the sensing chain is noisy or lossy
+/// ([`crate::model::SensingNoise::is_noisy`]) and the finite difference for an ideal
+/// sensor; the tracker assumes the chain's effective bearing noise unless
+/// `sensors.tracker.bearing_noise_deg` says otherwise.
+fn bearing_filter(
+    se: &crate::scenario::settings::SensorSpec,
+    noise: &crate::model::SensingNoise,
+) -> BearingFilter<f64> {
     use crate::scenario::settings::FilterChoice;
     let tracker = matches!(se.bearing_filter, FilterChoice::Tracker)
-        || (se.bearing_filter == FilterChoice::Auto && se.bearing_noise_deg > 0.0);
+        || (se.bearing_filter == FilterChoice::Auto && noise.is_noisy());
     if !tracker {
         return BearingFilter::FiniteDifference;
     }
     let t = &se.tracker;
     let sigma_deg = t
         .bearing_noise_deg
-        .unwrap_or(se.bearing_noise_deg)
+        .unwrap_or(noise.bearing.to_degrees())
         .max(MIN_TRACKER_NOISE_DEG);
     BearingFilter::Tracker(TrackerConfig {
         bearing_noise: sigma_deg.to_radians(),

@@ -211,6 +211,25 @@ pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile) -> Timing {
         cr.velocity_tolerance,
     );
     c.positive(InvalidValue, "criteria.shape_tolerance", cr.shape_tolerance);
+    c.non_negative(InvalidValue, "criteria.steady_window", cr.steady_window);
+    if cr.steady_window > s.duration {
+        c.err(
+            InvalidValue,
+            "criteria.steady_window",
+            format!(
+                "{} s is longer than the run (duration = {} s)",
+                cr.steady_window, s.duration
+            ),
+        );
+    }
+    c.probability("criteria.safe_share", cr.safe_share);
+    c.positive(InvalidValue, "criteria.angle_band_cap", cr.angle_band_cap);
+    c.positive(InvalidValue, "criteria.scale_band_cap", cr.scale_band_cap);
+    c.positive(
+        InvalidValue,
+        "criteria.velocity_band_cap",
+        cr.velocity_band_cap,
+    );
     Timing {
         dt,
         steps_per_tick,

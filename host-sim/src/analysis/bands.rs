@@ -1,0 +1,118 @@
+//! The bands a run with random sensing or a random world is judged against
+//! (`docs/outputs.md`, "Outcome"): what the controller achieves under the same sensing
+//! when it starts at the target, measured by a **calibration run**, with a margin, never
+//! below the noise-free tolerances and never above the caps of `[criteria]`.
+
+use super::steady::Window;
+use crate::model::Criteria;
+
+/// The calibration's statistic times this is the band: a steady run's worst sub-window
+/// varies from seed to seed (`host-sim/tests/verdict.rs` runs several).
+pub const MARGIN: f64 = 1.5;
+
+/// What the calibration run measured: the worst sub-window's 95th percentile of each
+/// quantity over its steady window ([`super::steady::Series::worst_sub_window`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Calibration {
+    /// Its seed (the run's, mixed: another draw of the same sensing).
+    pub seed: u64,
+    /// Its duration (s).
+    pub duration: f64,
+    /// The window it was read on (its last `W` seconds, `W` the run's own).
+    pub window: Window,
+    /// `max |α − α*|` (rad).
+    pub angle: f64,
+    /// `| |z| − |z*| |` (m).
+    pub scale: f64,
+    /// `max_n |v_n − v*|` (m/s).
+    pub velocity: f64,
+}
+
+/// The bands of the steady window.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bands {
+    /// Angle band (rad).
+    pub angle: f64,
+    /// Scale band of the leader edge (m).
+    pub scale: f64,
+    /// Velocity band (m/s).
+    pub velocity: f64,
+    /// Which bands the caps of `[criteria]` cut: angle, scale, velocity.
+    pub capped: [bool; 3],
+    /// The calibration they came from (`None`: it could not run; the bands are the caps).
+    pub calibration: Option<Calibration>,
+}
+
+/// `MARGIN · x`, at least `lo`, at most `cap`; whether the cap cut it.
+fn band(x: f64, lo: f64, cap: f64) -> (f64, bool) {
+    if x.is_nan() {
+        return (cap, true);
+    }
+    let b = (MARGIN * x).max(lo);
+    if b > cap {
+        (cap, true)
+    } else {
+        (b, false)
+    }
+}
+
+impl Bands {
+    /// The bands of a calibration under `cr`.
+    pub fn calibrated(cr: &Criteria, c: Calibration) -> Self {
+        let (angle, ca) = band(c.angle, cr.angle_tolerance, cr.angle_band_cap);
+        let (scale, cs) = band(c.scale, cr.displacement_tolerance, cr.scale_band_cap);
+        let (velocity, cv) = band(c.velocity, cr.velocity_tolerance, cr.velocity_band_cap);
+        Self {
+            angle,
+            scale,
+            velocity,
+            capped: [ca, cs, cv],
+            calibration: Some(c),
+        }
+    }
+
+    /// The caps themselves (a calibration that could not run).
+    pub fn caps(cr: &Criteria) -> Self {
+        Self {
+            angle: cr.angle_band_cap,
+            scale: cr.scale_band_cap,
+            velocity: cr.velocity_band_cap,
+            capped: [true; 3],
+            calibration: None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bands_are_the_margin_between_tolerance_and_cap() {
+        let cr = Criteria::default();
+        let w = Window {
+            from: 75.0,
+            to: 100.0,
+            sub: 6.25,
+        };
+        let c = |angle| Calibration {
+            seed: 1,
+            duration: 31.25,
+            window: w,
+            angle,
+            scale: 0.0,
+            velocity: 0.02,
+        };
+        let b = Bands::calibrated(&cr, c(0.004));
+        assert!((b.angle - 0.006).abs() < 1e-15);
+        assert_eq!(b.scale, cr.displacement_tolerance);
+        assert!((b.velocity - 0.03).abs() < 1e-15);
+        assert_eq!(b.capped, [false; 3]);
+        // Noise the cap cuts: the band is the cap, and says so.
+        let b = Bands::calibrated(&cr, c(0.1));
+        assert_eq!(b.angle, cr.angle_band_cap);
+        assert!(b.capped[0]);
+        // A NaN statistic (no instant) is the cap, never a NaN band.
+        assert_eq!(Bands::calibrated(&cr, c(f64::NAN)).angle, cr.angle_band_cap);
+    }
+}
