@@ -624,7 +624,7 @@ fn qemu_agent_3_runs_the_bearing_tracker_with_noisy_bearings() {
     let s = summary(&out);
     assert_eq!(s["outcome"], "converged");
     assert_eq!(s["bearing_filter"]["kind"], "tracker");
-    assert!(s["noise"]["steady_rms_angle_error_rad"].as_f64().is_some());
+    assert!(s["verdict"]["p95"]["angle_rad"].as_f64().is_some());
     assert!(s["final_max_angle_error_rad"].as_f64().expect("error") <= 0.035);
     let hil = s["hil"].as_array().expect("hil");
     assert_eq!(hil.len(), 1);

@@ -32,7 +32,7 @@ fn play(model: &Model, [e0, e1, e3, nan]: [usize; 4]) {
     let r_min = model.min_estimate;
     let wait = model.criteria.collapse_time;
     let mut diag = Diagnostics::new(model, info);
-    let mut monitor = Monitor::new(normal.len());
+    let mut monitor = Monitor::new(model, normal.len());
     // At each instant: the estimates at r_min, and one that is NaN.
     let mut observe = |t: f64, held: &[usize]| {
         let mut est = normal.clone();
@@ -42,7 +42,7 @@ fn play(model: &Model, [e0, e1, e3, nan]: [usize; 4]) {
         diag.evaluate(model, t, &q, &v, &est);
         // The monitor's copy only (a NaN in V would end the run as diverged).
         est[nan] = f64::NAN;
-        assert!(!monitor.observe(model, &diag, &est), "no terminal failure");
+        assert!(!monitor.observe(model, &diag, &q, &est), "no terminal failure");
         monitor
             .events
             .iter()

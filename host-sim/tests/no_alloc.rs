@@ -80,7 +80,7 @@ fn full_loop(
     csv: &mut CsvRecorder,
 ) {
     let mut diag = Diagnostics::new(model, engine.estimate_info().to_vec());
-    let mut monitor = Monitor::new(diag.estimates.len());
+    let mut monitor = Monitor::new(model, diag.estimates.len());
     let spt = model.steps_per_tick;
     let run = |diag: &mut Diagnostics,
                monitor: &mut Monitor,
@@ -95,7 +95,7 @@ fn full_loop(
                 let frames = engine.frame_counts();
                 let (q, v, est) = engine.view();
                 diag.evaluate(model, t, q, v, est);
-                assert!(!monitor.observe(model, diag, est));
+                assert!(!monitor.observe(model, diag, q, est));
                 csv.record(&Row {
                     snap: &diag.snap,
                     q,

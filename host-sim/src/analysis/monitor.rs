@@ -45,8 +45,12 @@ pub struct Monitor {
 }
 
 impl Monitor {
-    /// For `n_estimates` estimates.
-    pub fn new(n_estimates: usize) -> Self {
+    /// For a run of `model` with `n_estimates` estimates: the series of observed instants
+    /// is sized for every control and log instant of the run, so that observing never
+    /// allocates.
+    pub fn new(model: &Model, n_estimates: usize) -> Self {
+        let total = model.total_steps();
+        let instants = total / model.steps_per_tick.max(1) + total / model.log_every.max(1) + 2;
         Self {
             v0: None,
             run_min: f64::INFINITY,
@@ -54,7 +58,9 @@ impl Monitor {
             max_rise: 0.0,
             max_rise_t: 0.0,
             settle_candidate: None,
-            series: Series::default(),
+            series: Series {
+                instants: Vec::with_capacity(instants),
+            },
             c0: None,
             min_estimate: None,
             min_distance: (f64::INFINITY, 0.0, 0, 0),

@@ -233,7 +233,7 @@ pub(super) fn simulate(
     let log_every = model.log_every.max(1);
     let progress_every = (total / 200).max(1);
     let mut diag = Diagnostics::new(model, engine.estimate_info().to_vec());
-    let mut monitor = Monitor::new(diag.estimates.len());
+    let mut monitor = Monitor::new(model, diag.estimates.len());
     let area0: Vec<f64> = {
         let (q, _, _) = engine.view();
         model
