@@ -7,8 +7,10 @@ use super::steady::Window;
 use crate::model::Criteria;
 
 /// The calibration's statistic times this is the band: a steady run's worst sub-window
-/// varies from seed to seed (`host-sim/tests/verdict.rs` runs several).
-pub const MARGIN: f64 = 1.5;
+/// varies from seed to seed, most in the slow modes (the leader edge's scale). With 1.5,
+/// 10–29 % of `paper`'s runs at 0.5–2° missed a band by a few per cent (100 seeds per
+/// point, docs/sensors.md); the caps keep a wider margin from excusing a bad shape.
+pub const MARGIN: f64 = 2.0;
 
 /// What the calibration run measured: the worst sub-window's 95th percentile of each
 /// quantity over its steady window ([`super::steady::Series::worst_sub_window`]).
@@ -104,9 +106,9 @@ mod tests {
             velocity: 0.02,
         };
         let b = Bands::calibrated(&cr, c(0.004));
-        assert!((b.angle - 0.006).abs() < 1e-15);
+        assert!((b.angle - 0.008).abs() < 1e-15);
         assert_eq!(b.scale, cr.displacement_tolerance);
-        assert!((b.velocity - 0.03).abs() < 1e-15);
+        assert!((b.velocity - 0.04).abs() < 1e-15);
         assert_eq!(b.capped, [false; 3]);
         // Noise the cap cuts: the band is the cap, and says so.
         let b = Bands::calibrated(&cr, c(0.1));

@@ -165,9 +165,9 @@ impl Series {
     }
 
     /// The largest [`PERCENTILE`] of `q` over the sub-windows of `w` (starting every
-    /// `sub / 4`): what a steady run's sub-windows reach (the calibration's statistic).
+    /// `sub / 8`): what a steady run's sub-windows reach (the calibration's statistic).
     pub fn worst_sub_window(&self, q: Quantity, w: &Window) -> Option<f64> {
-        let step = 0.25 * w.sub;
+        let step = 0.125 * w.sub;
         if !(step > 0.0) {
             return self.percentile(q, w.from, w.to);
         }
