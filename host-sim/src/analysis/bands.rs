@@ -58,12 +58,29 @@ fn band(x: f64, lo: f64, cap: f64) -> (f64, bool) {
     }
 }
 
+/// The caps of a formation whose leader edge is `|z*|` long (0 without one) and that
+/// moves at `|v*|`: `criteria`'s, or 1 % of `|z*|` for the scale and 2 % of `|v*|` for
+/// the velocity when larger (a bearing error turns the whole edge and the whole velocity:
+/// 1° is 1.7 % of either).
+pub fn caps(cr: &Criteria, z_star: f64, v_star: f64) -> [f64; 3] {
+    [
+        cr.angle_band_cap,
+        cr.scale_band_cap.max(SCALE_CAP_REL * z_star),
+        cr.velocity_band_cap.max(VELOCITY_CAP_REL * v_star),
+    ]
+}
+
+/// The scale cap's share of `|z*|`.
+pub const SCALE_CAP_REL: f64 = 0.01;
+/// The velocity cap's share of `|v*|`.
+pub const VELOCITY_CAP_REL: f64 = 0.02;
+
 impl Bands {
-    /// The bands of a calibration under `cr`.
-    pub fn calibrated(cr: &Criteria, c: Calibration) -> Self {
-        let (angle, ca) = band(c.angle, cr.angle_tolerance, cr.angle_band_cap);
-        let (scale, cs) = band(c.scale, cr.displacement_tolerance, cr.scale_band_cap);
-        let (velocity, cv) = band(c.velocity, cr.velocity_tolerance, cr.velocity_band_cap);
+    /// The bands of a calibration under `cr` and the caps of [`caps`].
+    pub fn calibrated(cr: &Criteria, c: Calibration, caps: [f64; 3]) -> Self {
+        let (angle, ca) = band(c.angle, cr.angle_tolerance, caps[0]);
+        let (scale, cs) = band(c.scale, cr.displacement_tolerance, caps[1]);
+        let (velocity, cv) = band(c.velocity, cr.velocity_tolerance, caps[2]);
         Self {
             angle,
             scale,
@@ -74,11 +91,11 @@ impl Bands {
     }
 
     /// The caps themselves (a calibration that could not run).
-    pub fn caps(cr: &Criteria) -> Self {
+    pub fn capped(caps: [f64; 3]) -> Self {
         Self {
-            angle: cr.angle_band_cap,
-            scale: cr.scale_band_cap,
-            velocity: cr.velocity_band_cap,
+            angle: caps[0],
+            scale: caps[1],
+            velocity: caps[2],
             capped: [true; 3],
             calibration: None,
         }
@@ -105,16 +122,20 @@ mod tests {
             scale: 0.0,
             velocity: 0.02,
         };
-        let b = Bands::calibrated(&cr, c(0.004));
+        let cap = caps(&cr, 0.0, 0.0);
+        let b = Bands::calibrated(&cr, c(0.004), cap);
         assert!((b.angle - 0.008).abs() < 1e-15);
         assert_eq!(b.scale, cr.displacement_tolerance);
         assert!((b.velocity - 0.04).abs() < 1e-15);
         assert_eq!(b.capped, [false; 3]);
         // Noise the cap cuts: the band is the cap, and says so.
-        let b = Bands::calibrated(&cr, c(0.1));
+        let b = Bands::calibrated(&cr, c(0.1), cap);
         assert_eq!(b.angle, cr.angle_band_cap);
         assert!(b.capped[0]);
         // A NaN statistic (no instant) is the cap, never a NaN band.
-        assert_eq!(Bands::calibrated(&cr, c(f64::NAN)).angle, cr.angle_band_cap);
+        assert_eq!(Bands::calibrated(&cr, c(f64::NAN), cap).angle, cr.angle_band_cap);
+        // A long leader edge and a fast formation get caps relative to them.
+        let [_, s, v] = caps(&cr, 14.14, 4.243);
+        assert!((s - 0.1414).abs() < 1e-12 && (v - 0.08486).abs() < 1e-12);
     }
 }

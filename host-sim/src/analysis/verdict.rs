@@ -314,11 +314,7 @@ impl SteadyReport {
             cal.map(|c| c.scale),
             cal.map(|c| c.velocity),
         ];
-        let caps = [
-            model.criteria.angle_band_cap,
-            model.criteria.scale_band_cap,
-            model.criteria.velocity_band_cap,
-        ];
+        let caps = [b.angle, b.scale, b.velocity];
         let mut ok = Vec::new();
         let mut missing = Vec::new();
         for (k, (_, name, unit)) in JUDGED.iter().enumerate() {

@@ -9,7 +9,7 @@ use super::continuous::ContinuousSim;
 use super::driver::{simulate, Engine};
 use super::record::NullRecorder;
 use super::sampled::SampledSim;
-use crate::analysis::bands::{Bands, Calibration};
+use crate::analysis::bands::{caps, Bands, Calibration};
 use crate::analysis::steady::{Quantity, Window};
 use crate::model::shape::fit_similarity;
 use crate::model::{Mode, Model};
@@ -21,9 +21,16 @@ const SEED_MIX: u64 = 0x9E37_79B9_7F4A_7C15;
 /// The bands of `model`, whose run ended at positions `q` with estimates `est`: from a
 /// calibration run, or the caps of `[criteria]` when none can be made.
 pub fn bands(model: &Model, q: &[Vec2<f64>], est: &[f64]) -> Bands {
+    let norm = |v: [f64; 2]| v[0].hypot(v[1]);
+    let end = model.duration;
+    let caps = caps(
+        &model.criteria,
+        model.z_star(end).map_or(0.0, norm),
+        norm(model.v_star(end)),
+    );
     match calibration(model, q, est) {
-        Some(c) => Bands::calibrated(&model.criteria, c),
-        None => Bands::caps(&model.criteria),
+        Some(c) => Bands::calibrated(&model.criteria, c, caps),
+        None => Bands::capped(caps),
     }
 }
 
