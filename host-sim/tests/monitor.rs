@@ -42,7 +42,10 @@ fn play(model: &Model, [e0, e1, e3, nan]: [usize; 4]) {
         diag.evaluate(model, t, &q, &v, &est);
         // The monitor's copy only (a NaN in V would end the run as diverged).
         est[nan] = f64::NAN;
-        assert!(!monitor.observe(model, &diag, &q, &est), "no terminal failure");
+        assert!(
+            !monitor.observe(model, &diag, &q, &est),
+            "no terminal failure"
+        );
         monitor
             .events
             .iter()

@@ -44,7 +44,11 @@ fn two_degrees_and_ten_percent_loss_converge_with_default_criteria() {
         );
         let p95 = s.p95[0].expect("p95");
         assert!(p95 > 0.0 && p95 <= s.bands.angle, "{name}: {s:?}");
-        assert!(r.reason.contains("held over the steady window"), "{name}: {}", r.reason);
+        assert!(
+            r.reason.contains("held over the steady window"),
+            "{name}: {}",
+            r.reason
+        );
     }
 }
 
@@ -74,7 +78,11 @@ fn a_collapse_under_noise_is_still_a_collapse() {
     );
     let r = run(&m);
     assert_eq!(r.outcome, Outcome::NotConverged, "{}", r.reason);
-    assert!(r.reason.contains("not held over the steady window"), "{}", r.reason);
+    assert!(
+        r.reason.contains("not held over the steady window"),
+        "{}",
+        r.reason
+    );
 }
 
 #[test]

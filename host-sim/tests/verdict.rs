@@ -232,3 +232,20 @@ fn pose_is_reported_apart_from_shape() {
     let none = run(&model("formation-only", &["duration=20"]));
     assert!(none.pose.orientation.is_none() && none.pose.scale_rel.is_none());
 }
+
+/// A channel far too slow for the swarm's frames: the neighbours fall silent, and the
+/// reason says the channel was overloaded.
+#[test]
+fn an_overloaded_channel_is_named() {
+    let r = run(&model(
+        STRIP,
+        &[
+            "radio.channel.preset=crazyflie",
+            "radio.channel.bit_rate_bps=2000",
+            "duration=10",
+        ],
+    ));
+    assert_eq!(r.outcome, Outcome::NotInControl, "{}", r.reason);
+    assert!(r.reason.contains("a neighbour silent"), "{}", r.reason);
+    assert!(r.reason.contains("channel was overloaded"), "{}", r.reason);
+}

@@ -133,7 +133,10 @@ mod tests {
         assert_eq!(b.angle, cr.angle_band_cap);
         assert!(b.capped[0]);
         // A NaN statistic (no instant) is the cap, never a NaN band.
-        assert_eq!(Bands::calibrated(&cr, c(f64::NAN), cap).angle, cr.angle_band_cap);
+        assert_eq!(
+            Bands::calibrated(&cr, c(f64::NAN), cap).angle,
+            cr.angle_band_cap
+        );
         // A long leader edge and a fast formation get caps relative to them.
         let [_, s, v] = caps(&cr, 14.14, 4.243);
         assert!((s - 0.1414).abs() < 1e-12 && (v - 0.08486).abs() < 1e-12);

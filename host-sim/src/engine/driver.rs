@@ -168,11 +168,23 @@ pub fn drive(
         None
     };
     let steady_control = engine.control_stats().window;
+    let channel = engine.channel_stats();
     let (q, v, est) = engine.view();
     let verdict = sim
         .monitor
         .verdict(model, &sim.diag.snap, q, &steady_control, bands.as_ref());
     let mut reason = verdict.reason;
+    if verdict.outcome == crate::analysis::Outcome::NotInControl {
+        if let Some(c) = &channel {
+            let u = c.total_utilisation(sim.diag.snap.t);
+            if u > 1.0 {
+                reason = format!(
+                    "{reason}; the shared channel was overloaded: {:.0} % of its air time offered",
+                    100.0 * u
+                );
+            }
+        }
+    }
     if verdict.outcome != crate::analysis::Outcome::Converged {
         if let Some(note) = speed_limit_note(model) {
             reason = format!("{reason}; {note}");
@@ -212,7 +224,7 @@ pub fn drive(
             .collect(),
         frames: engine.frame_counts(),
         control: engine.control_stats(),
-        channel: engine.channel_stats(),
+        channel,
         attacks: engine.attack_counts(),
         warnings,
         steps: sim.steps,
