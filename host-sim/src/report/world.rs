@@ -20,6 +20,11 @@ pub fn add_json(obj: &mut Map<String, Value>, model: &Model) {
             "max_speed_m_s": v.max_speed,
             "lead_s": v.lead,
         }),
+        VehicleModel::CrazyfliePid(v) => json!({
+            "model": "crazyflie_pid",
+            "max_speed_m_s": v.max_speed,
+            "lead_s": v.lead,
+        }),
     };
     let wind = w.wind.map(|x| {
         json!({
