@@ -34,6 +34,8 @@ pub enum ActuateError {
     MaxSpeed,
     /// The lead is not finite and non-negative.
     Lead,
+    /// The second-order lead is not finite and non-negative.
+    SecondLead,
 }
 
 /// The virtual plant of SPEC S1 for one agent: mass, friction `D^r` per axis, the
@@ -45,6 +47,7 @@ pub struct VirtualMass<T> {
     friction: [T; 2],
     max_speed: T,
     lead: T,
+    second_lead: T,
 }
 
 impl<T: Real> VirtualMass<T> {
@@ -66,6 +69,7 @@ impl<T: Real> VirtualMass<T> {
             friction,
             max_speed,
             lead: T::zero(),
+            second_lead: T::zero(),
         })
     }
 
@@ -77,6 +81,26 @@ impl<T: Real> VirtualMass<T> {
             return Err(ActuateError::Lead);
         }
         Ok(Self { lead, ..self })
+    }
+
+    /// The same plant with second-order lead `second_lead` (s², finite, ≥ 0; S21b): for
+    /// a vehicle whose velocity answers its setpoint like `1 / (τ_a τ s² + τ s + 1)` (a
+    /// velocity loop of time constant `τ` through an attitude loop of time constant
+    /// `τ_a`), `second_lead = τ τ_a` adds that many times the virtual jerk to the
+    /// setpoint ([`VelocityCommand::step`]). 0 (the default): first order only.
+    pub fn with_second_lead(self, second_lead: T) -> Result<Self, ActuateError> {
+        if !(second_lead.finite() && second_lead >= T::zero()) {
+            return Err(ActuateError::SecondLead);
+        }
+        Ok(Self {
+            second_lead,
+            ..self
+        })
+    }
+
+    /// The second-order lead (s²).
+    pub fn second_lead(&self) -> T {
+        self.second_lead
     }
 
     /// The lead (s).
@@ -162,6 +186,8 @@ fn is_positive<T: Real>(x: T) -> bool {
 pub struct VelocityCommand<T> {
     plant: VirtualMass<T>,
     command: Option<[T; 2]>,
+    /// The virtual acceleration of the last step (for the second-order lead).
+    accel: Option<[T; 2]>,
 }
 
 impl<T: Real> VelocityCommand<T> {
@@ -170,18 +196,24 @@ impl<T: Real> VelocityCommand<T> {
         Self {
             plant,
             command: None,
+            accel: None,
         }
     }
 
     /// Resumes a command at setpoint `command` (`None`: no state yet), e.g. state kept
     /// by a C caller between calls.
     pub fn resume(plant: VirtualMass<T>, command: Option<[T; 2]>) -> Self {
-        Self { plant, command }
+        Self {
+            plant,
+            command,
+            accel: None,
+        }
     }
 
     /// The next step starts again from the measured velocity.
     pub fn restart(&mut self) {
         self.command = None;
+        self.accel = None;
     }
 
     /// The current virtual velocity (`None` before the first step): the setpoint
@@ -203,7 +235,21 @@ impl<T: Real> VelocityCommand<T> {
         let from = self.command.unwrap_or(measured);
         let next = self.plant.step(from, force, dt);
         self.command = Some(next);
-        self.plant.setpoint(from, next, dt)
+        let p = &self.plant;
+        if !(p.second_lead > T::zero() && dt > T::zero() && dt.finite()) {
+            return p.setpoint(from, next, dt);
+        }
+        // S21b: S21 plus `τ₂` times the virtual jerk, the change of the virtual
+        // acceleration over the period (none on the first step after a (re)start).
+        let ([x, y], [x0, y0]) = (next, from);
+        let (ax, ay) = ((x - x0) / dt, (y - y0) / dt);
+        let [px, py] = self.accel.unwrap_or([ax, ay]);
+        self.accel = Some([ax, ay]);
+        let k = p.second_lead / dt;
+        p.limit([
+            x + p.lead * ax + k * (ax - px),
+            y + p.lead * ay + k * (ay - py),
+        ])
     }
 }
 

@@ -26,6 +26,8 @@ pub struct CrazyfliePid {
     pub max_speed: f64,
     /// The lead of the agent's setpoints (s, ≥ 0; SPEC S21).
     pub lead: f64,
+    /// The second-order lead of the agent's setpoints (s², ≥ 0; SPEC S21b).
+    pub second_lead: f64,
 }
 
 /// A velocity-tracking vehicle: `v̇ = sat_{a_max}((v_sp − v) / τ)`, `|v_sp| ≤ v_max`.

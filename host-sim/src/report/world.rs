@@ -24,6 +24,7 @@ pub fn add_json(obj: &mut Map<String, Value>, model: &Model) {
             "model": "crazyflie_pid",
             "max_speed_m_s": v.max_speed,
             "lead_s": v.lead,
+            "second_lead_s2": v.second_lead,
         }),
     };
     let wind = w.wind.map(|x| {

@@ -42,6 +42,10 @@ pub enum PlantSpec {
         /// derived lead `1 / (g K_p)` (0.234 s).
         #[serde(default)]
         lead_s: Option<f64>,
+        /// The second-order lead (s², SPEC S21b); default the cascade's derived
+        /// `τ / K_p^a` (0.039 s²).
+        #[serde(default)]
+        second_lead_s2: Option<f64>,
     },
 }
 
@@ -274,7 +278,8 @@ mod plant_tests {
             spec("model = \"crazyflie_pid\""),
             Ok(PlantSpec::CrazyfliePid {
                 max_speed: 1.0,
-                lead_s: None
+                lead_s: None,
+                second_lead_s2: None,
             })
         );
         assert!(matches!(

@@ -68,6 +68,15 @@ pub fn derived_lead() -> f64 {
     1.0 / (G * fw::VEL_KP.to_radians())
 }
 
+/// The second-order lead (s², SPEC S21b) that suits the cascade: at the formation's
+/// frequencies (well above the attitude integral's 0.5 rad/s) the attitude loop is a lag
+/// of `1 / K_p^a`, so the velocity answers its setpoint like
+/// `1 / (τ τ_a s² + τ s + 1)` with `τ` = [`derived_lead`] and `τ_a = 1 / K_p^a`:
+/// `τ τ_a` = 0.0390 s² (`docs/world.md`).
+pub fn derived_second_lead() -> f64 {
+    derived_lead() / fw::ATT_KP
+}
+
 /// One axis's controller state.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct Axis {
@@ -142,6 +151,7 @@ impl CrazyfliePidPlant {
             .map(|(i, x)| {
                 VirtualMass::new(x.mass, x.friction, vehicle.max_speed)
                     .and_then(|m| m.with_lead(vehicle.lead))
+                    .and_then(|m| m.with_second_lead(vehicle.second_lead))
                     .map(VelocityCommand::new)
                     .map_err(|error| SetupError::Vehicle { agent: i, error })
             })
@@ -399,5 +409,6 @@ mod tests {
         let a = tilt_acceleration(20.0, 0.0);
         assert!((a.x - 3.569_3).abs() < 1e-3 && a.y == 0.0, "{a:?}");
         assert!((derived_lead() - 0.2337).abs() < 1e-4, "{}", derived_lead());
+        assert!((derived_second_lead() - 0.03895).abs() < 1e-5);
     }
 }

@@ -9,7 +9,9 @@ mod crazyflie_pid;
 mod point_mass;
 mod velocity_tracking;
 
-pub use crazyflie_pid::{derived_lead, firmware, total_tilt, CrazyfliePidPlant};
+pub use crazyflie_pid::{
+    derived_lead, derived_second_lead, firmware, total_tilt, CrazyfliePidPlant,
+};
 pub use point_mass::{acceleration, PointMass};
 pub use velocity_tracking::{tracking_acceleration, VelocityTrackingPlant};
 

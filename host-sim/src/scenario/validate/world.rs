@@ -2,7 +2,7 @@
 //! into the model's [`WorldModel`] (`docs/world.md`).
 
 use super::checker::Checker;
-use crate::engine::plant::derived_lead;
+use crate::engine::plant::{derived_lead, derived_second_lead};
 use crate::model::{
     ClockModel, CrazyfliePid, HeadingModel, Mode, VehicleModel, VelocityTracking, WindModel,
     WorldModel,
@@ -51,11 +51,21 @@ pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile, period: f64) -> World
                 lead,
             });
         }
-        Ok(PlantSpec::CrazyfliePid { max_speed, lead_s }) => {
+        Ok(PlantSpec::CrazyfliePid {
+            max_speed,
+            lead_s,
+            second_lead_s2,
+        }) => {
             c.positive(InvalidValue, "plant.max_speed", max_speed);
             let lead = lead_s.unwrap_or_else(derived_lead);
             c.non_negative(InvalidValue, "plant.lead_s", lead);
-            world.vehicle = VehicleModel::CrazyfliePid(CrazyfliePid { max_speed, lead });
+            let second_lead = second_lead_s2.unwrap_or_else(derived_second_lead);
+            c.non_negative(InvalidValue, "plant.second_lead_s2", second_lead);
+            world.vehicle = VehicleModel::CrazyfliePid(CrazyfliePid {
+                max_speed,
+                lead,
+                second_lead,
+            });
         }
     }
     if let Some(w) = &s.wind {
