@@ -176,7 +176,9 @@ impl CrazyfliePidPlant {
     /// One firmware tick of every agent: the velocity PID on every fifth, then the
     /// attitude PID (controller_pid.c:115-131 runs them in that order).
     fn tick(&mut self) {
-        let velocity = self.ticks % u64::from(fw::ATTITUDE_RATE / fw::POSITION_RATE) == 0;
+        let velocity = self
+            .ticks
+            .is_multiple_of(u64::from(fw::ATTITUDE_RATE / fw::POSITION_RATE));
         for ((axes, v), sp) in self.axes.iter_mut().zip(&self.v).zip(&self.setpoint) {
             for (k, axis) in axes.iter_mut().enumerate() {
                 if velocity {
