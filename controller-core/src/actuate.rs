@@ -210,6 +210,26 @@ impl<T: Real> VelocityCommand<T> {
         }
     }
 
+    /// Resumes a command at setpoint `command` and last virtual acceleration `accel`
+    /// (for the second-order lead, S21b), e.g. state kept by a C caller between calls.
+    pub fn resume_with_accel(
+        plant: VirtualMass<T>,
+        command: Option<[T; 2]>,
+        accel: Option<[T; 2]>,
+    ) -> Self {
+        Self {
+            plant,
+            command,
+            accel,
+        }
+    }
+
+    /// The virtual acceleration of the last step (`None` before a step with a
+    /// second-order lead).
+    pub fn accel(&self) -> Option<[T; 2]> {
+        self.accel
+    }
+
     /// The next step starts again from the measured velocity.
     pub fn restart(&mut self) {
         self.command = None;
@@ -362,6 +382,46 @@ mod tests {
         assert_eq!(
             VirtualMass::new(1.0_f64, [0.0; 2], 1.0).and_then(|p| p.with_lead(-1.0)),
             Err(ActuateError::Lead)
+        );
+    }
+
+    /// S21b: a second-order vehicle `τ τ_a v̈ + τ v̇ + v = v_sp` follows a smoothly
+    /// turning virtual velocity far closer with the second-order lead `τ τ_a` than with
+    /// S21 alone.
+    #[test]
+    fn the_second_lead_cancels_a_second_order_velocity_loop() {
+        let (tau, tau_a) = (0.2337_f64, 1.0 / 6.0);
+        let lag = |second: f64| {
+            let plant = VirtualMass::new(1.0, [0.0; 2], f64::INFINITY)
+                .and_then(|p| p.with_lead(tau))
+                .and_then(|p| p.with_second_lead(second))
+                .unwrap();
+            let mut c = VelocityCommand::new(plant);
+            let (dt, sub) = (0.01, 100);
+            let (mut v, mut a) = (0.0, 0.0);
+            let mut worst: f64 = 0.0;
+            for k in 0..400 {
+                // A force turning smoothly (period 2 s): the virtual velocity oscillates.
+                let u = libm::sin(core::f64::consts::PI * f64::from(k) * dt);
+                let sp = c.step([u, 0.0], [v, 0.0], dt)[0];
+                let h = dt / f64::from(sub);
+                for _ in 0..sub {
+                    let jerk = (sp - v - tau * a) / (tau * tau_a);
+                    a += jerk * h;
+                    v += a * h;
+                }
+                if k > 100 {
+                    worst = worst.max((v - c.command().unwrap()[0]).abs());
+                }
+            }
+            worst
+        };
+        let (first, second) = (lag(0.0), lag(tau * tau_a));
+        assert!(first > 0.02, "{first}");
+        assert!(second < 0.1 * first, "{second} vs {first}");
+        assert_eq!(
+            VirtualMass::new(1.0_f64, [0.0; 2], 1.0).and_then(|p| p.with_second_lead(f64::NAN)),
+            Err(ActuateError::SecondLead)
         );
     }
 
