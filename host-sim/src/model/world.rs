@@ -24,10 +24,12 @@ pub struct CrazyfliePid {
     /// The largest velocity setpoint the agent sends (m/s, > 0; the app's
     /// `FORMATION_MAX_SPEED`: the firmware has none in velocity mode).
     pub max_speed: f64,
-    /// The lead of the agent's setpoints (s, ≥ 0; SPEC S21).
-    pub lead: f64,
-    /// The second-order lead of the agent's setpoints (s², ≥ 0; SPEC S21b).
-    pub second_lead: f64,
+    /// The lead of the agent's setpoints (s, ≥ 0; SPEC S21); `None`: the cascade's
+    /// derived `engine::plant::derived_lead`.
+    pub lead: Option<f64>,
+    /// The second-order lead of the agent's setpoints (s², ≥ 0; SPEC S21b); `None`: the
+    /// derived `engine::plant::derived_second_lead`.
+    pub second_lead: Option<f64>,
 }
 
 /// A velocity-tracking vehicle: `v̇ = sat_{a_max}((v_sp − v) / τ)`, `|v_sp| ≤ v_max`.

@@ -150,8 +150,10 @@ impl CrazyfliePidPlant {
             .enumerate()
             .map(|(i, x)| {
                 VirtualMass::new(x.mass, x.friction, vehicle.max_speed)
-                    .and_then(|m| m.with_lead(vehicle.lead))
-                    .and_then(|m| m.with_second_lead(vehicle.second_lead))
+                    .and_then(|m| m.with_lead(vehicle.lead.unwrap_or_else(derived_lead)))
+                    .and_then(|m| {
+                        m.with_second_lead(vehicle.second_lead.unwrap_or_else(derived_second_lead))
+                    })
                     .map(VelocityCommand::new)
                     .map_err(|error| SetupError::Vehicle { agent: i, error })
             })
@@ -403,6 +405,50 @@ mod tests {
         let (_, v, _) = response(Vec2::new(3.0, 0.0), 8.0);
         let last = v.last().copied().unwrap_or_default();
         assert!((last.x - 3.0).abs() < 0.1, "{last:?}");
+    }
+
+    /// Every firmware figure the model uses is in docs/world.md's table with its value
+    /// and its source line (the constants above cite the same lines).
+    #[test]
+    fn the_docs_cite_every_figure() {
+        let doc = include_str!("../../../../docs/world.md");
+        let rows = [
+            (fw::VEL_KP, "25 °/(m/s)", "platform_defaults_cf2.h:132"),
+            (fw::VEL_KI, "1 °/m", "platform_defaults_cf2.h:133"),
+            (fw::VEL_I_LIMIT, "±5000", "pid.h:33"),
+            (
+                fw::TILT_MAX_DEG * fw::TILT_OVERHEAD,
+                "1.1 × 20° = 22°",
+                "position_controller_pid.c:63",
+            ),
+            (fw::ATT_KP, "6 1/s", "platform_defaults_cf2.h:114"),
+            (fw::ATT_KI, "3 1/s²", "platform_defaults_cf2.h:115"),
+            (fw::ATT_I_LIMIT, "±20 ° s", "platform_defaults_cf2.h:118"),
+            (
+                f64::from(fw::POSITION_RATE),
+                "100 Hz",
+                "stabilizer_types.h:373",
+            ),
+            (
+                f64::from(fw::ATTITUDE_RATE),
+                "500 Hz",
+                "stabilizer_types.h:372",
+            ),
+        ];
+        for (value, text, source) in rows {
+            let row = doc
+                .lines()
+                .find(|l| l.contains(text) && l.contains(source))
+                .unwrap_or_else(|| panic!("docs/world.md: no row with {text} and {source}"));
+            let number = text
+                .trim_start_matches('±')
+                .split([' ', '°'])
+                .next()
+                .and_then(|n| n.parse::<f64>().ok());
+            if let Some(n) = number.filter(|_| !text.contains('×')) {
+                assert_eq!(n, value, "{row}");
+            }
+        }
     }
 
     /// At 20° the acceleration is `g tan 20°` along an axis; the lead is `1 / (g K_p)`.

@@ -2,7 +2,6 @@
 //! into the model's [`WorldModel`] (`docs/world.md`).
 
 use super::checker::Checker;
-use crate::engine::plant::{derived_lead, derived_second_lead};
 use crate::model::{
     ClockModel, CrazyfliePid, HeadingModel, Mode, VehicleModel, VelocityTracking, WindModel,
     WorldModel,
@@ -57,14 +56,16 @@ pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile, period: f64) -> World
             second_lead_s2,
         }) => {
             c.positive(InvalidValue, "plant.max_speed", max_speed);
-            let lead = lead_s.unwrap_or_else(derived_lead);
-            c.non_negative(InvalidValue, "plant.lead_s", lead);
-            let second_lead = second_lead_s2.unwrap_or_else(derived_second_lead);
-            c.non_negative(InvalidValue, "plant.second_lead_s2", second_lead);
+            if let Some(lead) = lead_s {
+                c.non_negative(InvalidValue, "plant.lead_s", lead);
+            }
+            if let Some(second) = second_lead_s2 {
+                c.non_negative(InvalidValue, "plant.second_lead_s2", second);
+            }
             world.vehicle = VehicleModel::CrazyfliePid(CrazyfliePid {
                 max_speed,
-                lead,
-                second_lead,
+                lead: lead_s,
+                second_lead: second_lead_s2,
             });
         }
     }
