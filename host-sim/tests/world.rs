@@ -294,3 +294,30 @@ fn bad_world_values_are_refused_with_their_field() {
         );
     }
 }
+
+/// `world = "crazyflie-camera"`: the AI-deck's 87° camera leaves formation-only's agents
+/// without some neighbours, and the outcome's reason names the agent, the neighbour and
+/// the field of view; with a camera seeing all round no such note (negative control).
+#[test]
+fn the_camera_world_names_a_neighbour_out_of_view() {
+    let r = run(&model(
+        "formation-only",
+        &["world=crazyflie-camera", "duration=30"],
+    ));
+    assert_ne!(r.outcome, Outcome::Converged);
+    assert!(
+        r.reason
+            .contains("out of view of its camera (field of view 87°"),
+        "{}",
+        r.reason
+    );
+    let r = run(&model(
+        "formation-only",
+        &[
+            "world=crazyflie-camera",
+            "duration=30",
+            "sensors.camera.fov_deg=360",
+        ],
+    ));
+    assert!(!r.reason.contains("out of view"), "{}", r.reason);
+}
