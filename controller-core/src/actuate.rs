@@ -34,6 +34,8 @@ pub enum ActuateError {
     MaxSpeed,
     /// The lead is not finite and non-negative.
     Lead,
+    /// The second-order lead is not finite and non-negative.
+    SecondLead,
 }
 
 /// The virtual plant of SPEC S1 for one agent: mass, friction `D^r` per axis, the
@@ -45,6 +47,7 @@ pub struct VirtualMass<T> {
     friction: [T; 2],
     max_speed: T,
     lead: T,
+    second_lead: T,
 }
 
 impl<T: Real> VirtualMass<T> {
@@ -66,6 +69,7 @@ impl<T: Real> VirtualMass<T> {
             friction,
             max_speed,
             lead: T::zero(),
+            second_lead: T::zero(),
         })
     }
 
@@ -77,6 +81,26 @@ impl<T: Real> VirtualMass<T> {
             return Err(ActuateError::Lead);
         }
         Ok(Self { lead, ..self })
+    }
+
+    /// The same plant with second-order lead `second_lead` (s², finite, ≥ 0; S21b): for
+    /// a vehicle whose velocity answers its setpoint like `1 / (τ_a τ s² + τ s + 1)` (a
+    /// velocity loop of time constant `τ` through an attitude loop of time constant
+    /// `τ_a`), `second_lead = τ τ_a` adds that many times the virtual jerk to the
+    /// setpoint ([`VelocityCommand::step`]). 0 (the default): first order only.
+    pub fn with_second_lead(self, second_lead: T) -> Result<Self, ActuateError> {
+        if !(second_lead.finite() && second_lead >= T::zero()) {
+            return Err(ActuateError::SecondLead);
+        }
+        Ok(Self {
+            second_lead,
+            ..self
+        })
+    }
+
+    /// The second-order lead (s²).
+    pub fn second_lead(&self) -> T {
+        self.second_lead
     }
 
     /// The lead (s).
@@ -162,6 +186,8 @@ fn is_positive<T: Real>(x: T) -> bool {
 pub struct VelocityCommand<T> {
     plant: VirtualMass<T>,
     command: Option<[T; 2]>,
+    /// The virtual acceleration of the last step (for the second-order lead).
+    accel: Option<[T; 2]>,
 }
 
 impl<T: Real> VelocityCommand<T> {
@@ -170,18 +196,44 @@ impl<T: Real> VelocityCommand<T> {
         Self {
             plant,
             command: None,
+            accel: None,
         }
     }
 
     /// Resumes a command at setpoint `command` (`None`: no state yet), e.g. state kept
     /// by a C caller between calls.
     pub fn resume(plant: VirtualMass<T>, command: Option<[T; 2]>) -> Self {
-        Self { plant, command }
+        Self {
+            plant,
+            command,
+            accel: None,
+        }
+    }
+
+    /// Resumes a command at setpoint `command` and last virtual acceleration `accel`
+    /// (for the second-order lead, S21b), e.g. state kept by a C caller between calls.
+    pub fn resume_with_accel(
+        plant: VirtualMass<T>,
+        command: Option<[T; 2]>,
+        accel: Option<[T; 2]>,
+    ) -> Self {
+        Self {
+            plant,
+            command,
+            accel,
+        }
+    }
+
+    /// The virtual acceleration of the last step (`None` before a step with a
+    /// second-order lead).
+    pub fn accel(&self) -> Option<[T; 2]> {
+        self.accel
     }
 
     /// The next step starts again from the measured velocity.
     pub fn restart(&mut self) {
         self.command = None;
+        self.accel = None;
     }
 
     /// The current virtual velocity (`None` before the first step): the setpoint
@@ -203,7 +255,21 @@ impl<T: Real> VelocityCommand<T> {
         let from = self.command.unwrap_or(measured);
         let next = self.plant.step(from, force, dt);
         self.command = Some(next);
-        self.plant.setpoint(from, next, dt)
+        let p = &self.plant;
+        if !(p.second_lead > T::zero() && dt > T::zero() && dt.finite()) {
+            return p.setpoint(from, next, dt);
+        }
+        // S21b: S21 plus `τ₂` times the virtual jerk, the change of the virtual
+        // acceleration over the period (none on the first step after a (re)start).
+        let ([x, y], [x0, y0]) = (next, from);
+        let (ax, ay) = ((x - x0) / dt, (y - y0) / dt);
+        let [px, py] = self.accel.unwrap_or([ax, ay]);
+        self.accel = Some([ax, ay]);
+        let k = p.second_lead / dt;
+        p.limit([
+            x + p.lead * ax + k * (ax - px),
+            y + p.lead * ay + k * (ay - py),
+        ])
     }
 }
 
@@ -316,6 +382,46 @@ mod tests {
         assert_eq!(
             VirtualMass::new(1.0_f64, [0.0; 2], 1.0).and_then(|p| p.with_lead(-1.0)),
             Err(ActuateError::Lead)
+        );
+    }
+
+    /// S21b: a second-order vehicle `τ τ_a v̈ + τ v̇ + v = v_sp` follows a smoothly
+    /// turning virtual velocity far closer with the second-order lead `τ τ_a` than with
+    /// S21 alone.
+    #[test]
+    fn the_second_lead_cancels_a_second_order_velocity_loop() {
+        let (tau, tau_a) = (0.2337_f64, 1.0 / 6.0);
+        let lag = |second: f64| {
+            let plant = VirtualMass::new(1.0, [0.0; 2], f64::INFINITY)
+                .and_then(|p| p.with_lead(tau))
+                .and_then(|p| p.with_second_lead(second))
+                .unwrap();
+            let mut c = VelocityCommand::new(plant);
+            let (dt, sub) = (0.01, 100);
+            let (mut v, mut a) = (0.0, 0.0);
+            let mut worst: f64 = 0.0;
+            for k in 0..400 {
+                // A force turning smoothly (period 2 s): the virtual velocity oscillates.
+                let u = libm::sin(core::f64::consts::PI * f64::from(k) * dt);
+                let sp = c.step([u, 0.0], [v, 0.0], dt)[0];
+                let h = dt / f64::from(sub);
+                for _ in 0..sub {
+                    let jerk = (sp - v - tau * a) / (tau * tau_a);
+                    a += jerk * h;
+                    v += a * h;
+                }
+                if k > 100 {
+                    worst = worst.max((v - c.command().unwrap()[0]).abs());
+                }
+            }
+            worst
+        };
+        let (first, second) = (lag(0.0), lag(tau * tau_a));
+        assert!(first > 0.02, "{first}");
+        assert!(second < 0.1 * first, "{second} vs {first}");
+        assert_eq!(
+            VirtualMass::new(1.0_f64, [0.0; 2], 1.0).and_then(|p| p.with_second_lead(f64::NAN)),
+            Err(ActuateError::SecondLead)
         );
     }
 

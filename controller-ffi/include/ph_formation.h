@@ -64,10 +64,11 @@
 /**
  * Version of this C ABI (the header's structs and functions; 3: `ph_config` gained
  * `bearing_filter`; 4: `ph_limits` gained `bearing_hold`, `ph_fault` gained
- * `PH_FAULT_NEGATIVE_DT`, `ph_actuator` and `ph_actuator_init` the lead). Compare the header's
- * value with `ph_abi_version()` of the library you link.
+ * `PH_FAULT_NEGATIVE_DT`, `ph_actuator` and `ph_actuator_init` the lead; 5: `ph_actuator`
+ * gained the second-order lead and its kept acceleration, `ph_actuator_set_second_lead`).
+ * Compare the header's value with `ph_abi_version()` of the library you link.
  */
-#define PH_ABI_VERSION 4
+#define PH_ABI_VERSION 5
 
 /**
  * An upper bound of a blob's length: a configuration with every capacity used
@@ -496,6 +497,19 @@ typedef struct {
    * 1 once `ph_actuate` has produced a setpoint.
    */
   uint8_t has_command;
+  /**
+   * Second-order lead (s², ≥ 0; SPEC S21b): `ph_actuator_set_second_lead`; 0 for
+   * none (`ph_actuator_init` sets 0).
+   */
+  float second_lead;
+  /**
+   * The virtual acceleration of the last step (m/s²), valid when `has_accel`.
+   */
+  float accel[2];
+  /**
+   * 1 once `ph_actuate` has kept a virtual acceleration (with a second-order lead).
+   */
+  uint8_t has_accel;
 } ph_actuator;
 
 /**
@@ -931,6 +945,17 @@ ph_status ph_actuator_init(ph_actuator *actuator,
                            float mass,
                            float max_speed,
                            float lead);
+
+/**
+ * Sets the second-order lead of `*actuator` (s², finite, ≥ 0; SPEC S21b: `τ τ_a` of a
+ * vehicle whose velocity loop `τ` acts through an attitude loop `τ_a`, 0.039 s² for the
+ * Crazyflie's PID cascade, docs/world.md) and forgets the kept acceleration.
+ * `PH_ERR_ARGUMENT` (nothing written) for a value that is not finite and non-negative.
+ *
+ * # Safety
+ * `actuator` is NULL or points to a `ph_actuator`.
+ */
+ph_status ph_actuator_set_second_lead(ph_actuator *actuator, float second_lead);
 
 /**
  * One control period: integrates S1 from the previous virtual velocity (the first time

@@ -28,6 +28,13 @@ pub struct ph_actuator {
     pub command: [f32; 2],
     /// 1 once `ph_actuate` has produced a setpoint.
     pub has_command: u8,
+    /// Second-order lead (s², ≥ 0; SPEC S21b): `ph_actuator_set_second_lead`; 0 for
+    /// none (`ph_actuator_init` sets 0).
+    pub second_lead: f32,
+    /// The virtual acceleration of the last step (m/s²), valid when `has_accel`.
+    pub accel: [f32; 2],
+    /// 1 once `ph_actuate` has kept a virtual acceleration (with a second-order lead).
+    pub has_accel: u8,
 }
 
 /// Fills `*actuator` for `agent`: mass `mass`, the friction `D^r` of the agent's
@@ -60,10 +67,42 @@ pub unsafe extern "C" fn ph_actuator_init(
             lead: plant.lead(),
             command: [0.0; 2],
             has_command: 0,
+            second_lead: 0.0,
+            accel: [0.0; 2],
+            has_accel: 0,
         };
         // SAFETY: per this function's contract.
         unsafe { write(actuator, value) }
     });
+    status(r)
+}
+
+/// Sets the second-order lead of `*actuator` (s², finite, ≥ 0; SPEC S21b: `τ τ_a` of a
+/// vehicle whose velocity loop `τ` acts through an attitude loop `τ_a`, 0.039 s² for the
+/// Crazyflie's PID cascade, docs/world.md) and forgets the kept acceleration.
+/// `PH_ERR_ARGUMENT` (nothing written) for a value that is not finite and non-negative.
+///
+/// # Safety
+/// `actuator` is NULL or points to a `ph_actuator`.
+#[no_mangle]
+pub unsafe extern "C" fn ph_actuator_set_second_lead(
+    actuator: *mut ph_actuator,
+    second_lead: f32,
+) -> ph_status {
+    let r = (|| {
+        if !(second_lead.is_finite() && second_lead >= 0.0) {
+            return Err(ph_status::PH_ERR_ARGUMENT);
+        }
+        // SAFETY: per this function's contract.
+        let a = unsafe { input(actuator.cast_const()) }?;
+        let updated = ph_actuator {
+            second_lead,
+            has_accel: 0,
+            ..*a
+        };
+        // SAFETY: per this function's contract.
+        unsafe { write(actuator, updated) }
+    })();
     status(r)
 }
 
@@ -95,12 +134,20 @@ pub unsafe extern "C" fn ph_actuate(
         let a = unsafe { input(actuator.cast_const()) }?;
         let plant = VirtualMass::new(a.mass, a.friction, a.max_speed)
             .and_then(|p| p.with_lead(a.lead))
+            .and_then(|p| p.with_second_lead(a.second_lead))
             .map_err(|_| ph_status::PH_ERR_ARGUMENT)?;
-        let mut command = VelocityCommand::resume(plant, (a.has_command != 0).then_some(a.command));
+        let mut command = VelocityCommand::resume_with_accel(
+            plant,
+            (a.has_command != 0).then_some(a.command),
+            (a.has_accel != 0).then_some(a.accel),
+        );
         let next = command.step(*force, *velocity, dt);
+        let accel = command.accel();
         let updated = ph_actuator {
             command: command.command().unwrap_or(next),
             has_command: 1,
+            accel: accel.unwrap_or([0.0; 2]),
+            has_accel: u8::from(accel.is_some()),
             ..*a
         };
         // SAFETY: per this function's contract.

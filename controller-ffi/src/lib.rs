@@ -78,9 +78,10 @@ pub const PH_MAX_FRAMES_PER_TICK: usize = (PH_MAX_TRIANGLES + 3) / 4 + 1;
 pub const PH_MAX_OWNED_ESTIMATES: usize = 4 * PH_MAX_TRIANGLES;
 /// Version of this C ABI (the header's structs and functions; 3: `ph_config` gained
 /// `bearing_filter`; 4: `ph_limits` gained `bearing_hold`, `ph_fault` gained
-/// `PH_FAULT_NEGATIVE_DT`, `ph_actuator` and `ph_actuator_init` the lead). Compare the header's
-/// value with `ph_abi_version()` of the library you link.
-pub const PH_ABI_VERSION: u32 = 4;
+/// `PH_FAULT_NEGATIVE_DT`, `ph_actuator` and `ph_actuator_init` the lead; 5: `ph_actuator`
+/// gained the second-order lead and its kept acceleration, `ph_actuator_set_second_lead`).
+/// Compare the header's value with `ph_abi_version()` of the library you link.
+pub const PH_ABI_VERSION: u32 = 5;
 
 /// The agent behind the C API.
 pub type FfiAgent = controller_core::Agent<f32, PH_MAX_TRIANGLES, PH_MAX_NEIGHBOURS>;

@@ -185,7 +185,7 @@ fn the_crazyflie_refuses_what_it_cannot_fly() {
         "controller.max_force=3",
     ]);
     assert!(
-        e.contains("4.243 m/s") && e.contains("PID_POS_VEL_X_MAX"),
+        e.contains("4.243 m/s") && e.contains("FORMATION_MAX_SPEED"),
         "{e}"
     );
     // Within the limits: exported.

@@ -1,10 +1,11 @@
-//! The command line: `host-sim [run|validate|list|plot|design|export|sweep]` (exit codes
+//! The command line: `host-sim [run|validate|list|plot|design|export|sweep|vehicle]` (exit codes
 //! in [`crate::exit_code`] and `docs/outputs.md`): a thin client of the library API
 //! ([`crate::Simulation`]).
 
 mod design;
 mod export;
 mod run;
+mod step;
 mod sweep;
 mod vehicle;
 mod view;
@@ -64,6 +65,9 @@ pub enum Command {
     Sweep(sweep::SweepArgs),
     /// Write agents' configurations as the C API's checked blobs (docs/c-api.md).
     Export(ExportArgs),
+    /// A vehicle on its own: `vehicle step` (docs/world.md).
+    #[command(subcommand)]
+    Vehicle(step::VehicleCommand),
     /// Print the path of a run's replay.html (writing it if missing), or of a sweep's
     /// sweep.html, and open it in a browser when there is one ($BROWSER, else xdg-open
     /// with a display).
@@ -196,6 +200,7 @@ pub fn execute(cli: Cli) -> u8 {
         ),
         Some(Command::Run(args)) => run_command(&args, quiet),
         Some(Command::Export(args)) => export::export_command(&args, quiet),
+        Some(Command::Vehicle(cmd)) => step::command(&cmd, quiet),
         Some(Command::Validate {
             scenario,
             set,

@@ -31,19 +31,20 @@ struct Limits {
 impl Vehicle {
     fn limits(self) -> Limits {
         match self {
-            // The velocity controller tilts at most 20° in roll and pitch
-            // (PID_VEL_ROLL_MAX / PID_VEL_PITCH_MAX), so thrust buys at most
-            // g·tan(20°) = 3.57 m/s² sideways; the position controller commands at most
-            // 1 m/s (PID_POS_VEL_X_MAX / _Y_MAX).
+            // The velocity controller clamps roll and pitch to 20° each
+            // (PID_VEL_ROLL_MAX / PID_VEL_PITCH_MAX), so thrust buys at least
+            // g·tan(20°) = 3.57 m/s² along any axis (more on a diagonal: the clamp is per
+            // axis). In velocity mode the firmware limits no speed (PID_POS_VEL_*_MAX
+            // bound only the position loop's output); the limit is the app's own.
             Self::Crazyflie => Limits {
                 name: "a Crazyflie 2.x",
                 max_acceleration: G * 20_f64.to_radians().tan(),
-                acceleration_source: "20° tilt limit: crazyflie-firmware \
-                    src/platform/interface/platform_defaults_cf2.h PID_VEL_ROLL_MAX/PID_VEL_PITCH_MAX, \
-                    applied in src/modules/src/controller/position_controller_pid.c",
+                acceleration_source: "20° tilt limit per axis: crazyflie-firmware \
+                    src/platform/interface/platform_defaults_cf2.h:152-153 PID_VEL_ROLL_MAX/PID_VEL_PITCH_MAX, \
+                    applied in src/modules/src/controller/position_controller_pid.c:254-255",
                 max_speed: 1.0,
-                speed_source: "crazyflie-firmware src/platform/interface/platform_defaults_cf2.h \
-                    PID_POS_VEL_X_MAX/PID_POS_VEL_Y_MAX",
+                speed_source: "the Crazyflie app's FORMATION_MAX_SPEED \
+                    (crazyflie-app/src/formation.h); the firmware has no speed limit in velocity mode",
             },
         }
     }

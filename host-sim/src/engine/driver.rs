@@ -97,6 +97,49 @@ pub fn speed_limit_note(model: &Model) -> Option<String> {
     ))
 }
 
+/// Why some bearings are missing at the end, if a camera with a limited field of view
+/// or range leaves an agent without one of its triangles' neighbours at positions `q`
+/// (headings taken as the preset's `heading.initial`, spread ignored): part of the
+/// outcome's reason when the run does not converge.
+pub fn view_note(model: &Model, q: &[[f64; 2]]) -> Option<String> {
+    let cam = model.sensors.camera.as_ref()?;
+    let heading = model.world.heading.map_or(0.0, |h| h.initial);
+    let d = [heading.cos(), heading.sin()];
+    let (cos_half, limited) = ((0.5 * cam.fov).cos(), cam.fov < std::f64::consts::TAU);
+    for t in &model.triangles {
+        for &i in &t.vertices {
+            for &j in t.vertices.iter().filter(|&&j| j != i) {
+                let (Some(a), Some(b)) = (q.get(i), q.get(j)) else {
+                    continue;
+                };
+                let e = [b[0] - a[0], b[1] - a[1]];
+                let r = e[0].hypot(e[1]);
+                let outside = limited && d[0] * e[0] + d[1] * e[1] < r * cos_half;
+                if outside || r > cam.range {
+                    let name = |k: usize| model.agents.get(k).map_or("?", |x| x.name.as_str());
+                    return Some(format!(
+                        "agent {}'s neighbour {} is {} its camera ({}: sensors.camera), \
+                         so it has no bearing to it",
+                        name(i),
+                        name(j),
+                        if outside {
+                            "out of view of"
+                        } else {
+                            "out of range of"
+                        },
+                        if outside {
+                            format!("field of view {:.0}°", cam.fov.to_degrees())
+                        } else {
+                            format!("range {} m at {r:.2} m", cam.range)
+                        }
+                    ));
+                }
+            }
+        }
+    }
+    None
+}
+
 /// Runs `model` in its mode, logging rows to `recorder` and reporting the simulated time
 /// to `progress`.
 pub fn run(
@@ -187,6 +230,10 @@ pub fn drive(
     }
     if verdict.outcome != crate::analysis::Outcome::Converged {
         if let Some(note) = speed_limit_note(model) {
+            reason = format!("{reason}; {note}");
+        }
+        let at: Vec<[f64; 2]> = q.iter().map(|p| [p.x, p.y]).collect();
+        if let Some(note) = view_note(model, &at) {
             reason = format!("{reason}; {note}");
         }
     }

@@ -35,7 +35,9 @@ pub use graph::Graph;
 pub use options::{BearingRate, Estimator, Mode};
 pub use sensing::SensingNoise;
 pub use target::Target;
-pub use world::{ClockModel, HeadingModel, VehicleModel, VelocityTracking, WindModel, WorldModel};
+pub use world::{
+    ClockModel, CrazyfliePid, HeadingModel, VehicleModel, VelocityTracking, WindModel, WorldModel,
+};
 
 use controller_core::{Limits, Schedule};
 

@@ -11,6 +11,25 @@ pub enum VehicleModel {
     /// position/velocity mode, a rover's wheel controller); the agent's force becomes the
     /// setpoint through the virtual mass of `controller_core::actuate`.
     VelocityTracking(VelocityTracking),
+    /// A Crazyflie 2.x flying its firmware's PID cascade in velocity mode
+    /// (`engine::plant::CrazyfliePidPlant`); the agent's force becomes the setpoint as for
+    /// [`VehicleModel::VelocityTracking`].
+    CrazyfliePid(CrazyfliePid),
+}
+
+/// The Crazyflie's cascade: its gains are the firmware's (`engine::plant::firmware`);
+/// what the agent adds is its setpoint limit and lead.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CrazyfliePid {
+    /// The largest velocity setpoint the agent sends (m/s, > 0; the app's
+    /// `FORMATION_MAX_SPEED`: the firmware has none in velocity mode).
+    pub max_speed: f64,
+    /// The lead of the agent's setpoints (s, ≥ 0; SPEC S21); `None`: the cascade's
+    /// derived `engine::plant::derived_lead`.
+    pub lead: Option<f64>,
+    /// The second-order lead of the agent's setpoints (s², ≥ 0; SPEC S21b); `None`: the
+    /// derived `engine::plant::derived_second_lead`.
+    pub second_lead: Option<f64>,
 }
 
 /// A velocity-tracking vehicle: `v̇ = sat_{a_max}((v_sp − v) / τ)`, `|v_sp| ≤ v_max`.
@@ -133,6 +152,7 @@ impl WorldModel {
         match &self.vehicle {
             VehicleModel::PointMass => None,
             VehicleModel::VelocityTracking(v) => Some(v.max_speed),
+            VehicleModel::CrazyfliePid(v) => Some(v.max_speed),
         }
     }
 }

@@ -20,6 +20,14 @@ pub fn add_json(obj: &mut Map<String, Value>, model: &Model) {
             "max_speed_m_s": v.max_speed,
             "lead_s": v.lead,
         }),
+        VehicleModel::CrazyfliePid(v) => json!({
+            "model": "crazyflie_pid",
+            "max_speed_m_s": v.max_speed,
+            "lead_s": v.lead.unwrap_or_else(crate::engine::plant::derived_lead),
+            "second_lead_s2": v
+                .second_lead
+                .unwrap_or_else(crate::engine::plant::derived_second_lead),
+        }),
     };
     let wind = w.wind.map(|x| {
         json!({

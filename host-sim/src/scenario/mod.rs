@@ -26,7 +26,7 @@ pub use settings::{CameraSpec, ChannelSpec, ControllerSpec, Integration, RadioSp
 pub use source::Source;
 pub use strip::strip_model;
 pub use validate::{check_model, validate, validate_text};
-pub use world::{ClockSpec, HeadingSpec, PlantKind, PlantSpec, WindSpec, PRESETS};
+pub use world::{plant_spec, ClockSpec, HeadingSpec, PlantSpec, PlantTable, WindSpec, PRESETS};
 
 use crate::model::Model;
 

@@ -3,7 +3,7 @@
 //! run-wide sections are in [`super::settings`].
 
 use super::settings::{AttackSpec, ControllerSpec, Integration, RadioSpec, SensorSpec};
-use super::world::{ClockSpec, HeadingSpec, PlantSpec, WindSpec};
+use super::world::{ClockSpec, HeadingSpec, PlantTable, WindSpec};
 use crate::model::{Criteria, Mode};
 use serde::{Deserialize, Serialize};
 
@@ -262,9 +262,9 @@ pub struct ScenarioFile {
     /// merged under the file.
     #[serde(default)]
     pub world: Option<String>,
-    /// `[plant]`: the vehicle.
+    /// `[plant]`: the vehicle, as written (resolved by `world::plant_spec`).
     #[serde(default)]
-    pub plant: PlantSpec,
+    pub plant: PlantTable,
     /// `[wind]` (optional).
     #[serde(default)]
     pub wind: Option<WindSpec>,

@@ -5,45 +5,103 @@
 
 use serde::{Deserialize, Serialize};
 
-/// `[plant]`: the vehicle every agent is.
+/// `[plant]` as the file writes it: a table whose `model` picks the vehicle (default
+/// `point_mass`). [`plant_spec`] resolves it into a [`PlantSpec`], refusing every key that
+/// is not the model's.
+pub type PlantTable = toml::Table;
+
+/// `[plant]`: the vehicle every agent is, one variant per `model` with its own keys.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct PlantSpec {
-    /// `point_mass` (SPEC S1, the default) or `velocity_tracking`.
-    pub model: PlantKind,
-    /// `velocity_tracking`: the velocity loop's time constant (s).
-    pub time_constant_s: f64,
-    /// `velocity_tracking`: the largest tilt (degrees); the largest acceleration is
-    /// `g tan(max_tilt_deg)`.
-    pub max_tilt_deg: f64,
-    /// `velocity_tracking`: the largest velocity setpoint (m/s).
-    pub max_speed: f64,
-    /// `velocity_tracking`: the lead of the agents' setpoints (s, SPEC S21); default
-    /// `time_constant_s` (the agents know their vehicle's loop).
-    pub lead_s: Option<f64>,
+#[serde(tag = "model", rename_all = "snake_case", deny_unknown_fields)]
+pub enum PlantSpec {
+    /// SPEC S1 (the default): no keys.
+    PointMass {},
+    /// A vehicle tracking velocity setpoints through a first-order lag.
+    VelocityTracking {
+        /// The velocity loop's time constant (s).
+        #[serde(default = "default_time_constant")]
+        time_constant_s: f64,
+        /// The largest tilt (degrees); the largest acceleration is `g tan(max_tilt_deg)`.
+        #[serde(default = "default_tilt")]
+        max_tilt_deg: f64,
+        /// The largest velocity setpoint (m/s).
+        #[serde(default = "default_speed")]
+        max_speed: f64,
+        /// The lead of the agents' setpoints (s, SPEC S21); default `time_constant_s`.
+        #[serde(default)]
+        lead_s: Option<f64>,
+    },
+    /// A Crazyflie 2.x flying its firmware's PID cascade in velocity mode (the gains are
+    /// the firmware's, `docs/world.md`).
+    CrazyfliePid {
+        /// The largest velocity setpoint the agent sends (m/s; the app's
+        /// `FORMATION_MAX_SPEED`).
+        #[serde(default = "default_speed")]
+        max_speed: f64,
+        /// The lead of the agents' setpoints (s, SPEC S21); default the cascade's
+        /// derived lead `1 / (g K_p)` (0.234 s).
+        #[serde(default)]
+        lead_s: Option<f64>,
+        /// The second-order lead (s², SPEC S21b); default the cascade's derived
+        /// `τ / K_p^a` (0.039 s²).
+        #[serde(default)]
+        second_lead_s2: Option<f64>,
+    },
 }
 
-impl Default for PlantSpec {
-    fn default() -> Self {
-        Self {
-            model: PlantKind::PointMass,
-            time_constant_s: 0.2,
-            max_tilt_deg: 20.0,
-            max_speed: 1.0,
-            lead_s: None,
+fn default_time_constant() -> f64 {
+    0.2
+}
+fn default_tilt() -> f64 {
+    20.0
+}
+fn default_speed() -> f64 {
+    1.0
+}
+
+/// The models `plant.model` may name.
+pub const PLANT_MODELS: &[&str] = &["point_mass", "velocity_tracking", "crazyflie_pid"];
+
+/// `[plant]` resolved: the model's variant, or why not (a key that is not the model's,
+/// an unknown model, a value of the wrong type), naming the key.
+pub fn plant_spec(table: &PlantTable) -> Result<PlantSpec, (String, String)> {
+    let mut t = table.clone();
+    let model = match t.get("model") {
+        None => "point_mass".to_owned(),
+        Some(toml::Value::String(m)) => m.clone(),
+        Some(other) => {
+            return Err((
+                "plant.model".into(),
+                format!(
+                    "must be a string, one of {}; got {other}",
+                    PLANT_MODELS.join(", ")
+                ),
+            ))
         }
+    };
+    if !PLANT_MODELS.contains(&model.as_str()) {
+        return Err((
+            "plant.model".into(),
+            format!(
+                "unknown model `{model}`; the models are {}",
+                PLANT_MODELS.join(", ")
+            ),
+        ));
     }
-}
-
-/// `plant.model`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum PlantKind {
-    /// SPEC S1.
-    #[default]
-    PointMass,
-    /// A vehicle tracking velocity setpoints.
-    VelocityTracking,
+    t.insert("model".into(), toml::Value::String(model.clone()));
+    toml::Value::Table(t).try_into().map_err(|e: toml::de::Error| {
+        let msg = e.message().trim().to_owned();
+        let key = msg
+            .split('`')
+            .nth(1)
+            .filter(|_| msg.starts_with("unknown field"))
+            .map(|k| format!("plant.{k}"))
+            .unwrap_or_else(|| "plant".to_owned());
+        (
+            key,
+            format!("{msg} (for model = \"{model}\"; each model takes only its own keys, docs/world.md)"),
+        )
+    })
 }
 
 /// `[wind]`: a constant part plus first-order gusts, as an acceleration on every agent.
@@ -117,13 +175,27 @@ pub const PRESETS: &[Preset] = &[
         name: "crazyflie",
         toml: include_str!("../../worlds/crazyflie.toml"),
         assumptions: &[
-            "plant.time_constant_s: the velocity loop's time constant is not published",
+            "plant: the rate loop is taken as ideal, the altitude as held and the estimator \
+             as exact",
             "wind: indoor drafts and neighbours' downwash, not measured",
-            "heading: spread, estimate error, drift and noise of a Crazyflie without an \
-             absolute heading source are not published",
             "clock.jitter_s: the app task's tick jitter is not published",
-            "sensors.camera: no bearing camera ships with the Crazyflie; field of view, \
-             range, detection, outliers and latency are assumed",
+            "sensors.positions.noise_m: Lighthouse precision rounded up to 1 mm; its \
+             slowly varying accuracy error is not modelled",
+            "sensors.velocity_noise: assumed estimator quality",
+        ],
+    },
+    Preset {
+        name: "crazyflie-camera",
+        toml: include_str!("../../worlds/crazyflie-camera.toml"),
+        assumptions: &[
+            "plant: the rate loop is taken as ideal, the altitude as held and the estimator \
+             as exact",
+            "wind: indoor drafts and neighbours' downwash, not measured",
+            "heading: spread, estimate error, drift and noise of a gyro-integrated yaw are \
+             not published",
+            "clock.jitter_s: the app task's tick jitter is not published",
+            "sensors.camera: range, detection, outliers and latency of a detector on the \
+             AI-deck are assumed",
             "sensors.bearing_noise_deg, sensors.velocity_noise: assumed sensor quality",
         ],
     },
@@ -137,9 +209,28 @@ pub fn preset(name: &str) -> Option<&'static Preset> {
 /// Merges `under` into `over`: every key of `under` missing from `over` is added, tables
 /// merged recursively (what `over` gives wins).
 pub(super) fn merge_under(over: &mut toml::Table, under: &toml::Table) {
+    // A `[plant]` naming another model than the preset's takes none of the preset's
+    // plant keys (they would be foreign to it).
+    let model = |t: &toml::Table| {
+        t.get("plant")
+            .and_then(|p| p.get("model"))
+            .and_then(|m| m.as_str())
+            .map(str::to_owned)
+    };
+    if let (Some(mine), Some(theirs)) = (model(over), model(under)) {
+        if mine != theirs {
+            let mut under = under.clone();
+            under.remove("plant");
+            return merge_tables(over, &under);
+        }
+    }
+    merge_tables(over, under);
+}
+
+fn merge_tables(over: &mut toml::Table, under: &toml::Table) {
     for (k, v) in under {
         match (over.get_mut(k), v) {
-            (Some(toml::Value::Table(o)), toml::Value::Table(u)) => merge_under(o, u),
+            (Some(toml::Value::Table(o)), toml::Value::Table(u)) => merge_tables(o, u),
             (Some(_), _) => {}
             (None, v) => {
                 over.insert(k.clone(), v.clone());
@@ -163,10 +254,52 @@ mod tests {
                 assert_eq!(file["plant"]["max_speed"].as_float(), Some(0.5));
                 assert_eq!(
                     file["plant"]["model"].as_str(),
-                    Some("velocity_tracking"),
+                    Some("crazyflie_pid"),
                     "{file:?}"
                 );
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod plant_tests {
+    use super::*;
+
+    fn spec(text: &str) -> Result<PlantSpec, (String, String)> {
+        plant_spec(&toml::from_str(text).unwrap())
+    }
+
+    /// No `[plant]` is the point mass; each model takes its own keys with their defaults.
+    #[test]
+    fn each_model_resolves() {
+        assert_eq!(spec(""), Ok(PlantSpec::PointMass {}));
+        assert_eq!(
+            spec("model = \"crazyflie_pid\""),
+            Ok(PlantSpec::CrazyfliePid {
+                max_speed: 1.0,
+                lead_s: None,
+                second_lead_s2: None,
+            })
+        );
+        assert!(matches!(
+            spec("model = \"velocity_tracking\"\ntime_constant_s = 0.3"),
+            Ok(PlantSpec::VelocityTracking { time_constant_s, .. }) if time_constant_s == 0.3
+        ));
+    }
+
+    /// A key of another model is refused, naming the key and the model.
+    #[test]
+    fn foreign_keys_are_refused() {
+        let (key, why) = spec("time_constant_s = 0.3").unwrap_err();
+        assert_eq!(key, "plant.time_constant_s");
+        assert!(why.contains("point_mass"), "{why}");
+        let (key, _) = spec("model = \"crazyflie_pid\"\nmax_tilt_deg = 30.0").unwrap_err();
+        assert_eq!(key, "plant.max_tilt_deg");
+        let (key, why) = spec("model = \"quadrotor\"").unwrap_err();
+        assert_eq!(key, "plant.model");
+        assert!(why.contains("crazyflie_pid"), "{why}");
+        // Negative control: the model's own key passes.
+        assert!(spec("model = \"crazyflie_pid\"\nmax_speed = 0.5").is_ok());
     }
 }

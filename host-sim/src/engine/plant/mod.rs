@@ -1,12 +1,17 @@
 //! The vehicles: what every agent's body does with its controller's output between
 //! ticks. One [`Plant`] per run, holding every agent's state; the paper's point mass S1
-//! ([`PointMass`]) and a velocity-tracking vehicle ([`VelocityTrackingPlant`]).
+//! ([`PointMass`]), a generic velocity-tracking vehicle ([`VelocityTrackingPlant`]) and a
+//! Crazyflie flying its firmware's PID cascade ([`CrazyfliePidPlant`]).
 //! `docs/architecture.md` ("Add a vehicle") says how to add one: a file here and a
 //! variant of [`crate::model::VehicleModel`].
 
+mod crazyflie_pid;
 mod point_mass;
 mod velocity_tracking;
 
+pub use crazyflie_pid::{
+    derived_lead, derived_second_lead, firmware, total_tilt, CrazyfliePidPlant,
+};
 pub use point_mass::{acceleration, PointMass};
 pub use velocity_tracking::{tracking_acceleration, VelocityTrackingPlant};
 
@@ -39,6 +44,15 @@ pub trait Plant: Send + Sync {
     /// Agent `i`'s force of its tick (N, world frame), `period` seconds by its own clock
     /// after its previous tick.
     fn command(&mut self, _i: usize, _force: Vec2<f64>, _period: f64) {}
+    /// Holds agent `i`'s velocity setpoint (m/s, world frame) directly, bypassing the
+    /// virtual mass (`host-sim vehicle step`); false if the vehicle has no velocity loop.
+    fn set_velocity_setpoint(&mut self, _i: usize, _setpoint: Vec2<f64>) -> bool {
+        false
+    }
+    /// Agent `i`'s tilt from vertical (rad), if the vehicle models one.
+    fn tilt(&self, _i: usize) -> Option<f64> {
+        None
+    }
     /// `steps` RK4 steps of length `dt` under `held`; `chunk`: on every thread of the
     /// current rayon pool, `chunk` agents per work item (the same bits either way).
     fn step(&mut self, held: &Held<'_>, dt: f64, steps: usize, chunk: Option<usize>);
@@ -49,5 +63,6 @@ pub fn new_plant(model: &Model) -> Result<Box<dyn Plant>, SetupError> {
     Ok(match &model.world.vehicle {
         VehicleModel::PointMass => Box::new(PointMass::new(model)),
         VehicleModel::VelocityTracking(v) => Box::new(VelocityTrackingPlant::new(model, v)?),
+        VehicleModel::CrazyfliePid(v) => Box::new(CrazyfliePidPlant::new(model, v)?),
     })
 }

@@ -105,6 +105,10 @@ impl Plant for VelocityTrackingPlant {
         }
     }
 
+    fn set_velocity_setpoint(&mut self, i: usize, setpoint: Vec2<f64>) -> bool {
+        self.setpoint.get_mut(i).map(|sp| *sp = setpoint).is_some()
+    }
+
     /// RK4 per agent, the setpoint and wind held over the step.
     fn step(&mut self, held: &Held<'_>, dt: f64, steps: usize, _chunk: Option<usize>) {
         let p = self.vehicle;

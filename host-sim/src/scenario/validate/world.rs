@@ -3,10 +3,11 @@
 
 use super::checker::Checker;
 use crate::model::{
-    ClockModel, HeadingModel, Mode, VehicleModel, VelocityTracking, WindModel, WorldModel,
+    ClockModel, CrazyfliePid, HeadingModel, Mode, VehicleModel, VelocityTracking, WindModel,
+    WorldModel,
 };
 use crate::scenario::error::ErrorKind::InvalidValue;
-use crate::scenario::world::{preset, PlantKind};
+use crate::scenario::world::{plant_spec, preset, PlantSpec};
 use crate::scenario::ScenarioFile;
 
 /// Standard gravity (m/s²): a tilt limit θ gives `g tan θ` of horizontal acceleration.
@@ -22,28 +23,51 @@ pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile, period: f64) -> World
             world.assumptions = p.assumptions.iter().map(|a| (*a).to_owned()).collect();
         }
     }
-    let p = &s.plant;
-    if p.model == PlantKind::VelocityTracking {
-        c.positive(InvalidValue, "plant.time_constant_s", p.time_constant_s);
-        c.positive(InvalidValue, "plant.max_speed", p.max_speed);
-        if !(p.max_tilt_deg.is_finite() && p.max_tilt_deg > 0.0 && p.max_tilt_deg < 90.0) {
-            c.err(
-                InvalidValue,
-                "plant.max_tilt_deg",
-                format!(
-                    "must be above 0 and below 90 degrees, got {}",
-                    p.max_tilt_deg
-                ),
-            );
+    match plant_spec(&s.plant) {
+        Err((field, why)) => c.err(InvalidValue, &field, why),
+        Ok(PlantSpec::PointMass {}) => {}
+        Ok(PlantSpec::VelocityTracking {
+            time_constant_s,
+            max_tilt_deg,
+            max_speed,
+            lead_s,
+        }) => {
+            c.positive(InvalidValue, "plant.time_constant_s", time_constant_s);
+            c.positive(InvalidValue, "plant.max_speed", max_speed);
+            if !(max_tilt_deg.is_finite() && max_tilt_deg > 0.0 && max_tilt_deg < 90.0) {
+                c.err(
+                    InvalidValue,
+                    "plant.max_tilt_deg",
+                    format!("must be above 0 and below 90 degrees, got {max_tilt_deg}"),
+                );
+            }
+            let lead = lead_s.unwrap_or(time_constant_s);
+            c.non_negative(InvalidValue, "plant.lead_s", lead);
+            world.vehicle = VehicleModel::VelocityTracking(VelocityTracking {
+                time_constant: time_constant_s,
+                max_acceleration: G * max_tilt_deg.to_radians().tan(),
+                max_speed,
+                lead,
+            });
         }
-        let lead = p.lead_s.unwrap_or(p.time_constant_s);
-        c.non_negative(InvalidValue, "plant.lead_s", lead);
-        world.vehicle = VehicleModel::VelocityTracking(VelocityTracking {
-            time_constant: p.time_constant_s,
-            max_acceleration: G * p.max_tilt_deg.to_radians().tan(),
-            max_speed: p.max_speed,
-            lead,
-        });
+        Ok(PlantSpec::CrazyfliePid {
+            max_speed,
+            lead_s,
+            second_lead_s2,
+        }) => {
+            c.positive(InvalidValue, "plant.max_speed", max_speed);
+            if let Some(lead) = lead_s {
+                c.non_negative(InvalidValue, "plant.lead_s", lead);
+            }
+            if let Some(second) = second_lead_s2 {
+                c.non_negative(InvalidValue, "plant.second_lead_s2", second);
+            }
+            world.vehicle = VehicleModel::CrazyfliePid(CrazyfliePid {
+                max_speed,
+                lead: lead_s,
+                second_lead: second_lead_s2,
+            });
+        }
     }
     if let Some(w) = &s.wind {
         c.finite2("wind.mean", w.mean);
