@@ -102,14 +102,21 @@ ph_status formation_state_init(formation_state *state, const ph_agent *agent)
     return ph_leader_partner(agent, &state->partner, &state->has_partner);
 }
 
+/* A float log variable, looked up once (`fallback` when the firmware has none). */
+static float log_float(logVarId_t *id, bool *ready, const char *group, const char *name,
+                       float fallback)
+{
+    if (!*ready) {
+        *id = logGetVarId(group, name);
+        *ready = true;
+    }
+    return logVarIdIsValid(*id) ? logGetFloat(*id) : fallback;
+}
+
 /* A log variable of the state estimator (0 when the firmware has none). */
 static float estimate(logVarId_t *id, bool *ready, const char *name)
 {
-    if (!*ready) {
-        *id = logGetVarId("stateEstimate", name);
-        *ready = true;
-    }
-    return logVarIdIsValid(*id) ? logGetFloat(*id) : 0.0f;
+    return log_float(id, ready, "stateEstimate", name, 0.0f);
 }
 
 void formation_read_velocity(float velocity[2])
@@ -146,7 +153,7 @@ static bool is_finite(float x)
 }
 
 bool formation_position_received(formation_state *state, const uint8_t *bytes, size_t len,
-                                 float now)
+                                 uint32_t now_ms)
 {
     if (len != FORMATION_POSITION_LEN || bytes[0] != FORMATION_POSITION_VERSION)
         return false;
@@ -159,7 +166,7 @@ bool formation_position_received(formation_state *state, const uint8_t *bytes, s
         formation_peer *peer = &state->peers[k];
         if (peer->id == bytes[1]) {
             peer->heard = 1;
-            peer->time = now;
+            peer->time_ms = now_ms;
             peer->position[0] = p[0];
             peer->position[1] = p[1];
             return true;
@@ -168,22 +175,42 @@ bool formation_position_received(formation_state *state, const uint8_t *bytes, s
     return false; /* not a neighbour: broadcast radio */
 }
 
-static const formation_peer *fresh(const formation_state *state, uint8_t id, float now)
+static bool is_fresh(const formation_peer *peer, uint32_t now_ms)
+{
+    return peer->heard && (uint32_t)(now_ms - peer->time_ms) <= FORMATION_POSITION_MAX_AGE_MS;
+}
+
+static const formation_peer *fresh(const formation_state *state, uint8_t id, uint32_t now_ms)
 {
     for (size_t k = 0; k < state->peer_count; k++) {
         const formation_peer *peer = &state->peers[k];
         if (peer->id == id)
-            return peer->heard && now - peer->time <= FORMATION_POSITION_MAX_AGE ? peer : NULL;
+            return is_fresh(peer, now_ms) ? peer : NULL;
     }
     return NULL;
 }
 
-size_t formation_read_bearings(const formation_state *state, const float own[2], float now,
-                               ph_bearing *out, size_t capacity)
+void formation_expire(formation_state *state, uint32_t now_ms)
+{
+    for (size_t k = 0; k < state->peer_count; k++)
+        if (!is_fresh(&state->peers[k], now_ms))
+            state->peers[k].heard = 0;
+}
+
+uint8_t formation_heard(const formation_state *state, uint32_t now_ms)
+{
+    uint8_t n = 0;
+    for (size_t k = 0; k < state->peer_count; k++)
+        n += is_fresh(&state->peers[k], now_ms) ? 1u : 0u;
+    return n;
+}
+
+size_t formation_read_bearings(const formation_state *state, const float own[2],
+                               uint32_t now_ms, ph_bearing *out, size_t capacity)
 {
     size_t written = 0;
     for (size_t k = 0; k < state->peer_count && written < capacity; k++) {
-        const formation_peer *peer = fresh(state, state->peers[k].id, now);
+        const formation_peer *peer = fresh(state, state->peers[k].id, now_ms);
         if (peer == NULL)
             continue;
         /* SPEC S2: the bearing g_ij = (q_j - q_i) / |q_j - q_i|, world frame. */
@@ -203,14 +230,46 @@ size_t formation_read_bearings(const formation_state *state, const float own[2],
 }
 
 bool formation_read_partner_offset(const formation_state *state, const float own[2],
-                                   float now, float offset[2])
+                                   uint32_t now_ms, float offset[2])
 {
     if (!state->has_partner)
         return false;
-    const formation_peer *peer = fresh(state, state->partner, now);
+    const formation_peer *peer = fresh(state, state->partner, now_ms);
     if (peer == NULL)
         return false;
     offset[0] = peer->position[0] - own[0];
     offset[1] = peer->position[1] - own[1];
+    return true;
+}
+
+bool formation_positioning_locked(void)
+{
+    static logVarId_t px, py;
+    static bool rx, ry;
+    float vx = log_float(&px, &rx, "kalman", "varPX", __builtin_inff());
+    float vy = log_float(&py, &ry, "kalman", "varPY", __builtin_inff());
+    return vx < FORMATION_POSITION_VAR && vy < FORMATION_POSITION_VAR; /* false for NaN */
+}
+
+/* crazyflie-app/formation.toml's [[agents]] positions, by id (checked by
+ * controller-ffi/tests/crazyflie_app.rs). */
+static const float starts[][2] = {{0.0f, 0.0f}, {0.45f, 1.1f}, {1.1f, 1.4f}, {0.9f, 0.55f},
+                                  {1.55f, 0.95f}};
+
+bool formation_policy(uint8_t id, flight_policy *p)
+{
+    if (id < 1 || id >= sizeof starts / sizeof starts[0])
+        return false;
+    __builtin_memset(p, 0, sizeof *p);
+    p->hold_timeout_ms = FORMATION_HOLD_TIMEOUT_MS;
+    p->fence_min[0] = FORMATION_FENCE_MIN_X;
+    p->fence_min[1] = FORMATION_FENCE_MIN_Y;
+    p->fence_max[0] = FORMATION_FENCE_MAX_X;
+    p->fence_max[1] = FORMATION_FENCE_MAX_Y;
+    p->vbat_land = FORMATION_VBAT_LAND;
+    p->vbat_ms = FORMATION_VBAT_MS;
+    p->start_tolerance = FORMATION_START_TOLERANCE;
+    p->start[0] = starts[id][0];
+    p->start[1] = starts[id][1];
     return true;
 }
