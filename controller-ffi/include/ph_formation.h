@@ -64,10 +64,11 @@
 /**
  * Version of this C ABI (the header's structs and functions; 3: `ph_config` gained
  * `bearing_filter`; 4: `ph_limits` gained `bearing_hold`, `ph_fault` gained
- * `PH_FAULT_NEGATIVE_DT`, `ph_actuator` and `ph_actuator_init` the lead). Compare the header's
- * value with `ph_abi_version()` of the library you link.
+ * `PH_FAULT_NEGATIVE_DT`, `ph_actuator` and `ph_actuator_init` the lead; 5: the safety
+ * policies `ph_policy_*` and `ph_separation_guard`). Compare the header's value with
+ * `ph_abi_version()` of the library you link.
  */
-#define PH_ABI_VERSION 4
+#define PH_ABI_VERSION 5
 
 /**
  * An upper bound of a blob's length: a configuration with every capacity used
@@ -400,6 +401,76 @@ enum ph_fault
 typedef enum ph_fault ph_fault;
 #else
 typedef uint8_t ph_fault;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
+ * What the vehicle should do (`ph_policy_update`).
+ */
+enum ph_policy_action
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint8_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * Fly the formation.
+   */
+  PH_POLICY_FLY = 0,
+  /**
+   * Hold the position.
+   */
+  PH_POLICY_HOLD = 1,
+  /**
+   * Land.
+   */
+  PH_POLICY_LAND = 2,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum ph_policy_action ph_policy_action;
+#else
+typedef uint8_t ph_policy_action;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
+ * Why (`ph_policy_update`, `ph_policy.last_landing`).
+ */
+enum ph_policy_reason
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint8_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * Nothing wrong.
+   */
+  PH_POLICY_NONE = 0,
+  /**
+   * Neighbours or radio lost (holding).
+   */
+  PH_POLICY_LOST = 1,
+  /**
+   * Lost for `hold_timeout_ms` (landing).
+   */
+  PH_POLICY_LOST_TIMEOUT = 2,
+  /**
+   * Outside the flight volume (landing).
+   */
+  PH_POLICY_FENCE = 3,
+  /**
+   * Battery low (landing).
+   */
+  PH_POLICY_BATTERY = 4,
+  /**
+   * Positioning lost (landing).
+   */
+  PH_POLICY_POSITIONING = 5,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum ph_policy_reason ph_policy_reason;
+#else
+typedef uint8_t ph_policy_reason;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
 
@@ -911,6 +982,110 @@ typedef struct {
   float value;
 } ph_estimate;
 
+/**
+ * The policies' state and counts, in caller memory: zero it (`ph_policy_init`) and
+ * hand it to every `ph_policy_update`. The counts are for the log (the app's log group
+ * `formation`).
+ */
+typedef struct {
+  /**
+   * Lost for this long (ms).
+   */
+  uint32_t lost_ms;
+  /**
+   * Battery low for this long (ms).
+   */
+  uint32_t low_ms;
+  /**
+   * Lost at the last update.
+   */
+  uint8_t lost;
+  /**
+   * Low at the last update.
+   */
+  uint8_t low;
+  /**
+   * The landing decided (a `ph_policy_reason`; `PH_POLICY_NONE`: none).
+   */
+  uint8_t landing;
+  /**
+   * The reason of the last landing (a `ph_policy_reason`).
+   */
+  uint8_t last_landing;
+  /**
+   * Ticks answered with `PH_POLICY_HOLD`.
+   */
+  uint32_t hold_ticks;
+  /**
+   * Landings decided.
+   */
+  uint32_t landings;
+  /**
+   * Setpoints `ph_separation_guard` changed.
+   */
+  uint32_t guarded;
+} ph_policy;
+
+/**
+ * The policies' settings (`controller_core::policy::PolicyConfig`).
+ */
+typedef struct {
+  /**
+   * Lost neighbours or radio for this long (ms): land (holding until then).
+   */
+  uint32_t hold_timeout_ms;
+  /**
+   * Non-zero: the flight volume `fence_min`–`fence_max` is checked.
+   */
+  uint8_t fence;
+  /**
+   * The flight volume's lower corner (m, world frame).
+   */
+  float fence_min[2];
+  /**
+   * Its upper corner (m).
+   */
+  float fence_max[2];
+  /**
+   * Battery voltage to land below (V; 0: off).
+   */
+  float battery_land;
+  /**
+   * For this long (ms).
+   */
+  uint32_t battery_ms;
+  /**
+   * Minimum separation of `ph_separation_guard` (m; 0: off).
+   */
+  float min_separation;
+} ph_policy_config;
+
+/**
+ * One tick's inputs of `ph_policy_update`.
+ */
+typedef struct {
+  /**
+   * Milliseconds since the previous update (0 on the first): integer time.
+   */
+  uint32_t dt_ms;
+  /**
+   * Non-zero: this tick's `ph_step` gave the safe output (neighbours or radio lost).
+   */
+  uint8_t lost;
+  /**
+   * Non-zero: the positioning system is locked.
+   */
+  uint8_t positioning;
+  /**
+   * Own position (m, world frame).
+   */
+  float position[2];
+  /**
+   * Battery voltage (V).
+   */
+  float battery;
+} ph_policy_input;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -1118,6 +1293,58 @@ ph_status ph_leader_partner(const ph_agent *agent, uint8_t *partner, uint8_t *is
  * (`longjmp`). See docs/c-api.md.
  */
 extern void ph_panic_hook(void);
+
+/**
+ * Zeroes `*policy`: flying, nothing counted.
+ *
+ * # Safety
+ * `policy` is NULL or writable.
+ */
+ph_status ph_policy_init(ph_policy *policy);
+
+/**
+ * A new flight: the timers and the landing forgotten, the counts kept.
+ *
+ * # Safety
+ * `policy` is NULL or points to a `ph_policy`.
+ */
+ph_status ph_policy_reset(ph_policy *policy);
+
+/**
+ * One tick of the policies (`controller_core::policy::Policy::update`): writes what to
+ * do to `*action` and why to `*why`. `PH_ERR_ARGUMENT` (nothing changed) for settings
+ * that are not finite, a fence with `min > max`, a negative voltage or separation, or
+ * a `*policy` with an unknown reason code.
+ *
+ * # Safety
+ * `policy` is NULL or points to a `ph_policy`; `config` and `in` are NULL or readable;
+ * `action` and `why` are NULL or writable.
+ */
+ph_status ph_policy_update(ph_policy *policy,
+                           const ph_policy_config *config,
+                           const ph_policy_input *in_,
+                           ph_policy_action *action_out,
+                           ph_policy_reason *why);
+
+/**
+ * The minimum-separation guard (`controller_core::policy::separation_guard`):
+ * removes from `setpoint[0..2]` (velocity or force, world frame) its component towards
+ * every neighbour of `neighbours[0..2·count]` (x, y pairs) closer to `own[0..2]` than
+ * `config->min_separation`; a neighbour closer than 1 mm stops it. Counts a change in
+ * `policy->guarded`. `PH_ERR_ARGUMENT` as for `ph_policy_update`.
+ *
+ * # Safety
+ * `policy` and `config` as for `ph_policy_update`; `own` is NULL or 2 readable floats;
+ * `neighbours` is NULL (only with `count` 0) or `2·count` readable floats, `count` at
+ * most `PH_MAX_NEIGHBOURS` (more: `PH_ERR_ARGUMENT`); `setpoint`
+ * is NULL or 2 readable and writable floats.
+ */
+ph_status ph_separation_guard(ph_policy *policy,
+                              const ph_policy_config *config,
+                              const float *own,
+                              const float *neighbours,
+                              size_t count,
+                              float *setpoint);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -48,6 +48,7 @@ pub mod config;
 // own handler uses controller-core directly, not this crate).
 #[cfg(target_os = "none")]
 mod panic;
+pub mod policy;
 pub mod status;
 pub mod storage;
 pub mod tick;
@@ -78,9 +79,10 @@ pub const PH_MAX_FRAMES_PER_TICK: usize = (PH_MAX_TRIANGLES + 3) / 4 + 1;
 pub const PH_MAX_OWNED_ESTIMATES: usize = 4 * PH_MAX_TRIANGLES;
 /// Version of this C ABI (the header's structs and functions; 3: `ph_config` gained
 /// `bearing_filter`; 4: `ph_limits` gained `bearing_hold`, `ph_fault` gained
-/// `PH_FAULT_NEGATIVE_DT`, `ph_actuator` and `ph_actuator_init` the lead). Compare the header's
-/// value with `ph_abi_version()` of the library you link.
-pub const PH_ABI_VERSION: u32 = 4;
+/// `PH_FAULT_NEGATIVE_DT`, `ph_actuator` and `ph_actuator_init` the lead; 5: the safety
+/// policies `ph_policy_*` and `ph_separation_guard`). Compare the header's value with
+/// `ph_abi_version()` of the library you link.
+pub const PH_ABI_VERSION: u32 = 5;
 
 /// The agent behind the C API.
 pub type FfiAgent = controller_core::Agent<f32, PH_MAX_TRIANGLES, PH_MAX_NEIGHBOURS>;

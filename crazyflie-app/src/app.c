@@ -95,6 +95,9 @@ static uint8_t log_neighbours;  /* neighbours in the formation */
 static uint32_t log_safe_ticks; /* ticks with the controller's safe output */
 static uint32_t log_refusals;   /* enable refused by the pre-flight checks */
 static uint8_t log_ph_fault;    /* the controller's ph_fault this tick */
+static uint32_t log_hold_ticks; /* policy: ticks holding (lost neighbours or radio) */
+static uint32_t log_guarded;    /* policy: setpoints the separation guard changed */
+static uint32_t log_landings;   /* policy: landings decided */
 
 LOG_GROUP_START(formation)
 LOG_ADD(LOG_UINT8, state, &log_state)
@@ -104,6 +107,9 @@ LOG_ADD(LOG_UINT8, heard, &log_heard)
 LOG_ADD(LOG_UINT8, neighbours, &log_neighbours)
 LOG_ADD(LOG_UINT32, refusals, &log_refusals)
 LOG_ADD(LOG_UINT8, phFault, &log_ph_fault)
+LOG_ADD(LOG_UINT32, holdTicks, &log_hold_ticks)
+LOG_ADD(LOG_UINT32, guarded, &log_guarded)
+LOG_ADD(LOG_UINT32, landings, &log_landings)
 LOG_GROUP_STOP(formation)
 
 /* Radio link task: queue the packet for the app task (the agent is not thread-safe:
@@ -208,6 +214,9 @@ void appMain(void)
          * schedules' clock restarts unless holding. */
         if (fl.state != FLIGHT_FORMATION)
             agent_loop_restart(&loop, now, fl.state != FLIGHT_HOLD);
+        if (action == FLIGHT_ACT_SETPOINT)
+            formation_guard(&loop.formation, now, &fl.policy, &policy.core, position,
+                            loop.setpoint);
         commands_apply(action, &fl, loop.setpoint, position);
 
         report(&loop, now, before);
@@ -218,5 +227,8 @@ void appMain(void)
         log_safe_ticks = loop.safe_ticks;
         log_refusals = fl.refusals;
         log_ph_fault = (uint8_t)loop.out.fault;
+        log_hold_ticks = fl.policy.hold_ticks;
+        log_guarded = fl.policy.guarded;
+        log_landings = fl.policy.landings;
     }
 }

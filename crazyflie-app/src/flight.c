@@ -7,6 +7,7 @@ void flight_init(flight *f)
 {
     __builtin_memset(f, 0, sizeof *f);
     f->state = FLIGHT_IDLE;
+    (void)ph_policy_init(&f->policy);
 }
 
 static flight_action enter(flight *f, flight_state s, flight_fault why, flight_action act)
@@ -33,26 +34,15 @@ static flight_fault preflight(const flight_policy *p, const flight_inputs *in)
     return FLIGHT_FAULT_NONE;
 }
 
-static bool outside_fence(const flight_policy *p, const float q[2])
+/* The landing fault of a policy reason. */
+static flight_fault landing_fault(ph_policy_reason why)
 {
-    for (int k = 0; k < 2; k++)
-        if (!(q[k] >= p->fence_min[k] && q[k] <= p->fence_max[k]))
-            return true; /* NaN is outside */
-    return false;
-}
-
-/* Battery low for vbat_ms (the voltage sags under load: a short dip is no reason). */
-static bool battery_low(flight *f, const flight_policy *p, const flight_inputs *in)
-{
-    if (!(p->vbat_land > 0.0f) || !(in->vbat < p->vbat_land)) {
-        f->low = false;
-        return false;
+    switch (why) {
+    case PH_POLICY_FENCE: return FLIGHT_FAULT_FENCE;
+    case PH_POLICY_BATTERY: return FLIGHT_FAULT_BATTERY;
+    case PH_POLICY_POSITIONING: return FLIGHT_FAULT_POSITIONING;
+    default: return FLIGHT_FAULT_LOST_TIMEOUT;
     }
-    if (!f->low) {
-        f->low = true;
-        f->low_ms = in->now_ms;
-    }
-    return (uint32_t)(in->now_ms - f->low_ms) >= p->vbat_ms;
 }
 
 flight_action flight_update(flight *f, const flight_policy *p, const flight_inputs *in)
@@ -60,7 +50,8 @@ flight_action flight_update(flight *f, const flight_policy *p, const flight_inpu
     bool rising = in->enable && !f->last_enable;
     f->last_enable = in->enable;
     f->restart = false;
-    bool low = battery_low(f, p, in);
+    uint32_t dt_ms = (uint32_t)(in->now_ms - f->last_ms); /* modulo 2^32 */
+    f->last_ms = in->now_ms;
 
     /* The supervisor always wins. */
     if (!in->flying && f->state != FLIGHT_IDLE) {
@@ -82,32 +73,37 @@ flight_action flight_update(flight *f, const flight_policy *p, const flight_inpu
             }
         }
         f->restart = true;
+        (void)ph_policy_reset(&f->policy); /* a new flight: the policies' timers at 0 */
+        f->last_ms = in->now_ms;
         return enter(f, FLIGHT_FORMATION, FLIGHT_FAULT_NONE, FLIGHT_ACT_SETPOINT);
     case FLIGHT_FORMATION:
-    case FLIGHT_HOLD:
+    case FLIGHT_HOLD: {
         if (!in->enable)
             return enter(f, FLIGHT_IDLE, FLIGHT_FAULT_NONE, FLIGHT_ACT_RELEASE);
-        if (!in->positioning)
-            return enter(f, FLIGHT_LANDING, FLIGHT_FAULT_POSITIONING, FLIGHT_ACT_LAND);
-        if (outside_fence(p, in->position))
-            return enter(f, FLIGHT_LANDING, FLIGHT_FAULT_FENCE, FLIGHT_ACT_LAND);
-        if (low)
-            return enter(f, FLIGHT_LANDING, FLIGHT_FAULT_BATTERY, FLIGHT_ACT_LAND);
-        if (f->state == FLIGHT_FORMATION) {
-            if (!in->controller_safe)
-                return FLIGHT_ACT_SETPOINT;
-            f->since_ms = in->now_ms;
-            f->hold[0] = in->position[0];
-            f->hold[1] = in->position[1];
+        ph_policy_input pi = {
+            .dt_ms = dt_ms,
+            .lost = in->controller_safe ? 1u : 0u,
+            .positioning = in->positioning ? 1u : 0u,
+            .position = {in->position[0], in->position[1]},
+            .battery = in->vbat,
+        };
+        ph_policy_action act = PH_POLICY_LAND;
+        ph_policy_reason why = PH_POLICY_NONE;
+        if (ph_policy_update(&f->policy, &p->core, &pi, &act, &why) != PH_OK)
+            return enter(f, FLIGHT_LANDING, FLIGHT_FAULT_SETTINGS, FLIGHT_ACT_LAND);
+        if (act == PH_POLICY_LAND)
+            return enter(f, FLIGHT_LANDING, landing_fault(why), FLIGHT_ACT_LAND);
+        if (act == PH_POLICY_HOLD) {
+            if (f->state == FLIGHT_FORMATION) {
+                f->hold[0] = in->position[0];
+                f->hold[1] = in->position[1];
+            }
             return enter(f, FLIGHT_HOLD, FLIGHT_FAULT_LOST, FLIGHT_ACT_HOLD);
         }
-        if (!in->controller_safe) {
+        if (f->state == FLIGHT_HOLD)
             f->restart = true;
-            return enter(f, FLIGHT_FORMATION, FLIGHT_FAULT_NONE, FLIGHT_ACT_SETPOINT);
-        }
-        if ((uint32_t)(in->now_ms - f->since_ms) >= p->hold_timeout_ms)
-            return enter(f, FLIGHT_LANDING, FLIGHT_FAULT_LOST_TIMEOUT, FLIGHT_ACT_LAND);
-        return FLIGHT_ACT_HOLD;
+        return enter(f, FLIGHT_FORMATION, FLIGHT_FAULT_NONE, FLIGHT_ACT_SETPOINT);
+    }
     case FLIGHT_LANDING:
     default:
         return FLIGHT_ACT_NONE; /* the high-level commander lands; the supervisor ends it */
@@ -127,6 +123,7 @@ const char *flight_fault_str(flight_fault f)
         "refused: neighbours not heard", "refused: away from the initial position",
         "supervisor",    "lost: holding",       "lost: landing",
         "fence: landing", "battery: landing",   "positioning lost: landing",
+        "policy settings refused: landing",
     };
     return (unsigned)f < sizeof names / sizeof names[0] ? names[f] : "?";
 }

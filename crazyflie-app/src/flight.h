@@ -20,11 +20,17 @@
  * Whatever the state: the supervisor not flying (emergency stop, crash, landed,
  * locked) -> IDLE at once, the priority relaxed, no setpoint ever again until the
  * next rising edge of enable.
+ *
+ * The policies (hold, then land when lost; fence; positioning; battery) are the
+ * core's, through the C API (ph_policy_update, controller-core/src/policy.rs): the
+ * simulator runs the same code (host-sim's [policy] keys, docs/scenarios.md).
  */
 #pragma once
 
 #include <stdbool.h>
 #include <stdint.h>
+
+#include "ph_formation.h"
 
 typedef enum {
     FLIGHT_IDLE = 0,
@@ -46,6 +52,7 @@ typedef enum {
     FLIGHT_FAULT_FENCE = 8,         /* landing: outside the flight volume */
     FLIGHT_FAULT_BATTERY = 9,       /* landing: battery low */
     FLIGHT_FAULT_POSITIONING = 10,  /* landing: positioning lost in flight */
+    FLIGHT_FAULT_SETTINGS = 11,     /* landing: ph_policy_update refused the settings */
 } flight_fault;
 
 /* What the app does with the commander this tick (app.c, flight_apply()). */
@@ -58,15 +65,12 @@ typedef enum {
     FLIGHT_ACT_RELAX = 5,    /* relax the priority only (the supervisor stopped flying) */
 } flight_action;
 
-/* The policies' settings. */
+/* The policies' settings: the core's (hold timeout, fence, battery, separation) and
+ * the pre-flight check's reference. */
 typedef struct {
-    uint32_t hold_timeout_ms; /* HOLD longer than this: land */
-    float fence_min[2];       /* flight volume (m, world frame) */
-    float fence_max[2];
-    float vbat_land;          /* V: below it for vbat_ms: land (0: off) */
-    uint32_t vbat_ms;
-    float start_tolerance;    /* m: pre-flight, own position from its initial one */
-    float start[2];           /* own initial position (the scenario's) */
+    ph_policy_config core;
+    float start_tolerance; /* m: pre-flight, own position from its initial one */
+    float start[2];        /* own initial position (the scenario's) */
 } flight_policy;
 
 /* What the app knows at one tick. */
@@ -86,9 +90,8 @@ typedef struct {
     flight_state state;
     flight_fault fault;
     uint8_t last_enable;
-    uint32_t since_ms;    /* entry into HOLD */
-    uint32_t low_ms;      /* start of the low battery (valid with low) */
-    bool low;
+    uint32_t last_ms;     /* the previous update (the policies' dt) */
+    ph_policy policy;     /* the core's policies: timers and counts */
     bool restart;         /* FORMATION entered this tick: restart the actuator */
     float hold[2];        /* the position held in HOLD */
     uint32_t refusals;    /* enable refused by the pre-flight checks */

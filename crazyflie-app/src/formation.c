@@ -261,15 +261,34 @@ bool formation_policy(uint8_t id, flight_policy *p)
     if (id < 1 || id >= sizeof starts / sizeof starts[0])
         return false;
     __builtin_memset(p, 0, sizeof *p);
-    p->hold_timeout_ms = FORMATION_HOLD_TIMEOUT_MS;
-    p->fence_min[0] = FORMATION_FENCE_MIN_X;
-    p->fence_min[1] = FORMATION_FENCE_MIN_Y;
-    p->fence_max[0] = FORMATION_FENCE_MAX_X;
-    p->fence_max[1] = FORMATION_FENCE_MAX_Y;
-    p->vbat_land = FORMATION_VBAT_LAND;
-    p->vbat_ms = FORMATION_VBAT_MS;
+    p->core.hold_timeout_ms = FORMATION_HOLD_TIMEOUT_MS;
+    p->core.fence = 1;
+    p->core.fence_min[0] = FORMATION_FENCE_MIN_X;
+    p->core.fence_min[1] = FORMATION_FENCE_MIN_Y;
+    p->core.fence_max[0] = FORMATION_FENCE_MAX_X;
+    p->core.fence_max[1] = FORMATION_FENCE_MAX_Y;
+    p->core.battery_land = FORMATION_VBAT_LAND;
+    p->core.battery_ms = FORMATION_VBAT_MS;
+    p->core.min_separation = FORMATION_MIN_SEPARATION;
     p->start_tolerance = FORMATION_START_TOLERANCE;
     p->start[0] = starts[id][0];
     p->start[1] = starts[id][1];
     return true;
+}
+
+void formation_guard(const formation_state *state, uint32_t now_ms, ph_policy *policy,
+                     const ph_policy_config *config, const float own[2], float setpoint[2])
+{
+    float near[PH_MAX_NEIGHBOURS][2];
+    size_t n = 0;
+    for (size_t k = 0; k < state->peer_count && n < PH_MAX_NEIGHBOURS; k++) {
+        const formation_peer *peer = &state->peers[k];
+        if (!is_fresh(peer, now_ms))
+            continue;
+        near[n][0] = peer->position[0];
+        near[n][1] = peer->position[1];
+        n++;
+    }
+    if (ph_separation_guard(policy, config, own, &near[0][0], n, setpoint) != PH_OK)
+        setpoint[0] = setpoint[1] = 0.0f; /* refused settings: no motion */
 }

@@ -120,8 +120,9 @@ bool formation_positioning_locked(void);
  * crazyflie-app/formation.toml (the pre-flight check's reference, within
  * FORMATION_START_TOLERANCE), the flight volume, the low-battery landing (pm.vbat
  * below FORMATION_VBAT_LAND for FORMATION_VBAT_MS: the Crazyflie 2.x's
- * DEFAULT_BAT_LOW_VOLTAGE, platform_defaults_cf2.h:37) and the hold before a landing
- * when neighbours or radio are lost. false: no agent `id`. */
+ * DEFAULT_BAT_LOW_VOLTAGE, platform_defaults_cf2.h:37), the hold before a landing
+ * when neighbours or radio are lost and the minimum separation of the setpoint guard
+ * (the core's policies, ph_policy_config). false: no agent `id`. */
 #define FORMATION_START_TOLERANCE 0.3f
 #define FORMATION_FENCE_MIN_X -0.5f
 #define FORMATION_FENCE_MIN_Y -0.5f
@@ -130,4 +131,11 @@ bool formation_positioning_locked(void);
 #define FORMATION_VBAT_LAND 3.2f
 #define FORMATION_VBAT_MS 2000u
 #define FORMATION_HOLD_TIMEOUT_MS 2000u
+#define FORMATION_MIN_SEPARATION 0.3f
 bool formation_policy(uint8_t id, flight_policy *policy);
+
+/* The minimum-separation guard (the core's, ph_separation_guard) on the velocity
+ * `setpoint` against every neighbour whose position is fresh at `now_ms`; a change is
+ * counted in policy->guarded. */
+void formation_guard(const formation_state *state, uint32_t now_ms, ph_policy *policy,
+                     const ph_policy_config *config, const float own[2], float setpoint[2]);

@@ -156,7 +156,7 @@ static void lost(void)
         uint32_t lost_at = in.now_ms;
         /* Negative control: just before the timeout, still holding. */
         int holding = 1;
-        for (in.now_ms = lost_at + 10u; in.now_ms != lost_at + pol.hold_timeout_ms;
+        for (in.now_ms = lost_at + 10u; in.now_ms != lost_at + pol.core.hold_timeout_ms;
              in.now_ms += 10u)
             holding &= flight_update(&f, &pol, &in) == FLIGHT_ACT_HOLD;
         a = flight_update(&f, &pol, &in);
@@ -238,10 +238,10 @@ static void battery(void)
         flight_inputs in = healthy(starts[s] + 20u);
         in.enable = 1;
         /* Negative control: a dip shorter than vbat_ms. */
-        in.vbat = pol.vbat_land - 0.1f;
+        in.vbat = pol.core.battery_land - 0.1f;
         int flying = 1;
         uint32_t t = in.now_ms;
-        for (; t != in.now_ms + pol.vbat_ms - 10u; t += 10u) {
+        for (; t != in.now_ms + pol.core.battery_ms - 10u; t += 10u) {
             flight_inputs k = in;
             k.now_ms = t;
             flying &= flight_update(&f, &pol, &k) == FLIGHT_ACT_SETPOINT;
@@ -253,13 +253,13 @@ static void battery(void)
         /* Low for vbat_ms: land. */
         uint32_t t1 = t + 10u, u = t1;
         flight_action a = FLIGHT_ACT_SETPOINT;
-        for (; a == FLIGHT_ACT_SETPOINT && u != t1 + pol.vbat_ms + 100u; u += 10u) {
+        for (; a == FLIGHT_ACT_SETPOINT && u != t1 + pol.core.battery_ms + 100u; u += 10u) {
             k.now_ms = u;
-            k.vbat = pol.vbat_land - 0.1f;
+            k.vbat = pol.core.battery_land - 0.1f;
             a = flight_update(&f, &pol, &k);
         }
         check(flying && a == FLIGHT_ACT_LAND && f.fault == FLIGHT_FAULT_BATTERY &&
-                  u - 10u - t1 == pol.vbat_ms,
+                  u - 10u - t1 == pol.core.battery_ms,
               s == 0 ? "low_battery_lands" : s == 1 ? "low_battery_lands_across_the_wrap"
                                                      : "low_battery_lands_after_a_year",
               flying ? "no landing after vbat_ms" : "a short dip landed");
@@ -460,6 +460,54 @@ static void positions_across_the_wrap(void)
           "expired_position_stays_stale_after_the_wrap", "an old position looked fresh");
 }
 
+/* The separation guard (the core's) on the app's setpoint: the approach to a close
+ * neighbour is removed and counted; a far one (negative control) changes nothing. */
+static void guard(void)
+{
+    formation_state st;
+    __builtin_memset(&st, 0, sizeof st);
+    st.peer_count = 1;
+    st.peers[0].id = 2;
+    uint8_t pkt[FORMATION_POSITION_LEN];
+    float own[2] = {1.0f, 1.0f};
+    for (int close = 1; close >= 0; close--) {
+        float q[2] = {own[0] + (close ? 0.2f : 0.5f), own[1]};
+        size_t n = formation_position_packet(2, q, pkt, sizeof pkt);
+        (void)formation_position_received(&st, pkt, n, 1000u);
+        ph_policy policy;
+        (void)ph_policy_init(&policy);
+        float v[2] = {0.4f, 0.3f};
+        formation_guard(&st, 1010u, &policy, &pol.core, own, v);
+        if (close)
+            check(v[0] == 0.0f && v[1] == 0.3f && policy.guarded == 1,
+                  "separation_guard_stops_the_approach", "the approach was kept");
+        else
+            check(v[0] == 0.4f && v[1] == 0.3f && policy.guarded == 0,
+                  "separation_guard_leaves_far_neighbours", "a far neighbour changed the setpoint");
+    }
+}
+
+/* Settings the core refuses land at once (negative control: the shipped ones fly). */
+static void refused_settings(void)
+{
+    flight_policy bad = pol;
+    bad.core.fence_min[0] = bad.core.fence_max[0] + 1.0f;
+    for (int b = 0; b < 2; b++) {
+        flight f;
+        flight_init(&f);
+        flight_inputs in = healthy(0);
+        in.enable = 1;
+        (void)flight_update(&f, b ? &bad : &pol, &in);
+        in.now_ms = 10;
+        flight_action a = flight_update(&f, b ? &bad : &pol, &in);
+        if (b)
+            check(a == FLIGHT_ACT_LAND && f.fault == FLIGHT_FAULT_SETTINGS,
+                  "refused_policy_settings_land", "flew with refused settings");
+        else
+            check(a == FLIGHT_ACT_SETPOINT, "shipped_policy_settings_fly", "shipped settings land");
+    }
+}
+
 /* The positioning check reads the Kalman filter's variances (the model's). */
 static void positioning(void)
 {
@@ -488,6 +536,8 @@ int main(void)
     the_model_sees_the_bugs();
     positions_across_the_wrap();
     positioning();
+    guard();
+    refused_settings();
     /* The policies' initial positions (crazyflie_app.rs compares formation.toml). */
     for (uint8_t id = 1; id <= 4; id++) {
         flight_policy p;
