@@ -101,7 +101,8 @@ cfapp-flight)
     lib=$target_dir/release/libcontroller_ffi.a
     "${CC:-cc}" "${cflags[@]}" "${app_cflags[@]}" -o "$out/cfapp-flight" \
         "$app/test/flight_test.c" "$app/test/firmware_model.c" "$app/src/flight.c" \
-        "$app/src/commands.c" "$app/src/formation.c" "$app/src/blobs/ph_blobs.c" \
+        "$app/src/commands.c" "$app/src/epoch.c" "$app/src/formation.c" \
+        "$app/src/blobs/ph_blobs.c" \
         "$lib" -lgcc_s -lutil -lrt -lpthread -lm -ldl
     echo "$out/cfapp-flight"
     ;;

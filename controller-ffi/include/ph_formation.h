@@ -504,6 +504,38 @@ typedef uint8_t ph_estimator;
 #endif // __cplusplus
 
 /**
+ * How frames are protected (values of `ph_config.integrity`); the same for every agent
+ * of a swarm (see `docs/core.md`, wire format).
+ */
+enum ph_integrity
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint8_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * A CRC-16 trailer: raw UART or any link without its own check. Default.
+   */
+  PH_INTEGRITY_CRC16 = 0,
+  /**
+   * No trailer: the link checks its own CRC (the Crazyflie radio does).
+   */
+  PH_INTEGRITY_LINK = 1,
+  /**
+   * A 64-bit SipHash-2-4 tag under the swarm key `ph_config.auth_key` and replay
+   * protection (see `docs/core.md`, "auth"); call `ph_agent_set_boot_epoch` after
+   * `ph_agent_init*`.
+   */
+  PH_INTEGRITY_AUTH = 2,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum ph_integrity ph_integrity;
+#else
+typedef uint8_t ph_integrity;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
  * Which end of the leader edge an agent is (values of `ph_leader.role`; S11 with
  * `z = q_a − q_b`).
  */

@@ -51,6 +51,7 @@ fn sources() -> Vec<PathBuf> {
         "formation.c",
         "flight.c",
         "commands.c",
+        "epoch.c",
         "blobs/ph_blobs.c",
     ]
     .iter()
@@ -384,6 +385,9 @@ fn flight_states_against_the_firmware_model() {
         "separation_guard_leaves_far_neighbours",
         "refused_policy_settings_land",
         "shipped_policy_settings_fly",
+        "boot_epoch_increments_and_persists",
+        "rebooted_agent_heard_at_once_under_auth",
+        "reboot_without_a_new_epoch_is_a_replay",
     ] {
         assert!(
             log.lines().any(|l| l == format!("FLIGHT ok {name}")),

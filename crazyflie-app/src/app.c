@@ -44,6 +44,7 @@
 
 #include "agent_loop.h"
 #include "commands.h"
+#include "epoch.h"
 #include "flight.h"
 #include "ph_formation.h"
 
@@ -174,6 +175,19 @@ void appMain(void)
     rx_queue = xQueueCreate(RX_QUEUE_LEN, sizeof(rx_packet));
     if (rx_queue == NULL) {
         DEBUG_PRINT("no memory for the P2P queue\n");
+        return;
+    }
+    /* Authenticated frames: this boot's epoch, one more than the last boot's (kept in
+     * the storage), so that neighbours accept our frames at once (epoch.h). Without
+     * auth the call changes nothing. */
+    uint32_t epoch = 0;
+    if (!formation_next_boot_epoch(&epoch)) {
+        DEBUG_PRINT("no boot epoch (storage): no formation\n");
+        return;
+    }
+    s = ph_agent_set_boot_epoch(loop.agent, epoch);
+    if (s != PH_OK) {
+        DEBUG_PRINT("boot epoch: %s\n", ph_status_str(s));
         return;
     }
     if (!formation_policy(id, &policy)) {

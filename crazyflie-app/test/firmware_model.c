@@ -8,6 +8,7 @@
 #include "commander.h"
 #include "crtp_commander_high_level.h"
 #include "pm.h"
+#include "storage.h"
 #include "supervisor.h"
 
 firmware_model fw;
@@ -147,6 +148,31 @@ bool supervisorIsLocked(void)
 float pmGetBatteryVoltage(void)
 {
     return fw.vbat;
+}
+
+/* The persistent storage (storage.h): one entry, survives fw_reset (a reboot). */
+static char stored_key[32];
+static uint8_t stored[16];
+static size_t stored_len;
+bool fw_storage_fails;
+
+bool storageStore(const char *key, const void *buffer, size_t length)
+{
+    if (fw_storage_fails || length > sizeof stored || __builtin_strlen(key) >= sizeof stored_key)
+        return false;
+    __builtin_strcpy(stored_key, key);
+    __builtin_memcpy(stored, buffer, length);
+    stored_len = length;
+    return true;
+}
+
+size_t storageFetch(const char *key, void *buffer, size_t length)
+{
+    if (stored_len == 0 || __builtin_strcmp(key, stored_key) != 0)
+        return 0;
+    size_t n = length < stored_len ? length : stored_len;
+    __builtin_memcpy(buffer, stored, n);
+    return n;
 }
 
 /* The log variables the app reads (log.h): kalman.varPX, varPY (small with

@@ -50,3 +50,5 @@ void fw_takeoff(float height, float duration_s);
 void fw_emergency_stop(void);
 /* One 10 ms stabilizer tick at fw.now_ms (then advance fw.now_ms). */
 void fw_stabilizer_tick(void);
+/* The storage refuses to store (storage.h's storageStore returns false). */
+extern bool fw_storage_fails;

@@ -13,6 +13,7 @@
 #include "commander.h"
 #include "commands.h"
 #include "crtp_commander_high_level.h"
+#include "epoch.h"
 #include "firmware_model.h"
 #include "flight.h"
 #include "formation.h"
@@ -508,6 +509,72 @@ static void refused_settings(void)
     }
 }
 
+/* The boot epoch: 1, 2, ... across reboots (the storage survives them); a storage
+ * that fails gives none. */
+static void boot_epochs(void)
+{
+    uint32_t e1 = 0, e2 = 0, e3 = 0;
+    bool ok = formation_next_boot_epoch(&e1) && formation_next_boot_epoch(&e2);
+    fw_storage_fails = true;
+    bool refused = !formation_next_boot_epoch(&e3);
+    fw_storage_fails = false;
+    check(ok && e2 == e1 + 1 && refused, "boot_epoch_increments_and_persists",
+          "the epoch does not increment, or a failed store gave one");
+}
+
+/* Agent 1 of formation.c's struct with auth; `memory` its PH_AGENT_SIZE bytes. */
+static ph_agent *auth_agent(uint8_t *memory, uint8_t id)
+{
+    static ph_config c;
+    if (formation_config(id, &c) != PH_OK)
+        return NULL;
+    c.integrity = PH_INTEGRITY_AUTH;
+    for (int k = 0; k < 16; k++)
+        c.auth_key[k] = (uint8_t)(0xA5 ^ k);
+    ph_agent *a = (ph_agent *)memory;
+    return ph_agent_init(a, PH_AGENT_SIZE, &c) == PH_OK ? a : NULL;
+}
+
+/* The first frame of a's broadcast, received by b: its status. */
+static ph_status first_frame(ph_agent *a, ph_agent *b)
+{
+    uint8_t frames[PH_MAX_FRAMES_PER_TICK][PH_MAX_FRAME_LEN];
+    uint8_t lens[PH_MAX_FRAMES_PER_TICK];
+    size_t n = 0;
+    if (ph_frames(a, frames, lens, PH_MAX_FRAMES_PER_TICK, &n) != PH_OK || n == 0)
+        return PH_ERR_ARGUMENT;
+    return ph_receive(b, frames[0], lens[0]);
+}
+
+/* Under auth a rebooted agent is heard again from its first frame with the next boot
+ * epoch; rebooted with the same epoch (negative control: no persisted epoch), its
+ * frames are replays to its neighbour. */
+static void reboot_under_auth(void)
+{
+    static uint8_t ma[PH_AGENT_SIZE] __attribute__((aligned(PH_AGENT_ALIGN)));
+    static uint8_t mb[PH_AGENT_SIZE] __attribute__((aligned(PH_AGENT_ALIGN)));
+    ph_agent *b = auth_agent(mb, 3);
+    uint32_t e = 0;
+    ph_agent *a = auth_agent(ma, 1);
+    bool setup = a != NULL && b != NULL && formation_next_boot_epoch(&e) &&
+                 ph_agent_set_boot_epoch(a, e) == PH_OK;
+    ph_status before = setup ? first_frame(a, b) : PH_ERR_ARGUMENT;
+    /* Reboot with the persisted epoch + 1. */
+    a = auth_agent(ma, 1);
+    uint32_t e2 = 0;
+    bool next = a != NULL && formation_next_boot_epoch(&e2) && ph_agent_set_boot_epoch(a, e2) == PH_OK;
+    ph_status after = next ? first_frame(a, b) : PH_ERR_ARGUMENT;
+    /* Reboot with the same epoch again. */
+    a = auth_agent(ma, 1);
+    ph_status same = a != NULL && ph_agent_set_boot_epoch(a, e2) == PH_OK ? first_frame(a, b)
+                                                                           : PH_ERR_ARGUMENT;
+    char what[128];
+    snprintf(what, sizeof what, "before %s, after reboot %s, same epoch %s", ph_status_str(before),
+             ph_status_str(after), ph_status_str(same));
+    check(before == PH_OK && after == PH_OK, "rebooted_agent_heard_at_once_under_auth", what);
+    check(same == PH_ERR_FRAME_REPLAYED, "reboot_without_a_new_epoch_is_a_replay", what);
+}
+
 /* The positioning check reads the Kalman filter's variances (the model's). */
 static void positioning(void)
 {
@@ -538,6 +605,8 @@ int main(void)
     positioning();
     guard();
     refused_settings();
+    boot_epochs();
+    reboot_under_auth();
     /* The policies' initial positions (crazyflie_app.rs compares formation.toml). */
     for (uint8_t id = 1; id <= 4; id++) {
         flight_policy p;
