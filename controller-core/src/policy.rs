@@ -251,7 +251,10 @@ fn pick<T: Copy>(x: &[T; 2], k: usize) -> T {
 }
 
 /// Distance below which two positions count as coincident (m): no direction between
-/// them, so a guarded setpoint stops.
+/// them. The one rule for near-coincident neighbours: a guarded setpoint stops
+/// ([`separation_guard`]), and a bearing from shared positions is not measured (the
+/// Crazyflie app's `formation_read_bearings` through the C API's `PH_COINCIDENT_M`,
+/// host-sim's `SharedPositions`).
 pub const COINCIDENT: f64 = 1e-3;
 
 /// The minimum-separation guard: `setpoint` (a velocity or a force, world frame) with

@@ -71,6 +71,12 @@
 #define PH_ABI_VERSION 5
 
 /**
+ * Two positions closer than this (m) are coincident: no bearing between them, and
+ * `ph_separation_guard` stops the setpoint (`controller_core::policy::COINCIDENT`).
+ */
+#define PH_COINCIDENT_M 1e-3
+
+/**
  * An upper bound of a blob's length: a configuration with every capacity used
  * (8 triangles, 8-step schedules, a leader) encodes to less (`tests/blob.rs`).
  */

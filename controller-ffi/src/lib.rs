@@ -84,6 +84,10 @@ pub const PH_MAX_OWNED_ESTIMATES: usize = 4 * PH_MAX_TRIANGLES;
 /// `ph_abi_version()` of the library you link.
 pub const PH_ABI_VERSION: u32 = 5;
 
+/// Two positions closer than this (m) are coincident: no bearing between them, and
+/// `ph_separation_guard` stops the setpoint (`controller_core::policy::COINCIDENT`).
+pub const PH_COINCIDENT_M: f32 = 1e-3;
+
 /// The agent behind the C API.
 pub type FfiAgent = controller_core::Agent<f32, PH_MAX_TRIANGLES, PH_MAX_NEIGHBOURS>;
 /// Its configuration.
@@ -103,3 +107,5 @@ const _: () = assert!(
 const _: () = assert!(PH_MAX_SCHEDULE_STEPS == controller_core::MAX_SCHEDULE_STEPS);
 const _: () = assert!(PH_MAX_FRAME_LEN == controller_core::MAX_FRAME_LEN);
 const _: () = assert!(PH_MAX_NEIGHBOURS <= u8::MAX as usize + 1);
+#[allow(clippy::cast_possible_truncation)]
+const _: () = assert!(PH_COINCIDENT_M == controller_core::policy::COINCIDENT as f32);

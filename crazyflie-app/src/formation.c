@@ -216,7 +216,7 @@ size_t formation_read_bearings(const formation_state *state, const float own[2],
         /* SPEC S2: the bearing g_ij = (q_j - q_i) / |q_j - q_i|, world frame. */
         float dx = peer->position[0] - own[0], dy = peer->position[1] - own[1];
         float d = __builtin_sqrtf(dx * dx + dy * dy);
-        if (!(d > 1e-3f)) /* coincident positions have no bearing */
+        if (!(d >= (float)PH_COINCIDENT_M)) /* coincident: no bearing (the core's rule) */
             continue;
         ph_bearing *b = &out[written++];
         b->neighbour = peer->id;
