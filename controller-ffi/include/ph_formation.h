@@ -65,7 +65,7 @@
  * Version of this C ABI (the header's structs and functions; 3: `ph_config` gained
  * `bearing_filter`; 4: `ph_limits` gained `bearing_hold`, `ph_fault` gained
  * `PH_FAULT_NEGATIVE_DT`, `ph_actuator` and `ph_actuator_init` the lead; 5: the safety
- * policies `ph_policy_*` and `ph_separation_guard`). Compare the header's value with
+ * policies `ph_policy_*` and `ph_separation_guard`, the position packet `ph_position_*`). Compare the header's value with
  * `ph_abi_version()` of the library you link.
  */
 #define PH_ABI_VERSION 5
@@ -81,6 +81,11 @@
  * (8 triangles, 8-step schedules, a leader) encodes to less (`tests/blob.rs`).
  */
 #define PH_MAX_BLOB_LEN 1024
+
+/**
+ * Longest position packet (with `PH_INTEGRITY_AUTH`), bytes.
+ */
+#define PH_MAX_POSITION_LEN 27
 
 #if defined(PH_PTR32)
 /**
@@ -1124,6 +1129,21 @@ typedef struct {
   float battery;
 } ph_policy_input;
 
+/**
+ * What a receiver keeps of one sender's position packets: the last accepted `auth`
+ * counter (replays are refused). Zero it before the first packet.
+ */
+typedef struct {
+  /**
+   * Non-zero once a counter was accepted.
+   */
+  uint8_t has_counter;
+  /**
+   * The last accepted counter (`epoch · 2³² + n`).
+   */
+  uint64_t counter;
+} ph_position_peer;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -1383,6 +1403,55 @@ ph_status ph_separation_guard(ph_policy *policy,
                               const float *neighbours,
                               size_t count,
                               float *setpoint);
+
+/**
+ * Writes this agent's position packet (its id, `position[0..2]` in m, world frame)
+ * with its integrity mode into `out[0..capacity]` and its length to `*len`. `counter`
+ * is used with `PH_INTEGRITY_AUTH` only: this boot's `epoch · 2³² + n`, a new `n` for
+ * every packet (the receivers refuse a counter they accepted before).
+ * `PH_ERR_BUFFER_FULL` when `capacity` is below the packet's length.
+ *
+ * # Safety
+ * `agent` as for `ph_stats`; `position` NULL or 2 readable floats; `out` NULL or
+ * `capacity` writable bytes; `len` NULL or writable.
+ */
+ph_status ph_position_encode(const ph_agent *agent,
+                             const float *position,
+                             uint64_t counter,
+                             uint8_t *out,
+                             size_t capacity,
+                             size_t *len);
+
+/**
+ * Reads a neighbour's position packet `bytes[0..len]` sent with this agent's
+ * integrity mode: the sender to `*sender`, the position to `position[0..2]`; with
+ * `PH_INTEGRITY_AUTH` checks its counter against `*peer` (the receiver's record of
+ * that sender: look it up by the sender, e.g. with `ph_position_sender` first) and
+ * records it. Refusals: `PH_ERR_FRAME_MALFORMED` (not a position packet of this
+ * length), `PH_ERR_FRAME_MODE_MISMATCH`, `PH_ERR_FRAME_BAD_CRC`,
+ * `PH_ERR_FRAME_BAD_TAG` (spoofed or corrupted), `PH_ERR_FRAME_REPLAYED`,
+ * `PH_ERR_FRAME_INVALID_VALUE` (a coordinate not finite); nothing written then.
+ *
+ * # Safety
+ * `agent` as for `ph_stats`; `bytes` NULL or `len` readable bytes; `peer` NULL or a
+ * `ph_position_peer`; `sender` NULL or writable; `position` NULL or 2 writable floats.
+ */
+ph_status ph_position_decode(const ph_agent *agent,
+                             const uint8_t *bytes,
+                             size_t len,
+                             ph_position_peer *peer,
+                             uint8_t *sender,
+                             float *position);
+
+/**
+ * The sender of a position packet `bytes[0..len]` (byte 2), unchecked: to find the
+ * receiver's `ph_position_peer` before `ph_position_decode`. `PH_ERR_FRAME_MALFORMED`
+ * for a packet too short.
+ *
+ * # Safety
+ * `bytes` NULL or `len` readable bytes; `sender` NULL or writable.
+ */
+ph_status ph_position_sender(const uint8_t *bytes, size_t len, uint8_t *sender);
 
 #ifdef __cplusplus
 }  // extern "C"

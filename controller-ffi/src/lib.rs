@@ -49,6 +49,7 @@ pub mod config;
 #[cfg(target_os = "none")]
 mod panic;
 pub mod policy;
+pub mod position;
 pub mod status;
 pub mod storage;
 pub mod tick;
@@ -80,7 +81,7 @@ pub const PH_MAX_OWNED_ESTIMATES: usize = 4 * PH_MAX_TRIANGLES;
 /// Version of this C ABI (the header's structs and functions; 3: `ph_config` gained
 /// `bearing_filter`; 4: `ph_limits` gained `bearing_hold`, `ph_fault` gained
 /// `PH_FAULT_NEGATIVE_DT`, `ph_actuator` and `ph_actuator_init` the lead; 5: the safety
-/// policies `ph_policy_*` and `ph_separation_guard`). Compare the header's value with
+/// policies `ph_policy_*` and `ph_separation_guard`, the position packet `ph_position_*`). Compare the header's value with
 /// `ph_abi_version()` of the library you link.
 pub const PH_ABI_VERSION: u32 = 5;
 

@@ -388,6 +388,8 @@ fn flight_states_against_the_firmware_model() {
         "boot_epoch_increments_and_persists",
         "rebooted_agent_heard_at_once_under_auth",
         "reboot_without_a_new_epoch_is_a_replay",
+        "spoofed_position_refused_under_auth",
+        "replayed_position_refused_under_auth",
     ] {
         assert!(
             log.lines().any(|l| l == format!("FLIGHT ok {name}")),

@@ -36,7 +36,7 @@ void agent_loop_receive(agent_loop *loop, uint8_t port, const uint8_t *bytes, si
     if (port == AGENT_LOOP_FRAME_PORT)
         (void)ph_receive(loop->agent, bytes, len); /* rejections: ph_stats() */
     else if (port == FORMATION_POSITION_PORT)
-        (void)formation_position_received(&loop->formation, bytes, len, now_ms);
+        (void)formation_position_received(&loop->formation, loop->agent, bytes, len, now_ms);
 }
 
 typedef struct {
@@ -49,6 +49,12 @@ static void send_frame(void *ctx, const uint8_t *bytes, size_t len)
 {
     const frame_sink *sink = ctx;
     sink->send(sink->ctx, AGENT_LOOP_FRAME_PORT, bytes, len);
+}
+
+ph_status agent_loop_set_boot_epoch(agent_loop *loop, uint32_t epoch)
+{
+    loop->position_counter = (uint64_t)epoch << 32;
+    return ph_agent_set_boot_epoch(loop->agent, epoch);
 }
 
 void agent_loop_restart(agent_loop *loop, uint32_t now_ms, bool new_origin)
@@ -95,7 +101,9 @@ ph_status agent_loop_tick(agent_loop *loop, uint32_t now_ms, agent_loop_send_fn 
     frame_sink sink = {send, ctx};
     (void)ph_frames_cb(loop->agent, send_frame, &sink, NULL);
     uint8_t packet[FORMATION_POSITION_LEN];
-    size_t n = formation_position_packet(loop->id, position, packet, sizeof packet);
+    size_t n = formation_position_packet(loop->agent, position, loop->position_counter, packet,
+                                         sizeof packet);
+    loop->position_counter++;
     if (n > 0)
         send(ctx, FORMATION_POSITION_PORT, packet, n);
 

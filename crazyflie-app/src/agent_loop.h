@@ -37,6 +37,7 @@ typedef struct {
     float setpoint[2];    /* the last velocity setpoint (m/s, world frame) */
     uint32_t ticks;
     uint32_t safe_ticks;  /* ticks with the safe output, after the first */
+    uint64_t position_counter; /* auth: the next position packet's counter */
 } agent_loop;
 
 /* Builds agent `id` in memory[0..size] (PH_AGENT_SIZE bytes, PH_AGENT_ALIGN-aligned):
@@ -63,6 +64,10 @@ void agent_loop_receive(agent_loop *loop, uint8_t port, const uint8_t *bytes, si
  * ph_step status. */
 ph_status agent_loop_tick(agent_loop *loop, uint32_t now_ms, agent_loop_send_fn send,
                           void *ctx);
+
+/* This boot's epoch (epoch.h): for the formation's frames (ph_agent_set_boot_epoch) and
+ * the position packets' counters (epoch * 2^32 + n). */
+ph_status agent_loop_set_boot_epoch(agent_loop *loop, uint32_t epoch);
 
 /* The formation (re)starts at `now_ms`: the setpoint restarts from the measured
  * velocity at the next tick; with `new_origin`, the schedules' time restarts at 0. */

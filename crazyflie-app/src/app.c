@@ -185,7 +185,7 @@ void appMain(void)
         DEBUG_PRINT("no boot epoch (storage): no formation\n");
         return;
     }
-    s = ph_agent_set_boot_epoch(loop.agent, epoch);
+    s = agent_loop_set_boot_epoch(&loop, epoch);
     if (s != PH_OK) {
         DEBUG_PRINT("boot epoch: %s\n", ph_status_str(s));
         return;

@@ -135,42 +135,34 @@ void formation_read_position(float position[2])
     position[1] = estimate(&y, &ry, "y");
 }
 
-size_t formation_position_packet(uint8_t id, const float position[2], uint8_t *out,
-                                 size_t capacity)
+size_t formation_position_packet(const ph_agent *agent, const float position[2],
+                                 uint64_t counter, uint8_t *out, size_t capacity)
 {
-    if (capacity < FORMATION_POSITION_LEN)
-        return 0;
-    out[0] = FORMATION_POSITION_VERSION;
-    out[1] = id;
-    __builtin_memcpy(&out[2], &position[0], 4); /* Cortex-M4 and x86-64: little-endian */
-    __builtin_memcpy(&out[6], &position[1], 4);
-    return FORMATION_POSITION_LEN;
+    size_t n = 0;
+    return ph_position_encode(agent, position, counter, out, capacity, &n) == PH_OK ? n : 0;
 }
 
-static bool is_finite(float x)
+bool formation_position_received(formation_state *state, const ph_agent *agent,
+                                 const uint8_t *bytes, size_t len, uint32_t now_ms)
 {
-    return x - x == 0.0f; /* false for NaN and the infinities */
-}
-
-bool formation_position_received(formation_state *state, const uint8_t *bytes, size_t len,
-                                 uint32_t now_ms)
-{
-    if (len != FORMATION_POSITION_LEN || bytes[0] != FORMATION_POSITION_VERSION)
-        return false;
-    float p[2];
-    __builtin_memcpy(&p[0], &bytes[2], 4);
-    __builtin_memcpy(&p[1], &bytes[6], 4);
-    if (!is_finite(p[0]) || !is_finite(p[1]))
+    uint8_t sender = 0;
+    if (ph_position_sender(bytes, len, &sender) != PH_OK)
         return false;
     for (size_t k = 0; k < state->peer_count; k++) {
         formation_peer *peer = &state->peers[k];
-        if (peer->id == bytes[1]) {
-            peer->heard = 1;
-            peer->time_ms = now_ms;
-            peer->position[0] = p[0];
-            peer->position[1] = p[1];
-            return true;
-        }
+        if (peer->id != sender)
+            continue;
+        float p[2];
+        uint8_t from = 0;
+        /* Integrity, finite values, and (auth) a counter above the last: the core's. */
+        if (ph_position_decode(agent, bytes, len, &peer->link, &from, p) != PH_OK ||
+            from != sender)
+            return false;
+        peer->heard = 1;
+        peer->time_ms = now_ms;
+        peer->position[0] = p[0];
+        peer->position[1] = p[1];
+        return true;
     }
     return false; /* not a neighbour: broadcast radio */
 }

@@ -41,10 +41,11 @@
 #endif
 /* P2P port of the position packets (the formation's frames use port 0). */
 #define FORMATION_POSITION_PORT 1u
-/* Bytes of a position packet: version, sender id, x and y (float32, little-endian). */
-#define FORMATION_POSITION_LEN 10u
-/* Version byte of the position packet layout. */
-#define FORMATION_POSITION_VERSION 1u
+/* Room for a position packet: the core's (controller-core/src/wire/position.rs, C API
+ * ph_position_encode / ph_position_decode) with the agent's integrity mode: 13 bytes
+ * with crc16, 11 with link, 27 with auth (a tag and a counter: spoofed or replayed
+ * positions are refused). */
+#define FORMATION_POSITION_LEN PH_MAX_POSITION_LEN
 /* A neighbour's position older than this (ms) gives no bearing: the agent's own
  * neighbour timeout then makes the output safe. */
 #define FORMATION_POSITION_MAX_AGE_MS 100u
@@ -54,6 +55,7 @@ typedef struct {
     uint8_t id;
     uint8_t heard;    /* 1 while the last position is at most MAX_AGE old */
     uint32_t time_ms; /* the receiver's clock at arrival (ms, wraps: only differences) */
+    ph_position_peer link; /* auth: the last accepted counter (replays refused) */
     float position[2];
 } formation_peer;
 
@@ -80,15 +82,15 @@ ph_status formation_state_init(formation_state *state, const ph_agent *agent);
 void formation_read_velocity(float velocity[2]);
 void formation_read_position(float position[2]);
 
-/* This agent's position packet into out[0..capacity]; returns its length (0 if it
- * does not fit). */
-size_t formation_position_packet(uint8_t id, const float position[2], uint8_t *out,
-                                 size_t capacity);
+/* This agent's position packet into out[0..capacity] (`counter`: with auth, this
+ * boot's epoch * 2^32 + a new n per packet); returns its length (0 if refused). */
+size_t formation_position_packet(const ph_agent *agent, const float position[2],
+                                 uint64_t counter, uint8_t *out, size_t capacity);
 
-/* A received position packet at `now_ms`; returns true if it was a neighbour's and
- * was kept. */
-bool formation_position_received(formation_state *state, const uint8_t *bytes, size_t len,
-                                 uint32_t now_ms);
+/* A received position packet at `now_ms`, checked with `agent`'s integrity mode;
+ * returns true if it was a neighbour's and was kept. */
+bool formation_position_received(formation_state *state, const ph_agent *agent,
+                                 const uint8_t *bytes, size_t len, uint32_t now_ms);
 
 /* Forgets the positions older than FORMATION_POSITION_MAX_AGE_MS at `now_ms`. Called
  * every tick, it keeps a position heard once from looking fresh again when the 32-bit

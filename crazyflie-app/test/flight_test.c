@@ -430,6 +430,48 @@ static void the_model_sees_the_bugs(void)
     check(fw.null_flying > 0, "model_catches_a_bare_relax", "the model missed a bare relax");
 }
 
+/* Agent `id` of formation.c's struct (crc16, or auth with `auth`) in `memory`. */
+static ph_agent *agent_of(uint8_t *memory, uint8_t id, int auth)
+{
+    static ph_config c;
+    if (formation_config(id, &c) != PH_OK)
+        return NULL;
+    if (auth) {
+        c.integrity = PH_INTEGRITY_AUTH;
+        for (int k = 0; k < 16; k++)
+            c.auth_key[k] = (uint8_t)(0xA5 ^ k);
+    }
+    ph_agent *a = (ph_agent *)memory;
+    return ph_agent_init(a, PH_AGENT_SIZE, &c) == PH_OK ? a : NULL;
+}
+
+static uint8_t mem1[PH_AGENT_SIZE] __attribute__((aligned(PH_AGENT_ALIGN)));
+static uint8_t mem2[PH_AGENT_SIZE] __attribute__((aligned(PH_AGENT_ALIGN)));
+
+/* Under auth the app keeps a neighbour's position only from a packet with the swarm's
+ * tag and a new counter: a spoofed one (changed x) and a replayed one are refused; the
+ * genuine one (negative control) is kept. */
+static void positions_under_auth(void)
+{
+    ph_agent *rx = agent_of(mem1, 1, 1), *tx = agent_of(mem2, 2, 1);
+    formation_state st;
+    if (rx == NULL || tx == NULL || formation_state_init(&st, rx) != PH_OK) {
+        check(0, "positions_under_auth", "no agents");
+        return;
+    }
+    uint8_t pkt[FORMATION_POSITION_LEN], spoof[FORMATION_POSITION_LEN];
+    float q[2] = {1.0f, 2.0f};
+    size_t n = formation_position_packet(tx, q, ((uint64_t)3 << 32) | 7u, pkt, sizeof pkt);
+    __builtin_memcpy(spoof, pkt, n);
+    spoof[3] ^= 0x40; /* another x, the same tag */
+    bool spoofed = formation_position_received(&st, rx, spoof, n, 0u);
+    bool genuine = formation_position_received(&st, rx, pkt, n, 0u);
+    bool replayed = formation_position_received(&st, rx, pkt, n, 10u);
+    check(n == 27 && !spoofed && genuine, "spoofed_position_refused_under_auth",
+          "a spoofed position was kept, or the genuine one refused");
+    check(!replayed, "replayed_position_refused_under_auth", "a replayed position was kept");
+}
+
 /* The neighbours' positions: fresh for FORMATION_POSITION_MAX_AGE_MS across the wrap;
  * expired every tick, a position heard once does not come back when the clock wraps
  * round to the same value (negative control: without formation_expire it would). */
@@ -439,11 +481,12 @@ static void positions_across_the_wrap(void)
     __builtin_memset(&st, 0, sizeof st);
     st.peer_count = 1;
     st.peers[0].id = 2;
+    ph_agent *rx = agent_of(mem1, 1, 0), *tx = agent_of(mem2, 2, 0);
     uint8_t pkt[FORMATION_POSITION_LEN];
     float q[2] = {1.0f, 2.0f};
-    size_t n = formation_position_packet(2, q, pkt, sizeof pkt);
+    size_t n = formation_position_packet(tx, q, 0, pkt, sizeof pkt);
     uint32_t t = 0xFFFFFFF0u;
-    (void)formation_position_received(&st, pkt, n, t);
+    (void)formation_position_received(&st, rx, pkt, n, t);
     int fresh = formation_heard(&st, t + 50u) == 1 && formation_heard(&st, t + 100u) == 1 &&
                 formation_heard(&st, t + 101u) == 0;
     check(fresh, "position_age_across_the_wrap", "wrong age across the wrap");
@@ -471,10 +514,11 @@ static void guard(void)
     st.peers[0].id = 2;
     uint8_t pkt[FORMATION_POSITION_LEN];
     float own[2] = {1.0f, 1.0f};
+    ph_agent *rx = agent_of(mem1, 1, 0), *tx = agent_of(mem2, 2, 0);
     for (int close = 1; close >= 0; close--) {
         float q[2] = {own[0] + (close ? 0.2f : 0.5f), own[1]};
-        size_t n = formation_position_packet(2, q, pkt, sizeof pkt);
-        (void)formation_position_received(&st, pkt, n, 1000u);
+        size_t n = formation_position_packet(tx, q, 0, pkt, sizeof pkt);
+        (void)formation_position_received(&st, rx, pkt, n, 1000u);
         ph_policy policy;
         (void)ph_policy_init(&policy);
         float v[2] = {0.4f, 0.3f};
@@ -607,6 +651,7 @@ int main(void)
     refused_settings();
     boot_epochs();
     reboot_under_auth();
+    positions_under_auth();
     /* The policies' initial positions (crazyflie_app.rs compares formation.toml). */
     for (uint8_t id = 1; id <= 4; id++) {
         flight_policy p;
