@@ -42,6 +42,7 @@ pub mod energy;
 pub mod geometry;
 pub mod law;
 pub mod link;
+pub mod policy;
 pub mod scalar;
 pub mod stats;
 pub mod tracker;

@@ -9,6 +9,10 @@
 #                                                driving four simulated vehicles
 #   controller-ffi/c/build.sh cfapp-firmware OUT_DIR   OUT_DIR/cfapp-firmware.elf: the
 #                                                same on the STM32F405 (stack figures)
+#   controller-ffi/c/build.sh cfapp-flight OUT_DIR     OUT_DIR/cfapp-flight: the app's
+#                                                flight states and commands against a
+#                                                model of the firmware's commander and
+#                                                supervisor (crazyflie-app/test/flight_test.c)
 #   (CFAPP_CFLAGS: extra flags for the app, e.g. -DFORMATION_USE_STRUCT)
 #
 # The staticlib: for the firmware `cargo rustc -p controller-ffi --release --lib
@@ -92,8 +96,18 @@ cfapp-firmware)
         "$lib" -lgcc
     echo "$out/cfapp-firmware.elf"
     ;;
+cfapp-flight)
+    (cd "$root" && "$cargo" build -q -p controller-ffi --release --lib)
+    lib=$target_dir/release/libcontroller_ffi.a
+    "${CC:-cc}" "${cflags[@]}" "${app_cflags[@]}" -o "$out/cfapp-flight" \
+        "$app/test/flight_test.c" "$app/test/firmware_model.c" "$app/src/flight.c" \
+        "$app/src/commands.c" "$app/src/epoch.c" "$app/src/formation.c" \
+        "$app/src/blobs/ph_blobs.c" \
+        "$lib" -lgcc_s -lutil -lrt -lpthread -lm -ldl
+    echo "$out/cfapp-flight"
+    ;;
 *)
-    echo "$0: unknown target '$what' (host, firmware, cfapp-host or cfapp-firmware)" >&2
+    echo "$0: unknown target '$what' (host, firmware, cfapp-host, cfapp-firmware or cfapp-flight)" >&2
     exit 2
     ;;
 esac

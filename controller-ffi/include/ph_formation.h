@@ -65,16 +65,29 @@
  * Version of this C ABI (the header's structs and functions; 3: `ph_config` gained
  * `bearing_filter`; 4: `ph_limits` gained `bearing_hold`, `ph_fault` gained
  * `PH_FAULT_NEGATIVE_DT`, `ph_actuator` and `ph_actuator_init` the lead; 5: `ph_actuator`
- * gained the second-order lead and its kept acceleration, `ph_actuator_set_second_lead`).
- * Compare the header's value with `ph_abi_version()` of the library you link.
+ * gained the second-order lead and its kept acceleration, `ph_actuator_set_second_lead`;
+ * the safety policies `ph_policy_*` and `ph_separation_guard`, the position packet
+ * `ph_position_*`). Compare the header's value with `ph_abi_version()` of the library
+ * you link.
  */
 #define PH_ABI_VERSION 5
+
+/**
+ * Two positions closer than this (m) are coincident: no bearing between them, and
+ * `ph_separation_guard` stops the setpoint (`controller_core::policy::COINCIDENT`).
+ */
+#define PH_COINCIDENT_M 1e-3
 
 /**
  * An upper bound of a blob's length: a configuration with every capacity used
  * (8 triangles, 8-step schedules, a leader) encodes to less (`tests/blob.rs`).
  */
 #define PH_MAX_BLOB_LEN 1024
+
+/**
+ * Longest position packet (with `PH_INTEGRITY_AUTH`), bytes.
+ */
+#define PH_MAX_POSITION_LEN 27
 
 #if defined(PH_PTR32)
 /**
@@ -405,6 +418,76 @@ typedef uint8_t ph_fault;
 #endif // __cplusplus
 
 /**
+ * What the vehicle should do (`ph_policy_update`).
+ */
+enum ph_policy_action
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint8_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * Fly the formation.
+   */
+  PH_POLICY_FLY = 0,
+  /**
+   * Hold the position.
+   */
+  PH_POLICY_HOLD = 1,
+  /**
+   * Land.
+   */
+  PH_POLICY_LAND = 2,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum ph_policy_action ph_policy_action;
+#else
+typedef uint8_t ph_policy_action;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
+ * Why (`ph_policy_update`, `ph_policy.last_landing`).
+ */
+enum ph_policy_reason
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint8_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * Nothing wrong.
+   */
+  PH_POLICY_NONE = 0,
+  /**
+   * Neighbours or radio lost (holding).
+   */
+  PH_POLICY_LOST = 1,
+  /**
+   * Lost for `hold_timeout_ms` (landing).
+   */
+  PH_POLICY_LOST_TIMEOUT = 2,
+  /**
+   * Outside the flight volume (landing).
+   */
+  PH_POLICY_FENCE = 3,
+  /**
+   * Battery low (landing).
+   */
+  PH_POLICY_BATTERY = 4,
+  /**
+   * Positioning lost (landing).
+   */
+  PH_POLICY_POSITIONING = 5,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum ph_policy_reason ph_policy_reason;
+#else
+typedef uint8_t ph_policy_reason;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
  * How the agent gets the distances of S8 (values of `ph_config.estimator`).
  */
 enum ph_estimator
@@ -430,6 +513,38 @@ enum ph_estimator
 typedef enum ph_estimator ph_estimator;
 #else
 typedef uint8_t ph_estimator;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
+ * How frames are protected (values of `ph_config.integrity`); the same for every agent
+ * of a swarm (see `docs/core.md`, wire format).
+ */
+enum ph_integrity
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint8_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * A CRC-16 trailer: raw UART or any link without its own check. Default.
+   */
+  PH_INTEGRITY_CRC16 = 0,
+  /**
+   * No trailer: the link checks its own CRC (the Crazyflie radio does).
+   */
+  PH_INTEGRITY_LINK = 1,
+  /**
+   * A 64-bit SipHash-2-4 tag under the swarm key `ph_config.auth_key` and replay
+   * protection (see `docs/core.md`, "auth"); call `ph_agent_set_boot_epoch` after
+   * `ph_agent_init*`.
+   */
+  PH_INTEGRITY_AUTH = 2,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum ph_integrity ph_integrity;
+#else
+typedef uint8_t ph_integrity;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
 
@@ -925,6 +1040,125 @@ typedef struct {
   float value;
 } ph_estimate;
 
+/**
+ * The policies' state and counts, in caller memory: zero it (`ph_policy_init`) and
+ * hand it to every `ph_policy_update`. The counts are for the log (the app's log group
+ * `formation`).
+ */
+typedef struct {
+  /**
+   * Lost for this long (ms).
+   */
+  uint32_t lost_ms;
+  /**
+   * Battery low for this long (ms).
+   */
+  uint32_t low_ms;
+  /**
+   * Lost at the last update.
+   */
+  uint8_t lost;
+  /**
+   * Low at the last update.
+   */
+  uint8_t low;
+  /**
+   * The landing decided (a `ph_policy_reason`; `PH_POLICY_NONE`: none).
+   */
+  uint8_t landing;
+  /**
+   * The reason of the last landing (a `ph_policy_reason`).
+   */
+  uint8_t last_landing;
+  /**
+   * Ticks answered with `PH_POLICY_HOLD`.
+   */
+  uint32_t hold_ticks;
+  /**
+   * Landings decided.
+   */
+  uint32_t landings;
+  /**
+   * Setpoints `ph_separation_guard` changed.
+   */
+  uint32_t guarded;
+} ph_policy;
+
+/**
+ * The policies' settings (`controller_core::policy::PolicyConfig`).
+ */
+typedef struct {
+  /**
+   * Lost neighbours or radio for this long (ms): land (holding until then).
+   */
+  uint32_t hold_timeout_ms;
+  /**
+   * Non-zero: the flight volume `fence_min`–`fence_max` is checked.
+   */
+  uint8_t fence;
+  /**
+   * The flight volume's lower corner (m, world frame).
+   */
+  float fence_min[2];
+  /**
+   * Its upper corner (m).
+   */
+  float fence_max[2];
+  /**
+   * Battery voltage to land below (V; 0: off).
+   */
+  float battery_land;
+  /**
+   * For this long (ms).
+   */
+  uint32_t battery_ms;
+  /**
+   * Minimum separation of `ph_separation_guard` (m; 0: off).
+   */
+  float min_separation;
+} ph_policy_config;
+
+/**
+ * One tick's inputs of `ph_policy_update`.
+ */
+typedef struct {
+  /**
+   * Milliseconds since the previous update (0 on the first): integer time.
+   */
+  uint32_t dt_ms;
+  /**
+   * Non-zero: this tick's `ph_step` gave the safe output (neighbours or radio lost).
+   */
+  uint8_t lost;
+  /**
+   * Non-zero: the positioning system is locked.
+   */
+  uint8_t positioning;
+  /**
+   * Own position (m, world frame).
+   */
+  float position[2];
+  /**
+   * Battery voltage (V).
+   */
+  float battery;
+} ph_policy_input;
+
+/**
+ * What a receiver keeps of one sender's position packets: the last accepted `auth`
+ * counter (replays are refused). Zero it before the first packet.
+ */
+typedef struct {
+  /**
+   * Non-zero once a counter was accepted.
+   */
+  uint8_t has_counter;
+  /**
+   * The last accepted counter (`epoch · 2³² + n`).
+   */
+  uint64_t counter;
+} ph_position_peer;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -1143,6 +1377,107 @@ ph_status ph_leader_partner(const ph_agent *agent, uint8_t *partner, uint8_t *is
  * (`longjmp`). See docs/c-api.md.
  */
 extern void ph_panic_hook(void);
+
+/**
+ * Zeroes `*policy`: flying, nothing counted.
+ *
+ * # Safety
+ * `policy` is NULL or writable.
+ */
+ph_status ph_policy_init(ph_policy *policy);
+
+/**
+ * A new flight: the timers and the landing forgotten, the counts kept.
+ *
+ * # Safety
+ * `policy` is NULL or points to a `ph_policy`.
+ */
+ph_status ph_policy_reset(ph_policy *policy);
+
+/**
+ * One tick of the policies (`controller_core::policy::Policy::update`): writes what to
+ * do to `*action` and why to `*why`. `PH_ERR_ARGUMENT` (nothing changed) for settings
+ * that are not finite, a fence with `min > max`, a negative voltage or separation, or
+ * a `*policy` with an unknown reason code.
+ *
+ * # Safety
+ * `policy` is NULL or points to a `ph_policy`; `config` and `in` are NULL or readable;
+ * `action` and `why` are NULL or writable.
+ */
+ph_status ph_policy_update(ph_policy *policy,
+                           const ph_policy_config *config,
+                           const ph_policy_input *in_,
+                           ph_policy_action *action_out,
+                           ph_policy_reason *why);
+
+/**
+ * The minimum-separation guard (`controller_core::policy::separation_guard`):
+ * removes from `setpoint[0..2]` (velocity or force, world frame) its component towards
+ * every neighbour of `neighbours[0..2·count]` (x, y pairs) closer to `own[0..2]` than
+ * `config->min_separation`; a neighbour closer than 1 mm stops it. Counts a change in
+ * `policy->guarded`. `PH_ERR_ARGUMENT` as for `ph_policy_update`.
+ *
+ * # Safety
+ * `policy` and `config` as for `ph_policy_update`; `own` is NULL or 2 readable floats;
+ * `neighbours` is NULL (only with `count` 0) or `2·count` readable floats, `count` at
+ * most `PH_MAX_NEIGHBOURS` (more: `PH_ERR_ARGUMENT`); `setpoint`
+ * is NULL or 2 readable and writable floats.
+ */
+ph_status ph_separation_guard(ph_policy *policy,
+                              const ph_policy_config *config,
+                              const float *own,
+                              const float *neighbours,
+                              size_t count,
+                              float *setpoint);
+
+/**
+ * Writes this agent's position packet (its id, `position[0..2]` in m, world frame)
+ * with its integrity mode into `out[0..capacity]` and its length to `*len`. `counter`
+ * is used with `PH_INTEGRITY_AUTH` only: this boot's `epoch · 2³² + n`, a new `n` for
+ * every packet (the receivers refuse a counter they accepted before).
+ * `PH_ERR_BUFFER_FULL` when `capacity` is below the packet's length.
+ *
+ * # Safety
+ * `agent` as for `ph_stats`; `position` NULL or 2 readable floats; `out` NULL or
+ * `capacity` writable bytes; `len` NULL or writable.
+ */
+ph_status ph_position_encode(const ph_agent *agent,
+                             const float *position,
+                             uint64_t counter,
+                             uint8_t *out,
+                             size_t capacity,
+                             size_t *len);
+
+/**
+ * Reads a neighbour's position packet `bytes[0..len]` sent with this agent's
+ * integrity mode: the sender to `*sender`, the position to `position[0..2]`; with
+ * `PH_INTEGRITY_AUTH` checks its counter against `*peer` (the receiver's record of
+ * that sender: look it up by the sender, e.g. with `ph_position_sender` first) and
+ * records it. Refusals: `PH_ERR_FRAME_MALFORMED` (not a position packet of this
+ * length), `PH_ERR_FRAME_MODE_MISMATCH`, `PH_ERR_FRAME_BAD_CRC`,
+ * `PH_ERR_FRAME_BAD_TAG` (spoofed or corrupted), `PH_ERR_FRAME_REPLAYED`,
+ * `PH_ERR_FRAME_INVALID_VALUE` (a coordinate not finite); nothing written then.
+ *
+ * # Safety
+ * `agent` as for `ph_stats`; `bytes` NULL or `len` readable bytes; `peer` NULL or a
+ * `ph_position_peer`; `sender` NULL or writable; `position` NULL or 2 writable floats.
+ */
+ph_status ph_position_decode(const ph_agent *agent,
+                             const uint8_t *bytes,
+                             size_t len,
+                             ph_position_peer *peer,
+                             uint8_t *sender,
+                             float *position);
+
+/**
+ * The sender of a position packet `bytes[0..len]` (byte 2), unchecked: to find the
+ * receiver's `ph_position_peer` before `ph_position_decode`. `PH_ERR_FRAME_MALFORMED`
+ * for a packet too short.
+ *
+ * # Safety
+ * `bytes` NULL or `len` readable bytes; `sender` NULL or writable.
+ */
+ph_status ph_position_sender(const uint8_t *bytes, size_t len, uint8_t *sender);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -60,7 +60,7 @@ pub(crate) unsafe fn write<T>(ptr: *mut T, value: T) -> Result<(), ph_status> {
 ///
 /// # Safety
 /// For `len > 0`, a non-null `ptr` points to `len` valid `T`s for `'a`.
-unsafe fn slice<'a, T>(ptr: *const T, len: usize) -> Result<&'a [T], ph_status> {
+pub(crate) unsafe fn slice<'a, T>(ptr: *const T, len: usize) -> Result<&'a [T], ph_status> {
     if len == 0 {
         return Ok(&[]);
     }

@@ -48,6 +48,8 @@ pub mod config;
 // own handler uses controller-core directly, not this crate).
 #[cfg(target_os = "none")]
 mod panic;
+pub mod policy;
+pub mod position;
 pub mod status;
 pub mod storage;
 pub mod tick;
@@ -79,9 +81,15 @@ pub const PH_MAX_OWNED_ESTIMATES: usize = 4 * PH_MAX_TRIANGLES;
 /// Version of this C ABI (the header's structs and functions; 3: `ph_config` gained
 /// `bearing_filter`; 4: `ph_limits` gained `bearing_hold`, `ph_fault` gained
 /// `PH_FAULT_NEGATIVE_DT`, `ph_actuator` and `ph_actuator_init` the lead; 5: `ph_actuator`
-/// gained the second-order lead and its kept acceleration, `ph_actuator_set_second_lead`).
-/// Compare the header's value with `ph_abi_version()` of the library you link.
+/// gained the second-order lead and its kept acceleration, `ph_actuator_set_second_lead`;
+/// the safety policies `ph_policy_*` and `ph_separation_guard`, the position packet
+/// `ph_position_*`). Compare the header's value with `ph_abi_version()` of the library
+/// you link.
 pub const PH_ABI_VERSION: u32 = 5;
+
+/// Two positions closer than this (m) are coincident: no bearing between them, and
+/// `ph_separation_guard` stops the setpoint (`controller_core::policy::COINCIDENT`).
+pub const PH_COINCIDENT_M: f32 = 1e-3;
 
 /// The agent behind the C API.
 pub type FfiAgent = controller_core::Agent<f32, PH_MAX_TRIANGLES, PH_MAX_NEIGHBOURS>;
@@ -102,3 +110,5 @@ const _: () = assert!(
 const _: () = assert!(PH_MAX_SCHEDULE_STEPS == controller_core::MAX_SCHEDULE_STEPS);
 const _: () = assert!(PH_MAX_FRAME_LEN == controller_core::MAX_FRAME_LEN);
 const _: () = assert!(PH_MAX_NEIGHBOURS <= u8::MAX as usize + 1);
+#[allow(clippy::cast_possible_truncation)]
+const _: () = assert!(PH_COINCIDENT_M == controller_core::policy::COINCIDENT as f32);

@@ -18,6 +18,20 @@
 //!   tick (painted stack); `CONFIG_APP_STACKSIZE × 4` in `crazyflie-app/app-config`
 //!   must be at least 1.25 × the peak, and docs/c-api.md must state the peaks.
 //!
+//! * `flight_states_against_the_firmware_model`: `cfapp-flight` (`c/build.sh
+//!   cfapp-flight`, `crazyflie-app/test/flight_test.c`) drives the app's flight states
+//!   (`src/flight.c`) through every transition and policy, each with a negative
+//!   control, and its commands (`src/commands.c`) against a model of the firmware's
+//!   commander, high-level commander and supervisor (`test/firmware_model.c`): no
+//!   stale setpoint, no null setpoint in the air, the emergency stop wins; the
+//!   policies' initial positions are formation.toml's.
+//! * `app_clock_wraps_and_runs_a_year`: the swarm run with the control clock starting
+//!   just before the 32-bit millisecond wrap, and after a year of uptime, prints the
+//!   same lines as from boot.
+//! * `app_declares_its_parameter_and_log_groups`: `app.c` compiled for the host has
+//!   the sections `.param.formation` and `.log.formation` of the firmware's macros
+//!   (`stub/param.h`, `stub/log.h`), with the expected number of entries.
+//!
 //! The ignored tests need `arm-none-eabi-gcc` and `qemu-system-arm`
 //! (scripts/firmware-deps.sh): `cargo test -p controller-ffi --test crazyflie_app --
 //! --include-ignored`.
@@ -31,15 +45,28 @@ use common::{build_with, max_difference, parse_demo_final, root, scratch};
 
 fn sources() -> Vec<PathBuf> {
     let dir = root().join("crazyflie-app/src");
-    ["app.c", "agent_loop.c", "formation.c", "blobs/ph_blobs.c"]
-        .iter()
-        .map(|f| dir.join(f))
-        .collect()
+    [
+        "app.c",
+        "agent_loop.c",
+        "formation.c",
+        "flight.c",
+        "commands.c",
+        "epoch.c",
+        "blobs/ph_blobs.c",
+    ]
+    .iter()
+    .map(|f| dir.join(f))
+    .collect()
 }
 
 fn compile(compiler: &str, extra: &[&str]) {
+    compile_in(&format!("crazyflie-app-{compiler}"), compiler, extra);
+}
+
+/// Compiles the app's sources into a scratch directory `name`, returned.
+fn compile_in(name: &str, compiler: &str, extra: &[&str]) -> PathBuf {
     let root = root();
-    let out = scratch(&format!("crazyflie-app-{compiler}"));
+    let out = scratch(name);
     for src in sources() {
         let obj = out.join(src.with_extension("o").file_name().expect("file name"));
         let run = Command::new(compiler)
@@ -68,6 +95,7 @@ fn compile(compiler: &str, extra: &[&str]) {
             String::from_utf8_lossy(&run.stderr)
         );
     }
+    out
 }
 
 #[test]
@@ -287,4 +315,137 @@ fn app_stack_fits_its_task_on_the_crazyflie_mcu() {
             "docs/c-api.md states {row:?}; measured init {init}, tick {tick} bytes: update it"
         );
     }
+}
+
+/// The `[[agents]]` positions of crazyflie-app/formation.toml, by id.
+fn scenario_starts() -> Vec<(u32, f64, f64)> {
+    let text = std::fs::read_to_string(root().join("crazyflie-app/formation.toml"))
+        .expect("crazyflie-app/formation.toml");
+    let mut out = Vec::new();
+    let mut id = None;
+    for line in text.lines() {
+        let line = line.trim();
+        if let Some(v) = line.strip_prefix("id = ") {
+            id = v.trim().parse().ok();
+        } else if let (Some(v), Some(i)) = (line.strip_prefix("position = ["), id) {
+            let xy: Vec<f64> = v
+                .trim_end_matches(']')
+                .split(',')
+                .map(|c| c.trim().parse().expect("position"))
+                .collect();
+            out.push((i, xy[0], xy[1]));
+            id = None;
+        }
+    }
+    out
+}
+
+#[test]
+fn flight_states_against_the_firmware_model() {
+    let program = build_with("cfapp-flight", &scratch("cfapp-flight"), &[]);
+    let out = Command::new(&program).output().expect("run cfapp-flight");
+    let log = String::from_utf8_lossy(&out.stdout).into_owned();
+    println!("{log}");
+    assert!(out.status.success(), "cfapp-flight failed:\n{log}");
+    let summary = log
+        .lines()
+        .find(|l| l.starts_with("FLIGHT checks="))
+        .unwrap_or_else(|| panic!("no summary:\n{log}"));
+    assert!(summary.ends_with(" failed=0"), "{summary}");
+    // Every transition and policy is checked, with its negative control.
+    for name in [
+        "idle_sends_no_setpoint",
+        "enable_starts_the_formation",
+        "disable_releases_to_the_high_level_commander",
+        "preflight_refuses_on_the_ground",
+        "preflight_refuses_without_positioning",
+        "preflight_refuses_unheard_neighbour",
+        "preflight_refuses_away_from_start",
+        "lost_holds",
+        "lost_lands_after_the_timeout_after_a_year",
+        "heard_again_resumes_the_formation",
+        "disable_while_holding_releases",
+        "fence_lands",
+        "positioning_lost_lands",
+        "low_battery_lands_across_the_wrap",
+        "supervisor_stops_the_formation",
+        "supervisor_stops_the_hold",
+        "landing_ends_when_landed",
+        "disable_does_not_cancel_a_landing",
+        "operate_disable_then_land",
+        "operate_low_battery_lands",
+        "operate_lost_holds_then_lands",
+        "operate_emergency_stop_wins",
+        "model_catches_a_stale_setpoint",
+        "model_catches_a_bare_relax",
+        "expired_position_stays_stale_after_the_wrap",
+        "float_seconds_would_lose_positions",
+        "positioning_from_the_kalman_variances",
+        "separation_guard_stops_the_approach",
+        "separation_guard_leaves_far_neighbours",
+        "refused_policy_settings_land",
+        "shipped_policy_settings_fly",
+        "boot_epoch_increments_and_persists",
+        "rebooted_agent_heard_at_once_under_auth",
+        "reboot_without_a_new_epoch_is_a_replay",
+        "spoofed_position_refused_under_auth",
+        "replayed_position_refused_under_auth",
+    ] {
+        assert!(
+            log.lines().any(|l| l == format!("FLIGHT ok {name}")),
+            "no passing check {name}:\n{log}"
+        );
+    }
+    let starts = scenario_starts();
+    assert_eq!(starts.len(), 4, "formation.toml's agents");
+    for (id, x, y) in starts {
+        let line = format!("FLIGHT start id={id} x={x} y={y}");
+        assert!(
+            log.lines().any(|l| l == line),
+            "formation.c's initial position of agent {id} is not formation.toml's ({x}, {y}):\n{log}"
+        );
+    }
+}
+
+#[test]
+fn app_clock_wraps_and_runs_a_year() {
+    let program = build_with("cfapp-host", &scratch("cfapp-clock"), &[]);
+    let from_boot = run(&program);
+    converged(&from_boot);
+    // 2^32 − 4096 ms: the clock wraps 41 s into the run; 365 days of milliseconds.
+    for start in ["4294963200", "31536000000"] {
+        let out = Command::new(&program)
+            .args(["--start-ms", start])
+            .output()
+            .expect("run cfapp-host --start-ms");
+        let log = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert!(out.status.success(), "{log}");
+        assert_eq!(
+            log, from_boot,
+            "the swarm with the clock at {start} ms differs from the run from boot"
+        );
+    }
+}
+
+#[test]
+fn app_declares_its_parameter_and_log_groups() {
+    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
+    let obj = compile_in("crazyflie-app-groups", &cc, &["-c"]).join("app.o");
+    let out = Command::new("objdump")
+        .arg("-h")
+        .arg(&obj)
+        .output()
+        .expect("run objdump");
+    let table = String::from_utf8_lossy(&out.stdout).into_owned();
+    let size = |section: &str| -> Option<usize> {
+        table.lines().find_map(|l| {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            (f.get(1) == Some(&section)).then(|| usize::from_str_radix(f[2], 16).ok())?
+        })
+    };
+    // On x86-64, struct param_s is 40 bytes (2 bytes padded to 8, 4 pointers) and
+    // struct log_s 24 (1 byte padded to 8, 2 pointers).
+    // Entries: the group's start and stop, and its variables.
+    assert_eq!(size(".param.formation"), Some(3 * 40), "{table}");
+    assert_eq!(size(".log.formation"), Some(12 * 24), "{table}");
 }

@@ -31,12 +31,12 @@ ph_status agent_loop_init(agent_loop *loop, uint8_t *memory, size_t size, uint8_
 }
 
 void agent_loop_receive(agent_loop *loop, uint8_t port, const uint8_t *bytes, size_t len,
-                        float now)
+                        uint32_t now_ms)
 {
     if (port == AGENT_LOOP_FRAME_PORT)
         (void)ph_receive(loop->agent, bytes, len); /* rejections: ph_stats() */
     else if (port == FORMATION_POSITION_PORT)
-        (void)formation_position_received(&loop->formation, bytes, len, now);
+        (void)formation_position_received(&loop->formation, loop->agent, bytes, len, now_ms);
 }
 
 typedef struct {
@@ -51,21 +51,39 @@ static void send_frame(void *ctx, const uint8_t *bytes, size_t len)
     sink->send(sink->ctx, AGENT_LOOP_FRAME_PORT, bytes, len);
 }
 
-ph_status agent_loop_tick(agent_loop *loop, float now, float dt, agent_loop_send_fn send,
+ph_status agent_loop_set_boot_epoch(agent_loop *loop, uint32_t epoch)
+{
+    loop->position_counter = (uint64_t)epoch << 32;
+    return ph_agent_set_boot_epoch(loop->agent, epoch);
+}
+
+void agent_loop_restart(agent_loop *loop, uint32_t now_ms, bool new_origin)
+{
+    loop->actuator.has_command = 0; /* the next ph_actuate starts from the velocity */
+    if (new_origin)
+        loop->origin_ms = now_ms;
+}
+
+ph_status agent_loop_tick(agent_loop *loop, uint32_t now_ms, agent_loop_send_fn send,
                           void *ctx)
 {
     ph_bearing bearings[PH_MAX_NEIGHBOURS];
     float position[2];
     ph_measurements m = {0};
-    m.time = now;
-    m.dt = loop->first ? 0.0f : dt;
+    if (loop->first)
+        loop->origin_ms = now_ms;
+    /* Differences modulo 2^32: right across the clock's wrap. */
+    m.time = (float)(uint32_t)(now_ms - loop->origin_ms) / 1000.0f;
+    m.dt = loop->first ? 0.0f : (float)(uint32_t)(now_ms - loop->previous_ms) / 1000.0f;
+    loop->previous_ms = now_ms;
+    formation_expire(&loop->formation, now_ms);
     formation_read_velocity(m.velocity);
     formation_read_position(position);
     m.bearings = bearings;
     m.bearing_count =
-        formation_read_bearings(&loop->formation, position, now, bearings, PH_MAX_NEIGHBOURS);
+        formation_read_bearings(&loop->formation, position, now_ms, bearings, PH_MAX_NEIGHBOURS);
     m.has_partner_offset =
-        formation_read_partner_offset(&loop->formation, position, now, m.partner_offset) ? 1u
+        formation_read_partner_offset(&loop->formation, position, now_ms, m.partner_offset) ? 1u
                                                                                           : 0u;
 
     /* A refused call (a bug here) leaves out as a zero, safe force: still apply it. */
@@ -83,7 +101,9 @@ ph_status agent_loop_tick(agent_loop *loop, float now, float dt, agent_loop_send
     frame_sink sink = {send, ctx};
     (void)ph_frames_cb(loop->agent, send_frame, &sink, NULL);
     uint8_t packet[FORMATION_POSITION_LEN];
-    size_t n = formation_position_packet(loop->id, position, packet, sizeof packet);
+    size_t n = formation_position_packet(loop->agent, position, loop->position_counter, packet,
+                                         sizeof packet);
+    loop->position_counter++;
     if (n > 0)
         send(ctx, FORMATION_POSITION_PORT, packet, n);
 

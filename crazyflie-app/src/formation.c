@@ -102,14 +102,21 @@ ph_status formation_state_init(formation_state *state, const ph_agent *agent)
     return ph_leader_partner(agent, &state->partner, &state->has_partner);
 }
 
+/* A float log variable, looked up once (`fallback` when the firmware has none). */
+static float log_float(logVarId_t *id, bool *ready, const char *group, const char *name,
+                       float fallback)
+{
+    if (!*ready) {
+        *id = logGetVarId(group, name);
+        *ready = true;
+    }
+    return logVarIdIsValid(*id) ? logGetFloat(*id) : fallback;
+}
+
 /* A log variable of the state estimator (0 when the firmware has none). */
 static float estimate(logVarId_t *id, bool *ready, const char *name)
 {
-    if (!*ready) {
-        *id = logGetVarId("stateEstimate", name);
-        *ready = true;
-    }
-    return logVarIdIsValid(*id) ? logGetFloat(*id) : 0.0f;
+    return log_float(id, ready, "stateEstimate", name, 0.0f);
 }
 
 void formation_read_velocity(float velocity[2])
@@ -128,68 +135,80 @@ void formation_read_position(float position[2])
     position[1] = estimate(&y, &ry, "y");
 }
 
-size_t formation_position_packet(uint8_t id, const float position[2], uint8_t *out,
-                                 size_t capacity)
+size_t formation_position_packet(const ph_agent *agent, const float position[2],
+                                 uint64_t counter, uint8_t *out, size_t capacity)
 {
-    if (capacity < FORMATION_POSITION_LEN)
-        return 0;
-    out[0] = FORMATION_POSITION_VERSION;
-    out[1] = id;
-    __builtin_memcpy(&out[2], &position[0], 4); /* Cortex-M4 and x86-64: little-endian */
-    __builtin_memcpy(&out[6], &position[1], 4);
-    return FORMATION_POSITION_LEN;
+    size_t n = 0;
+    return ph_position_encode(agent, position, counter, out, capacity, &n) == PH_OK ? n : 0;
 }
 
-static bool is_finite(float x)
+bool formation_position_received(formation_state *state, const ph_agent *agent,
+                                 const uint8_t *bytes, size_t len, uint32_t now_ms)
 {
-    return x - x == 0.0f; /* false for NaN and the infinities */
-}
-
-bool formation_position_received(formation_state *state, const uint8_t *bytes, size_t len,
-                                 float now)
-{
-    if (len != FORMATION_POSITION_LEN || bytes[0] != FORMATION_POSITION_VERSION)
-        return false;
-    float p[2];
-    __builtin_memcpy(&p[0], &bytes[2], 4);
-    __builtin_memcpy(&p[1], &bytes[6], 4);
-    if (!is_finite(p[0]) || !is_finite(p[1]))
+    uint8_t sender = 0;
+    if (ph_position_sender(bytes, len, &sender) != PH_OK)
         return false;
     for (size_t k = 0; k < state->peer_count; k++) {
         formation_peer *peer = &state->peers[k];
-        if (peer->id == bytes[1]) {
-            peer->heard = 1;
-            peer->time = now;
-            peer->position[0] = p[0];
-            peer->position[1] = p[1];
-            return true;
-        }
+        if (peer->id != sender)
+            continue;
+        float p[2];
+        uint8_t from = 0;
+        /* Integrity, finite values, and (auth) a counter above the last: the core's. */
+        if (ph_position_decode(agent, bytes, len, &peer->link, &from, p) != PH_OK ||
+            from != sender)
+            return false;
+        peer->heard = 1;
+        peer->time_ms = now_ms;
+        peer->position[0] = p[0];
+        peer->position[1] = p[1];
+        return true;
     }
     return false; /* not a neighbour: broadcast radio */
 }
 
-static const formation_peer *fresh(const formation_state *state, uint8_t id, float now)
+static bool is_fresh(const formation_peer *peer, uint32_t now_ms)
+{
+    return peer->heard && (uint32_t)(now_ms - peer->time_ms) <= FORMATION_POSITION_MAX_AGE_MS;
+}
+
+static const formation_peer *fresh(const formation_state *state, uint8_t id, uint32_t now_ms)
 {
     for (size_t k = 0; k < state->peer_count; k++) {
         const formation_peer *peer = &state->peers[k];
         if (peer->id == id)
-            return peer->heard && now - peer->time <= FORMATION_POSITION_MAX_AGE ? peer : NULL;
+            return is_fresh(peer, now_ms) ? peer : NULL;
     }
     return NULL;
 }
 
-size_t formation_read_bearings(const formation_state *state, const float own[2], float now,
-                               ph_bearing *out, size_t capacity)
+void formation_expire(formation_state *state, uint32_t now_ms)
+{
+    for (size_t k = 0; k < state->peer_count; k++)
+        if (!is_fresh(&state->peers[k], now_ms))
+            state->peers[k].heard = 0;
+}
+
+uint8_t formation_heard(const formation_state *state, uint32_t now_ms)
+{
+    uint8_t n = 0;
+    for (size_t k = 0; k < state->peer_count; k++)
+        n += is_fresh(&state->peers[k], now_ms) ? 1u : 0u;
+    return n;
+}
+
+size_t formation_read_bearings(const formation_state *state, const float own[2],
+                               uint32_t now_ms, ph_bearing *out, size_t capacity)
 {
     size_t written = 0;
     for (size_t k = 0; k < state->peer_count && written < capacity; k++) {
-        const formation_peer *peer = fresh(state, state->peers[k].id, now);
+        const formation_peer *peer = fresh(state, state->peers[k].id, now_ms);
         if (peer == NULL)
             continue;
         /* SPEC S2: the bearing g_ij = (q_j - q_i) / |q_j - q_i|, world frame. */
         float dx = peer->position[0] - own[0], dy = peer->position[1] - own[1];
         float d = __builtin_sqrtf(dx * dx + dy * dy);
-        if (!(d > 1e-3f)) /* coincident positions have no bearing */
+        if (!(d >= (float)PH_COINCIDENT_M)) /* coincident: no bearing (the core's rule) */
             continue;
         ph_bearing *b = &out[written++];
         b->neighbour = peer->id;
@@ -203,14 +222,65 @@ size_t formation_read_bearings(const formation_state *state, const float own[2],
 }
 
 bool formation_read_partner_offset(const formation_state *state, const float own[2],
-                                   float now, float offset[2])
+                                   uint32_t now_ms, float offset[2])
 {
     if (!state->has_partner)
         return false;
-    const formation_peer *peer = fresh(state, state->partner, now);
+    const formation_peer *peer = fresh(state, state->partner, now_ms);
     if (peer == NULL)
         return false;
     offset[0] = peer->position[0] - own[0];
     offset[1] = peer->position[1] - own[1];
     return true;
+}
+
+bool formation_positioning_locked(void)
+{
+    static logVarId_t px, py;
+    static bool rx, ry;
+    float vx = log_float(&px, &rx, "kalman", "varPX", __builtin_inff());
+    float vy = log_float(&py, &ry, "kalman", "varPY", __builtin_inff());
+    return vx < FORMATION_POSITION_VAR && vy < FORMATION_POSITION_VAR; /* false for NaN */
+}
+
+/* crazyflie-app/formation.toml's [[agents]] positions, by id (checked by
+ * controller-ffi/tests/crazyflie_app.rs). */
+static const float starts[][2] = {{0.0f, 0.0f}, {0.45f, 1.1f}, {1.1f, 1.4f}, {0.9f, 0.55f},
+                                  {1.55f, 0.95f}};
+
+bool formation_policy(uint8_t id, flight_policy *p)
+{
+    if (id < 1 || id >= sizeof starts / sizeof starts[0])
+        return false;
+    __builtin_memset(p, 0, sizeof *p);
+    p->core.hold_timeout_ms = FORMATION_HOLD_TIMEOUT_MS;
+    p->core.fence = 1;
+    p->core.fence_min[0] = FORMATION_FENCE_MIN_X;
+    p->core.fence_min[1] = FORMATION_FENCE_MIN_Y;
+    p->core.fence_max[0] = FORMATION_FENCE_MAX_X;
+    p->core.fence_max[1] = FORMATION_FENCE_MAX_Y;
+    p->core.battery_land = FORMATION_VBAT_LAND;
+    p->core.battery_ms = FORMATION_VBAT_MS;
+    p->core.min_separation = FORMATION_MIN_SEPARATION;
+    p->start_tolerance = FORMATION_START_TOLERANCE;
+    p->start[0] = starts[id][0];
+    p->start[1] = starts[id][1];
+    return true;
+}
+
+void formation_guard(const formation_state *state, uint32_t now_ms, ph_policy *policy,
+                     const ph_policy_config *config, const float own[2], float setpoint[2])
+{
+    float near[PH_MAX_NEIGHBOURS][2];
+    size_t n = 0;
+    for (size_t k = 0; k < state->peer_count && n < PH_MAX_NEIGHBOURS; k++) {
+        const formation_peer *peer = &state->peers[k];
+        if (!is_fresh(peer, now_ms))
+            continue;
+        near[n][0] = peer->position[0];
+        near[n][1] = peer->position[1];
+        n++;
+    }
+    if (ph_separation_guard(policy, config, own, &near[0][0], n, setpoint) != PH_OK)
+        setpoint[0] = setpoint[1] = 0.0f; /* refused settings: no motion */
 }

@@ -21,6 +21,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "flight.h"
 #include "ph_formation.h"
 
 /* The plant model the controller assumes (SPEC S1, per axis): m dv/dt = -D^r v + U,
@@ -38,24 +39,23 @@
 #ifndef FORMATION_LEAD
 #define FORMATION_LEAD 0.23f
 #endif
-/* Flight altitude held while in formation (m). */
-#define FORMATION_ALTITUDE 0.5f
-
 /* P2P port of the position packets (the formation's frames use port 0). */
 #define FORMATION_POSITION_PORT 1u
-/* Bytes of a position packet: version, sender id, x and y (float32, little-endian). */
-#define FORMATION_POSITION_LEN 10u
-/* Version byte of the position packet layout. */
-#define FORMATION_POSITION_VERSION 1u
-/* A neighbour's position older than this (s) gives no bearing: the agent's own
+/* Room for a position packet: the core's (controller-core/src/wire/position.rs, C API
+ * ph_position_encode / ph_position_decode) with the agent's integrity mode: 13 bytes
+ * with crc16, 11 with link, 27 with auth (a tag and a counter: spoofed or replayed
+ * positions are refused). */
+#define FORMATION_POSITION_LEN PH_MAX_POSITION_LEN
+/* A neighbour's position older than this (ms) gives no bearing: the agent's own
  * neighbour timeout then makes the output safe. */
-#define FORMATION_POSITION_MAX_AGE 0.1f
+#define FORMATION_POSITION_MAX_AGE_MS 100u
 
 /* The last position heard from one neighbour. */
 typedef struct {
     uint8_t id;
-    uint8_t heard; /* 1 once a position arrived */
-    float time;    /* s, the receiver's clock at arrival */
+    uint8_t heard;    /* 1 while the last position is at most MAX_AGE old */
+    uint32_t time_ms; /* the receiver's clock at arrival (ms, wraps: only differences) */
+    ph_position_peer link; /* auth: the last accepted counter (replays refused) */
     float position[2];
 } formation_peer;
 
@@ -82,22 +82,62 @@ ph_status formation_state_init(formation_state *state, const ph_agent *agent);
 void formation_read_velocity(float velocity[2]);
 void formation_read_position(float position[2]);
 
-/* This agent's position packet into out[0..capacity]; returns its length (0 if it
- * does not fit). */
-size_t formation_position_packet(uint8_t id, const float position[2], uint8_t *out,
-                                 size_t capacity);
+/* This agent's position packet into out[0..capacity] (`counter`: with auth, this
+ * boot's epoch * 2^32 + a new n per packet); returns its length (0 if refused). */
+size_t formation_position_packet(const ph_agent *agent, const float position[2],
+                                 uint64_t counter, uint8_t *out, size_t capacity);
 
-/* A received position packet; returns true if it was a neighbour's and was kept. */
-bool formation_position_received(formation_state *state, const uint8_t *bytes, size_t len,
-                                 float now);
+/* A received position packet at `now_ms`, checked with `agent`'s integrity mode;
+ * returns true if it was a neighbour's and was kept. */
+bool formation_position_received(formation_state *state, const ph_agent *agent,
+                                 const uint8_t *bytes, size_t len, uint32_t now_ms);
+
+/* Forgets the positions older than FORMATION_POSITION_MAX_AGE_MS at `now_ms`. Called
+ * every tick, it keeps a position heard once from looking fresh again when the 32-bit
+ * millisecond clock wraps (every 49.7 days): ages are differences modulo 2^32. */
+void formation_expire(formation_state *state, uint32_t now_ms);
+
+/* Neighbours whose position is fresh at `now_ms`. */
+uint8_t formation_heard(const formation_state *state, uint32_t now_ms);
 
 /* Bearings to the neighbours whose position is fresh, unit vectors in the world
  * frame, in ph_neighbours() order; returns how many were written (at most
  * `capacity`). */
-size_t formation_read_bearings(const formation_state *state, const float own[2], float now,
-                               ph_bearing *out, size_t capacity);
+size_t formation_read_bearings(const formation_state *state, const float own[2],
+                               uint32_t now_ms, ph_bearing *out, size_t capacity);
 
 /* Leaders: the partner's position minus this agent's (m, world frame); false when
  * this agent is no leader or the partner's position is stale. */
 bool formation_read_partner_offset(const formation_state *state, const float own[2],
-                                   float now, float offset[2]);
+                                   uint32_t now_ms, float offset[2]);
+
+/* Positioning locked: the Kalman estimator's position variances kalman.varPX and
+ * varPY (crazyflie-firmware src/modules/src/estimator/estimator_kalman.c:474-478)
+ * below FORMATION_POSITION_VAR (m^2, a 5 cm standard deviation); false without the
+ * Kalman estimator. */
+#define FORMATION_POSITION_VAR 0.0025f
+bool formation_positioning_locked(void);
+
+/* The safety policies of agent `id` (flight.h): its initial position in
+ * crazyflie-app/formation.toml (the pre-flight check's reference, within
+ * FORMATION_START_TOLERANCE), the flight volume, the low-battery landing (pm.vbat
+ * below FORMATION_VBAT_LAND for FORMATION_VBAT_MS: the Crazyflie 2.x's
+ * DEFAULT_BAT_LOW_VOLTAGE, platform_defaults_cf2.h:37), the hold before a landing
+ * when neighbours or radio are lost and the minimum separation of the setpoint guard
+ * (the core's policies, ph_policy_config). false: no agent `id`. */
+#define FORMATION_START_TOLERANCE 0.3f
+#define FORMATION_FENCE_MIN_X -0.5f
+#define FORMATION_FENCE_MIN_Y -0.5f
+#define FORMATION_FENCE_MAX_X 3.0f
+#define FORMATION_FENCE_MAX_Y 3.0f
+#define FORMATION_VBAT_LAND 3.2f
+#define FORMATION_VBAT_MS 2000u
+#define FORMATION_HOLD_TIMEOUT_MS 2000u
+#define FORMATION_MIN_SEPARATION 0.3f
+bool formation_policy(uint8_t id, flight_policy *policy);
+
+/* The minimum-separation guard (the core's, ph_separation_guard) on the velocity
+ * `setpoint` against every neighbour whose position is fresh at `now_ms`; a change is
+ * counted in policy->guarded. */
+void formation_guard(const formation_state *state, uint32_t now_ms, ph_policy *policy,
+                     const ph_policy_config *config, const float own[2], float setpoint[2]);

@@ -9,6 +9,9 @@
  *                                               also prints
  *                                               CFAPP shape noise=<m> rms=<m> max=<m>
  *                                               (q_i - q_1 against the square, last 10 s)
+ *   cfapp-host --start-ms MS                    the first, with the control clock
+ *                                               starting at MS ms (modulo 2^32: a year
+ *                                               of uptime is 31,536,000,000 ms)
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,7 +28,7 @@ int main(int argc, char **argv)
 {
     if (ph_abi_version() != PH_ABI_VERSION || ph_agent_size() != PH_AGENT_SIZE)
         return 1;
-    swarm_options options = {0.0f, 0};
+    swarm_options options = {0.0f, 0, 0};
     int study = 0;
     for (int k = 1; k + 1 < argc; k += 2) {
         char *end = NULL;
@@ -38,8 +41,14 @@ int main(int argc, char **argv)
             options.position_noise = (float)value;
         else if (strcmp(argv[k], "--seconds") == 0)
             options.seconds = (uint32_t)value;
+        else if (strcmp(argv[k], "--start-ms") == 0) {
+            /* The uptime at the start, modulo 2^32 ms (the clock's wrap). */
+            options.start_ms = (uint32_t)(uint64_t)value;
+            continue; /* not a study: the run until converged */
+        }
         else {
-            fprintf(stderr, "usage: %s [--position-noise M] [--seconds S]\n", argv[0]);
+            fprintf(stderr, "usage: %s [--position-noise M] [--seconds S] [--start-ms MS]\n",
+                    argv[0]);
             return 2;
         }
         study = 1;

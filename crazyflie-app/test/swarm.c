@@ -32,6 +32,7 @@ static float v[SWARM_N][2];
 static inbox air[2][SWARM_N];
 static int current;   /* the robot whose app runs (its state estimator) */
 static float noise;   /* position noise (m), swarm_run_with() */
+static uint32_t start_ms; /* the control clock at tick 0, swarm_run_with() */
 static uint32_t rng = 0x9e3779b9u;
 
 /* Approximately standard normal: the sum of 12 uniforms minus 6 (xorshift32; no
@@ -146,6 +147,7 @@ int swarm_run(swarm_result *r)
 void swarm_run_with(const swarm_options *options, swarm_result *r, swarm_shape_error *error)
 {
     noise = options->position_noise;
+    start_ms = options->start_ms;
     if (options->seconds == 0) {
         run(SWARM_MAX_TIME_S * 100u, 1, r, error);
         return;
@@ -161,7 +163,7 @@ static void run(uint32_t max_ticks, int stop_when_converged, swarm_result *r,
     uint32_t samples = 0;
     uint32_t tick = 0;
     for (; tick < max_ticks; tick++) {
-        float now = (float)tick * TICK_S;
+        uint32_t now = start_ms + tick * 10u; /* ms, wraps modulo 2^32 */
         int receiving = sending;
         sending = 1 - sending;
         for (int i = 0; i < SWARM_N; i++) {
@@ -171,7 +173,7 @@ static void run(uint32_t max_ticks, int stop_when_converged, swarm_result *r,
                 agent_loop_receive(&loops[i], b->items[k].port, b->items[k].bytes,
                                    b->items[k].len, now);
             b->count = 0;
-            ph_status s = agent_loop_tick(&loops[i], now, TICK_S, broadcast, &i);
+            ph_status s = agent_loop_tick(&loops[i], now, broadcast, &i);
             if (s != PH_OK && r->error == PH_OK)
                 r->error = s;
             float speed = norm(loops[i].setpoint[0], loops[i].setpoint[1]);

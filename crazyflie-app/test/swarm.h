@@ -46,6 +46,7 @@ typedef struct {
 typedef struct {
     float position_noise; /* m, 0: exact */
     uint32_t seconds;     /* 0: until converged or SWARM_MAX_TIME_S */
+    uint32_t start_ms;    /* the control clock at the start (ms; wraps modulo 2^32) */
 } swarm_options;
 
 /* RMS and largest distance of q_i - q_1 from the square over the last

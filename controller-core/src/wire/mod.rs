@@ -83,6 +83,7 @@ pub mod auth;
 mod checked;
 mod cobs;
 mod frame;
+pub mod position;
 pub mod quant;
 mod reader;
 mod writer;

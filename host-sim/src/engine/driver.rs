@@ -58,6 +58,10 @@ pub trait Engine {
     fn channel_stats(&self) -> Option<ChannelStats> {
         None
     }
+    /// What the safety policies did, per agent (empty without `[policy]`).
+    fn policy_counts(&self) -> Vec<controller_core::policy::PolicyCounts> {
+        Vec::new()
+    }
     /// A controller failure that ends the run (a host-in-the-loop target that stopped
     /// answering or sent a corrupt frame), taken once; checked after every
     /// [`Self::control`].
@@ -273,6 +277,7 @@ pub fn drive(
         control: engine.control_stats(),
         channel,
         attacks: engine.attack_counts(),
+        policy: engine.policy_counts(),
         warnings,
         steps: sim.steps,
         wall_seconds: started.elapsed().as_secs_f64(),

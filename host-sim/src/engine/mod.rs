@@ -17,6 +17,7 @@ mod driver;
 mod error;
 pub mod hil;
 pub mod plant;
+pub mod policy;
 pub mod radio;
 mod record;
 mod result;

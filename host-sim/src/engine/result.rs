@@ -61,6 +61,10 @@ pub struct RunResult {
     pub channel: Option<ChannelStats>,
     /// Frames each attacker overheard and injected (`[[attacks]]` order).
     pub attacks: Vec<AttackCounts>,
+    /// What the safety policies did, per agent in agent order: ticks holding, landings
+    /// and the last one's reason, setpoints the separation guard changed (empty
+    /// without `[policy]`; `crate::engine::policy`).
+    pub policy: Vec<controller_core::policy::PolicyCounts>,
     /// Things the user should know (ignored settings, …).
     pub warnings: Vec<String>,
     /// RK4 steps taken.

@@ -90,6 +90,8 @@ pub struct SampledSim<'m> {
     direct: bool,
     /// Every controller is a [`LocalCore`](super::LocalCore) (ticks may run in parallel).
     local: bool,
+    /// The safety policies (`[policy]`), applied to each force after its tick.
+    policy: Option<super::policy::PolicyRun>,
 }
 
 /// Frames one agent emits per tick, at most, in the standard capacity (used to
@@ -199,6 +201,7 @@ impl<'m> SampledSim<'m> {
             stats: ControlStats::with_window(crate::analysis::steady::Window::of(model).from),
             direct,
             local: false,
+            policy: model.policy.map(|c| super::policy::PolicyRun::new(c, n)),
         })
     }
 
@@ -258,6 +261,7 @@ impl SampledSim<'_> {
             && self.model.n() >= PARALLEL_MIN_AGENTS
             && rayon::current_num_threads() > 1
             && self.world.clocks.is_none()
+            && self.policy.is_none()
     }
 
     /// What agent `i` takes in at this tick: what the radio delivered, or with direct
@@ -466,7 +470,19 @@ impl Engine for SampledSim<'_> {
             } else {
                 self.broadcast(t, i);
             }
-            let force = world_force(self.world.headings.as_ref(), i, &at, out.force);
+            let own = match self.policy.as_mut() {
+                Some(p) => p.force(
+                    i,
+                    &out,
+                    at.dt,
+                    self.plant.q(),
+                    self.plant.v(),
+                    model.graph.radio.of(i),
+                    model.limits.safe_damping,
+                ),
+                None => out.force,
+            };
+            let force = world_force(self.world.headings.as_ref(), i, &at, own);
             self.forces[i] = force;
             if self.plant.takes_commands() {
                 self.plant.command(i, force, at.dt);
@@ -562,6 +578,12 @@ impl Engine for SampledSim<'_> {
 
     fn control_stats(&self) -> ControlStats {
         self.stats
+    }
+
+    fn policy_counts(&self) -> Vec<controller_core::policy::PolicyCounts> {
+        self.policy
+            .as_ref()
+            .map_or_else(Vec::new, super::policy::PolicyRun::counts)
     }
 
     fn channel_stats(&self) -> Option<ChannelStats> {

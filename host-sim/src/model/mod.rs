@@ -99,6 +99,8 @@ pub struct Model {
     pub attacks: Vec<AttackModel>,
     /// The robot's world: vehicle, wind, headings, clocks (`docs/world.md`).
     pub world: WorldModel,
+    /// The vehicles' safety policies (`[policy]`; `None`: none run).
+    pub policy: Option<controller_core::policy::PolicyConfig<f64>>,
 }
 
 impl Model {

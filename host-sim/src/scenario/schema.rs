@@ -274,6 +274,9 @@ pub struct ScenarioFile {
     /// `[clock]`: each agent's own clock (optional).
     #[serde(default)]
     pub clock: Option<ClockSpec>,
+    /// `[policy]`: the vehicles' safety policies (optional).
+    #[serde(default)]
+    pub policy: Option<super::policy::PolicySpec>,
 }
 
 /// `[target]`: the target shape, one `[x, y]` per agent in `[[agents]]` order; compared

@@ -81,6 +81,7 @@ pub fn strip_model(n: usize, duration: f64) -> Result<Model, ScenarioErrors> {
         graph: Graph::new(n, &tri, None),
         attacks: Vec::new(),
         world: crate::model::WorldModel::ideal(),
+        policy: None,
         // The equilateral strip the 60° angles encode.
         target: Target {
             positions: (0..n)

@@ -184,6 +184,10 @@ impl BearingSensor for SharedPositions {
         draws: &mut Draws<'_>,
     ) -> Option<BearingMeasurement<f64>> {
         let other = self.fresh(i, j)?;
+        // Coincident positions give no bearing: the core's one rule, as the app's.
+        if (other - self.own[i]).norm() < controller_core::policy::COINCIDENT {
+            return None;
+        }
         let sight = Sight {
             neighbour: ids[j],
             q_self: &self.own[i],

@@ -10,6 +10,7 @@ mod checker;
 mod comm;
 mod graph;
 mod model;
+mod policy;
 mod positions;
 mod references;
 mod settings;
@@ -64,6 +65,7 @@ fn check(
     let channel = comm::channel(&mut c, s, period);
     let auth_key = comm::auth_key(&mut c, s);
     let world = world::check(&mut c, s, period);
+    let policy = policy::check(&mut c, s);
     let (mut agents, index) = agents::check(&mut c, s);
     let camera = camera::check(&mut c, s, &agents);
     let positions = positions::check(&mut c, s);
@@ -147,6 +149,7 @@ fn check(
         attacks,
         target,
         world,
+        policy,
     };
     model.sensors.bearing_filter = bearing_filter(se, &model.sensing_noise());
     // Last line of defence, shared with generated models (`model::check_model`): wire

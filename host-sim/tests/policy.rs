@@ -1,0 +1,107 @@
+//! `[policy]` (docs/scenarios.md "Safety policies"): the core's safety policies run in
+//! the simulator's controller adapter (`host_sim::engine::policy`), and the run result
+//! says per agent what they did (`RunResult::policy`). Each check has its negative
+//! control; bad values are refused with file, field and reason.
+
+use controller_core::policy::PolicyReason;
+use host_sim::engine::{self as sim, NullRecorder, RunResult};
+use host_sim::load;
+
+fn room(overrides: &[&str]) -> Result<host_sim::model::Model, String> {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../crazyflie-app/formation.toml"
+    );
+    let mut o: Vec<String> = vec!["duration=10".to_owned()];
+    o.extend(overrides.iter().map(|s| (*s).to_owned()));
+    load(path, &o).map_err(|e| e.to_string())
+}
+
+fn run(overrides: &[&str]) -> RunResult {
+    let m = room(overrides).unwrap_or_else(|e| panic!("{e}"));
+    sim::run(&m, &mut NullRecorder, &mut |_| {}).expect("run")
+}
+
+#[test]
+fn without_a_policy_table_nothing_runs() {
+    let r = run(&[]);
+    assert!(r.policy.is_empty());
+}
+
+#[test]
+fn leaving_the_fence_lands_and_inside_does_not() {
+    // The square drifts at 0.5 m/s in x: it leaves x <= 2.5 m within 10 s.
+    let moving = "velocity_reference=[0.5, 0.0]";
+    let r = run(&[
+        moving,
+        "policy.fence_min=[-1.0, -1.0]",
+        "policy.fence_max=[2.5, 3.0]",
+    ]);
+    println!("fence: {:?}, final {:?}", r.policy, r.final_positions);
+    assert_eq!(r.policy.len(), 4);
+    assert!(
+        r.policy
+            .iter()
+            .any(|c| c.landings == 1 && c.last_landing == PolicyReason::Fence),
+        "{:?}",
+        r.policy
+    );
+    // The landed agents stopped inside a braking distance of the fence.
+    for q in &r.final_positions {
+        assert!(q[0] < 3.5, "{q:?}");
+    }
+    // Negative control: a fence the run stays inside.
+    let r = run(&[
+        moving,
+        "policy.fence_min=[-1.0, -1.0]",
+        "policy.fence_max=[20.0, 20.0]",
+    ]);
+    assert!(r.policy.iter().all(|c| c.landings == 0), "{:?}", r.policy);
+}
+
+#[test]
+fn lost_radio_holds_then_lands_after_the_timeout() {
+    let r = run(&["radio.loss=1.0", "policy.hold_timeout_s=1.5"]);
+    for c in &r.policy {
+        assert_eq!(c.landings, 1, "{c:?}");
+        assert_eq!(c.last_landing, PolicyReason::LostTimeout);
+        // Lost from the first tick: 1.5 s of 10 ms ticks held, the next one lands.
+        assert_eq!(c.hold_ticks, 150, "{c:?}");
+    }
+    // Negative control: the radio works; the first ticks (nobody heard yet) hold only.
+    let r = run(&["policy.hold_timeout_s=1.5"]);
+    for c in &r.policy {
+        assert_eq!(c.landings, 0, "{c:?}");
+        assert!(c.hold_ticks < 5, "{c:?}");
+    }
+}
+
+#[test]
+fn separation_guard_acts_only_inside_the_minimum() {
+    // 3 m: every neighbour is inside it, so every approach is cut.
+    let r = run(&["policy.min_separation=3.0"]);
+    println!("min_separation 3 m: {:?}", r.policy);
+    assert!(r.policy.iter().any(|c| c.guarded > 0), "{:?}", r.policy);
+    let r = run(&["policy.min_separation=0.05"]);
+    assert!(r.policy.iter().all(|c| c.guarded == 0), "{:?}", r.policy);
+}
+
+#[test]
+fn bad_policy_values_are_refused_with_the_field() {
+    for (set, field) in [
+        ("policy.hold_timeout_s=-1.0", "policy.hold_timeout_s"),
+        ("policy.min_separation=-0.1", "policy.min_separation"),
+        ("policy.fence_min=[0.0, 0.0]", "policy.fence_min"),
+    ] {
+        let e = room(&[set]).expect_err(set);
+        assert!(
+            e.contains(field) && e.contains("formation.toml"),
+            "{set}: {e}"
+        );
+    }
+    let e = room(&["policy.fence_min=[2.0, 0.0]", "policy.fence_max=[1.0, 3.0]"])
+        .expect_err("inverted fence");
+    assert!(e.contains("policy.fence_max"), "{e}");
+    let e = room(&["policy.hold_timeout=1"]).expect_err("unknown key");
+    assert!(e.contains("hold_timeout"), "{e}");
+}
