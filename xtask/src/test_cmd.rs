@@ -156,7 +156,9 @@ fn phases(
         )
     })?;
     phase("bench-counts (host-sim under callgrind)", &mut || {
-        // The dev build `cargo test` made: only the example links (docs/performance.md).
+        // The dev profile, but `-p host-sim`'s own feature set (the binary the budgets
+        // were measured on): host-sim and the crates whose features differ from the
+        // workspace's (postcard, controller-core, …) compile again (docs/performance.md).
         let o = crate::bench_counts::Options {
             profile: "dev".into(),
             budgets: crate::bench_counts::default_budgets(),
