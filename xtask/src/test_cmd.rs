@@ -121,10 +121,12 @@ fn phases(
             // The tests that need arm-none-eabi-gcc and QEMU (ignored by plain `cargo test`):
             // the C firmware converges, links no panic path, and prints its figures (text of
             // the staticlib's code, RAM per agent, instructions per tick through the C API);
-            // the Crazyflie app compiles against the header stub.
+            // the Crazyflie app compiles against the header stub. The staticlibs are
+            // release builds (`controller-ffi/c/build.sh`); the test binaries themselves
+            // are the ones `cargo test` built (no `-p`, no `--release`: nothing rebuilt).
             tools::run(
                 cargo()
-                    .args(["test", "-p", "controller-ffi", "--release"])
+                    .arg("test")
                     .args(["--test", "c_firmware", "--test", "crazyflie_app"])
                     .args([
                         "--",
@@ -154,7 +156,9 @@ fn phases(
         )
     })?;
     phase("bench-counts (host-sim under callgrind)", &mut || {
-        // The dev build `cargo test` made: only the example links (docs/performance.md).
+        // The dev profile, but `-p host-sim`'s own feature set (the binary the budgets
+        // were measured on): host-sim and the crates whose features differ from the
+        // workspace's (postcard, controller-core, …) compile again (docs/performance.md).
         let o = crate::bench_counts::Options {
             profile: "dev".into(),
             budgets: crate::bench_counts::default_budgets(),

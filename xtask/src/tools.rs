@@ -1,6 +1,6 @@
 //! The external programs the tasks run: cargo, rustc's `llvm-tools`, the plugin build.
 
-use qemu_harness::firmware::workspace_root;
+use qemu_harness::firmware::{target_dir, workspace_root};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
@@ -9,6 +9,21 @@ pub fn cargo() -> Command {
     let mut c = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
     c.current_dir(workspace_root());
     c
+}
+
+/// Builds the `host-sim` binary as `cargo test` builds it (no `-p`: the default members'
+/// feature set; dev profile) and returns its path. After `cargo test` nothing is rebuilt,
+/// so the simulator the tests ran is the one used (no release build of host-sim and its
+/// dependencies only for this: Rust's floating point is the same at every opt-level,
+/// so a run's outputs are the same byte for byte).
+pub fn host_sim_dev() -> Result<PathBuf, String> {
+    run(cargo().args(["test", "--no-run", "--test", "sweep"]))?;
+    let exe = target_dir().join("debug/host-sim");
+    if exe.is_file() {
+        Ok(exe)
+    } else {
+        Err(format!("{} was not built", exe.display()))
+    }
 }
 
 /// Runs `cmd` with inherited output; an error names the command and its exit status.

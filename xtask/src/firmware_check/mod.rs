@@ -215,6 +215,7 @@ fn qemu_tests(c: &mut Checker, peaks: &mut BTreeMap<&str, u64>, out: &Path) -> R
     let demo_log = out.join("qemu-demo.log");
     let uart_log = out.join("qemu-uart.log");
     let test_log = out.join("qemu-tests.log");
+    let summary = host_sim_paper(out)?;
     // No `-p`: the default members' feature set, so the test binaries and their
     // dependencies are the ones `cargo test` already built.
     let ok = tools::run_logged(
@@ -222,7 +223,8 @@ fn qemu_tests(c: &mut Checker, peaks: &mut BTreeMap<&str, u64>, out: &Path) -> R
             .args(["test", "--test", "qemu_demo", "--test", "qemu_uart"])
             .args(["--", "--include-ignored", "--nocapture"])
             .env("PH_QEMU_DEMO_LOG", &demo_log)
-            .env("PH_QEMU_UART_LOG", &uart_log),
+            .env("PH_QEMU_UART_LOG", &uart_log)
+            .env("PH_HOST_SIM_SUMMARY", &summary),
         &test_log,
     )?;
     let output = std::fs::read_to_string(&test_log).unwrap_or_default();
@@ -259,4 +261,21 @@ fn qemu_tests(c: &mut Checker, peaks: &mut BTreeMap<&str, u64>, out: &Path) -> R
     let uart = std::fs::read_to_string(&uart_log).unwrap_or_default();
     stack_of(c, peaks, "qemu-uart", &uart, out);
     Ok(())
+}
+
+/// The host simulator's `paper` run that `demo_matches_host_sim` compares the demo with
+/// (its `summary.json`, passed as `PH_HOST_SIM_SUMMARY`): run by the dev binary `cargo
+/// test` built ([`tools::host_sim_dev`]) rather than by the test's own `cargo run
+/// --release -p host-sim`, a release build (fat LTO) of the simulator and its
+/// dependencies for a run of about a second. The same code and the same `f64` results.
+fn host_sim_paper(out: &Path) -> Result<PathBuf, String> {
+    let host_sim = tools::host_sim_dev()?;
+    let dir = out.join("host-sim-paper");
+    let _ = std::fs::remove_dir_all(&dir);
+    tools::run(
+        std::process::Command::new(host_sim)
+            .args(["run", "paper", "--quiet", "--no-plots", "--out"])
+            .arg(&dir),
+    )?;
+    Ok(dir.join("summary.json"))
 }
