@@ -99,6 +99,24 @@ pub fn add_json(obj: &mut Map<String, Value>, model: &Model, r: &RunResult) {
         );
     }
     obj.insert("verdict".to_owned(), verdict);
+    // The core's safety policies (`[policy]`, docs/scenarios.md): what each agent's did.
+    if !r.policy.is_empty() {
+        let agents: Vec<Value> = r
+            .policy
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                json!({
+                    "agent": name(i),
+                    "hold_ticks": p.hold_ticks,
+                    "landings": p.landings,
+                    "last_landing": format!("{:?}", p.last_landing),
+                    "guarded": p.guarded,
+                })
+            })
+            .collect();
+        obj.insert("policy".to_owned(), Value::Array(agents));
+    }
     obj.insert(
         "pose".to_owned(),
         json!({
