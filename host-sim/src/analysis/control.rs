@@ -9,6 +9,18 @@ pub const FAULT_KINDS: usize = 8;
 /// How many agents [`FaultTally`] names.
 pub const FAULT_EXAMPLES: usize = 8;
 
+/// One fault of each kind, in [`fault_kind`]'s order (for words and keys by kind).
+pub const FAULT_SAMPLES: [Fault; FAULT_KINDS] = [
+    Fault::Measurement(controller_core::MeasurementError::NonFinite),
+    Fault::MissingBearing(0),
+    Fault::Stale(0),
+    Fault::MissingData(0),
+    Fault::MissingPartnerOffset,
+    Fault::MissingRange(0),
+    Fault::NonFinite,
+    Fault::Internal,
+];
+
 /// The kind of a fault, `0..FAULT_KINDS`, and its name in words.
 pub fn fault_kind(f: &Fault) -> (usize, &'static str) {
     match f {

@@ -6,7 +6,7 @@
 //! pose (orientation, scale, translation) is reported apart.
 
 use super::bands::Bands;
-use super::control::{fault_kind, WindowCounts, FAULT_KINDS};
+use super::control::{fault_kind, WindowCounts, FAULT_KINDS, FAULT_SAMPLES};
 use super::monitor::Monitor;
 use super::outcome::Outcome;
 use super::shape_check::{folded_names, shape_check};
@@ -424,20 +424,9 @@ fn kind_words(model: &Model, k: usize) -> &'static str {
         1 if se.positions.is_some() => "bearings missing: neighbours' positions stale or never heard",
         1 => "bearings missing",
         2 => "a neighbour silent: no frame within the timeout (loss, or an overloaded channel)",
-        _ => {
-            // The same words as `fault_kind`.
-            let f = [
-                Fault::Measurement(controller_core::MeasurementError::NonFinite),
-                Fault::MissingBearing(0),
-                Fault::Stale(0),
-                Fault::MissingData(0),
-                Fault::MissingPartnerOffset,
-                Fault::MissingRange(0),
-                Fault::NonFinite,
-                Fault::Internal,
-            ];
-            f.get(k).map_or("unknown", |f| fault_kind(f).1)
-        }
+        _ => FAULT_SAMPLES
+            .get(k)
+            .map_or("unknown", |f| fault_kind(f).1),
     }
 }
 

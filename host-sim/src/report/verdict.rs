@@ -131,23 +131,12 @@ pub fn add_json(obj: &mut Map<String, Value>, model: &Model, r: &RunResult) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::control::fault_kind;
-    use controller_core::Fault;
+    use crate::analysis::control::{fault_kind, FAULT_SAMPLES};
 
     /// The keys follow `fault_kind`'s numbering.
     #[test]
     fn keys_follow_the_fault_kinds() {
-        let faults = [
-            Fault::Measurement(controller_core::MeasurementError::NonFinite),
-            Fault::MissingBearing(1),
-            Fault::Stale(1),
-            Fault::MissingData(1),
-            Fault::MissingPartnerOffset,
-            Fault::MissingRange(1),
-            Fault::NonFinite,
-            Fault::Internal,
-        ];
-        for (k, f) in faults.iter().enumerate() {
+        for (k, f) in FAULT_SAMPLES.iter().enumerate() {
             assert_eq!(fault_kind(f).0, k);
             assert_ne!(kind_key(k), "unknown");
         }

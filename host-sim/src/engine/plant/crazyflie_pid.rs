@@ -234,14 +234,14 @@ impl Plant for CrazyfliePidPlant {
     /// The virtual mass integrates S1 over `period` under `force` (S20, with the lead of
     /// S21): the new velocity setpoint.
     fn command(&mut self, i: usize, force: Vec2<f64>, period: f64) {
-        if let (Some(c), Some(v), Some(sp)) = (
-            self.command.get_mut(i),
-            self.v.get(i),
-            self.setpoint.get_mut(i),
-        ) {
-            let next = c.step([force.x, force.y], [v.x, v.y], period);
-            *sp = Vec2::new(next[0], next[1]);
-        }
+        super::command_setpoint(
+            &mut self.command,
+            &self.v,
+            &mut self.setpoint,
+            i,
+            force,
+            period,
+        );
     }
 
     fn set_velocity_setpoint(&mut self, i: usize, setpoint: Vec2<f64>) -> bool {

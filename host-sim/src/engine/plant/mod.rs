@@ -66,3 +66,20 @@ pub fn new_plant(model: &Model) -> Result<Box<dyn Plant>, SetupError> {
         VehicleModel::CrazyfliePid(v) => Box::new(CrazyfliePidPlant::new(model, v)?),
     })
 }
+
+/// The velocity setpoint of agent `i` of a velocity-setpoint vehicle: its virtual mass
+/// (`command`, SPEC S20 with the leads of S21/S21b) integrates S1 over `period` under
+/// `force` from the vehicle's velocity `v`. The one implementation both such plants call.
+pub(crate) fn command_setpoint(
+    command: &mut [controller_core::actuate::VelocityCommand<f64>],
+    v: &[Vec2<f64>],
+    setpoint: &mut [Vec2<f64>],
+    i: usize,
+    force: Vec2<f64>,
+    period: f64,
+) {
+    if let (Some(c), Some(v), Some(sp)) = (command.get_mut(i), v.get(i), setpoint.get_mut(i)) {
+        let next = c.step([force.x, force.y], [v.x, v.y], period);
+        *sp = Vec2::new(next[0], next[1]);
+    }
+}
