@@ -168,7 +168,7 @@ impl Series {
     /// `sub / 8`): what a steady run's sub-windows reach (the calibration's statistic).
     pub fn worst_sub_window(&self, q: Quantity, w: &Window) -> Option<f64> {
         let step = 0.125 * w.sub;
-        if !(step > 0.0) {
+        if step.is_nan() || step <= 0.0 {
             return self.percentile(q, w.from, w.to);
         }
         let mut worst: Option<f64> = None;

@@ -372,7 +372,7 @@ fn not_in_control(model: &Model, control: &WindowCounts, w: &Window) -> Option<S
         .filter(|&k| control.safe.counts[k] > 0)
         .map(|k| (control.safe.counts[k], kind_words(model, k)))
         .collect();
-    kinds.sort_by(|a, b| b.0.cmp(&a.0));
+    kinds.sort_by_key(|k| std::cmp::Reverse(k.0));
     let causes: Vec<String> = kinds
         .iter()
         .map(|(c, w)| format!("{w} ({c} outputs)"))

@@ -120,7 +120,7 @@ fn placed_target(model: &Model, q: &[Vec2<f64>]) -> Option<Vec<[f64; 2]>> {
                 target[l.a][1] - target[l.b][1],
             ];
             let e2 = e[0] * e[0] + e[1] * e[1];
-            if !(e2 > 0.0) {
+            if e2.is_nan() || e2 <= 0.0 {
                 return None;
             }
             // a = z / e as complex numbers: the turn and scale taking e onto z.
