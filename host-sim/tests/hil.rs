@@ -519,8 +519,18 @@ fn positions(s: &serde_json::Value) -> Vec<[f64; 2]> {
 /// Runs `host-sim run paper` with `--hil` for `agents` into `out`; returns the output
 /// and the wall-clock time.
 fn qemu_run(agents: &[u8], out: &Path, extra: &[&str]) -> (Output, Duration) {
+    qemu_run_scenario("paper", agents, out, extra)
+}
+
+/// [`qemu_run`] of another built-in scenario.
+fn qemu_run_scenario(
+    scenario: &str,
+    agents: &[u8],
+    out: &Path,
+    extra: &[&str],
+) -> (Output, Duration) {
     let mut c = bin();
-    c.args(["-q", "run", "paper", "--no-plots", "--out"])
+    c.args(["-q", "run", scenario, "--no-plots", "--out"])
         .arg(out)
         .arg("--firmware")
         .arg(firmware())
@@ -599,11 +609,14 @@ fn qemu_agent_3_converges_like_the_host() {
 fn qemu_agent_3_runs_the_bearing_tracker_with_noisy_bearings() {
     // Issue 30: with 2° of bearing noise the configuration sent to the target carries the
     // bearing tracker (SPEC §11), the f32 core on the STM32F405 runs it, and the run
-    // converges under the noise-aware verdict like the pure-host one.
+    // converges under the verdict like the pure-host one. `formation-only` (the same four
+    // agents without the maneuvers): under the honest verdict (issue 39) a 30 s `paper`
+    // has not converged (its leader edge still 0.3 m off; it settles after 40 s).
     let _serial = QEMU_LOCK.lock().unwrap_or_else(|e| e.into_inner());
     let dir = tempfile::tempdir().expect("tempdir");
-    let out = dir.path().join("paper-hil3-noisy");
-    let (o, _) = qemu_run(
+    let out = dir.path().join("formation-only-hil3-noisy");
+    let (o, _) = qemu_run_scenario(
+        "formation-only",
         &[3],
         &out,
         &[
