@@ -523,18 +523,13 @@ fn qemu_run(agents: &[u8], out: &Path, extra: &[&str]) -> (Output, Duration) {
 }
 
 /// [`qemu_run`] of another built-in scenario.
-fn qemu_run_scenario(
-    scenario: &str,
-    agents: &[u8],
-    out: &Path,
-    extra: &[&str],
-) -> (Output, Duration) {
+fn qemu_run_scenario(scenario: &str, agents: &[u8], out: &Path, x: &[&str]) -> (Output, Duration) {
     let mut c = bin();
     c.args(["-q", "run", scenario, "--no-plots", "--out"])
         .arg(out)
         .arg("--firmware")
         .arg(firmware())
-        .args(extra);
+        .args(x);
     for a in agents {
         c.args(["--hil", &a.to_string()]);
     }
@@ -609,9 +604,8 @@ fn qemu_agent_3_converges_like_the_host() {
 fn qemu_agent_3_runs_the_bearing_tracker_with_noisy_bearings() {
     // Issue 30: with 2° of bearing noise the configuration sent to the target carries the
     // bearing tracker (SPEC §11), the f32 core on the STM32F405 runs it, and the run
-    // converges under the verdict like the pure-host one. `formation-only` (the same four
-    // agents without the maneuvers): under the honest verdict (issue 39) a 30 s `paper`
-    // has not converged (its leader edge still 0.3 m off; it settles after 40 s).
+    // converges like the pure-host one; on `formation-only`, as a 30 s `paper` has not
+    // converged under the honest verdict (issue 39: its leader edge still 0.3 m off).
     let _serial = QEMU_LOCK.lock().unwrap_or_else(|e| e.into_inner());
     let dir = tempfile::tempdir().expect("tempdir");
     let out = dir.path().join("formation-only-hil3-noisy");
