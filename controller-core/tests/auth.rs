@@ -5,9 +5,9 @@
 
 mod testkit;
 
-use controller_core::wire::auth::{self, counter, reconstruct, COUNTER_EXT_LEN, TAG_LEN};
-use controller_core::wire::{decode_frame, mode_byte, FrameWriter, Integrity, SwarmKey};
-use controller_core::{Agent, AgentConfig, AgentId, EstimatorMode, FrameError};
+use ph_formation_core::wire::auth::{self, counter, reconstruct, COUNTER_EXT_LEN, TAG_LEN};
+use ph_formation_core::wire::{decode_frame, mode_byte, FrameWriter, Integrity, SwarmKey};
+use ph_formation_core::{Agent, AgentConfig, AgentId, EstimatorMode, FrameError};
 use testkit::{fan, fan_positions, rng, sense_and_exchange, Formation, HostAgent, State};
 
 /// SipHash-2-4 with key `00 01 … 0f` of the messages `00 01 … (n−1)`, `n = 0..63`: the
@@ -305,7 +305,7 @@ fn the_centre_of_a_full_fan_sends_at_most_max_frames_per_tick() {
     // A fan of MAX_TRIANGLES triangles under `auth`: agent 0 is the apex of one angle
     // per triangle, items fill whole frames, and every eighth broadcast adds a sync frame:
     // the bound of `MAX_FRAMES_PER_TICK` is reached and never passed.
-    let mut agents = auth_fan(controller_core::MAX_TRIANGLES, 11);
+    let mut agents = auth_fan(ph_formation_core::MAX_TRIANGLES, 11);
     let counts: Vec<usize> = (0..9).map(|_| agents[0].frames(|_| ())).collect();
     let bound = HostAgent::<f64>::MAX_FRAMES_PER_TICK;
     assert_eq!(bound, 3);
@@ -320,7 +320,7 @@ fn auth_fan(k: usize, seed: u64) -> Vec<HostAgent<f64>> {
     let f = Formation::random(k + 2, fan(k), &q, &mut r);
     let s = State {
         q: q.clone(),
-        v: vec![controller_core::Vec2::new(0.1, 0.0); k + 2],
+        v: vec![ph_formation_core::Vec2::new(0.1, 0.0); k + 2],
     };
     let mut agents: Vec<HostAgent<f64>> = (0..k + 2)
         .map(|i| {

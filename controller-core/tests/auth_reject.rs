@@ -5,14 +5,14 @@
 //! neighbour, makes its attempts, and ends by checking that the receiver accepted
 //! nothing, counted every attempt as rejected, and still accepts the sender's next
 //! authentic frame (a rejected frame changes no state but the counters). The counts per
-//! rejection reason are printed (`cargo test -p controller-core --test auth_reject --
+//! rejection reason are printed (`cargo test -p ph-formation-core --test auth_reject --
 //! --nocapture`) and recorded in docs/core.md ("auth").
 
-use controller_core::wire::auth::{counter, Counter};
-use controller_core::wire::{
+use ph_formation_core::wire::auth::{counter, Counter};
+use ph_formation_core::wire::{
     mode_byte, mode_with_items, FrameWriter, Integrity, SwarmKey, MAX_FRAME_LEN,
 };
-use controller_core::{Agent, AgentConfig, AgentId, EstimatorMode, FrameError, FrameStats};
+use ph_formation_core::{Agent, AgentConfig, AgentId, EstimatorMode, FrameError, FrameStats};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::collections::BTreeMap;

@@ -3,8 +3,8 @@
 
 mod testkit;
 
-use controller_core::link::{link_estimates, LinkError, LinkOutput, MAX_LINK_ESTIMATES};
-use controller_core::{
+use ph_formation_core::link::{link_estimates, LinkError, LinkOutput, MAX_LINK_ESTIMATES};
+use ph_formation_core::{
     Agent, AgentConfig, AngleConfig, ConfigError, EstimatorMode, Fault, Schedule, ScheduleStep,
     Status, StepOutput, TriangleConfig, Vec2,
 };
@@ -190,7 +190,7 @@ fn copy_estimates_is_owned_estimates_values() {
         for mut a in f.agents::<f64>() {
             let owned: Vec<_> = a.owned_estimates().collect();
             for e in &owned {
-                assert!(a.set_estimate(&controller_core::OwnedEstimate {
+                assert!(a.set_estimate(&ph_formation_core::OwnedEstimate {
                     value: r.random_range(0.3..3.0),
                     ..*e
                 }));

@@ -5,7 +5,7 @@
 
 mod testkit;
 
-use controller_core::{energy, geometry, EstimatorMode, Vec2};
+use ph_formation_core::{energy, geometry, EstimatorMode, Vec2};
 use rand::Rng;
 use testkit::{
     fan, fan_positions, rng, sense_and_exchange, strip, strip_positions, Formation, State,
@@ -25,7 +25,7 @@ fn check(f: &Formation, s: &State, seed: u64) -> Check {
     for a in agents.iter_mut() {
         let owned: Vec<_> = a.owned_estimates().collect();
         for e in owned {
-            assert!(a.set_estimate(&controller_core::OwnedEstimate {
+            assert!(a.set_estimate(&ph_formation_core::OwnedEstimate {
                 value: r.random_range(0.3..3.0),
                 ..e
             }));

@@ -2,12 +2,12 @@
 
 mod testkit;
 
-use controller_core::Vec2;
+use ph_formation_core::Vec2;
 use nalgebra::Rotation2;
 use rand::Rng;
 use testkit::{rng, sense_and_exchange, strip, strip_positions, Formation, HostAgent, State};
 
-fn forces<T: controller_core::Real>(
+fn forces<T: ph_formation_core::Real>(
     f: &Formation,
     s: &State,
     estimates: &dyn Fn(usize) -> f64,
@@ -17,7 +17,7 @@ fn forces<T: controller_core::Real>(
         let owned: Vec<_> = a.owned_estimates().collect();
         for e in owned {
             let key = usize::from(e.apex) * 1000 + usize::from(e.far) * 10 + e.triangle;
-            assert!(a.set_estimate(&controller_core::OwnedEstimate {
+            assert!(a.set_estimate(&ph_formation_core::OwnedEstimate {
                 value: T::lit(estimates(key)),
                 ..e
             }));

@@ -5,7 +5,7 @@
 //! bound and falls with the square of the displacement (with the relative velocities zero: the neglected term `d_α (∂ẏ/∂q_k)·δ` is
 //! proportional to them, and vanishes at the formation's equilibrium).
 
-use controller_core::{geometry, law, Vec2};
+use ph_formation_core::{geometry, law, Vec2};
 use proptest::prelude::*;
 
 fn point() -> impl Strategy<Value = Vec2<f64>> {

@@ -1,6 +1,6 @@
 //! S6 against central finite differences at random non-degenerate triangles (f64).
 
-use controller_core::{geometry, Vec2};
+use ph_formation_core::{geometry, Vec2};
 use proptest::prelude::*;
 
 fn cos_at(u: Vec2<f64>, v: Vec2<f64>, w: Vec2<f64>) -> f64 {

@@ -3,7 +3,7 @@
 
 mod testkit;
 
-use controller_core::{
+use ph_formation_core::{
     BearingMeasurement, EstimatorMode, Fault, MeasurementError, Measurements, Status, Vec2,
 };
 use proptest::prelude::*;
@@ -43,7 +43,7 @@ fn meas<'a>(
     }
 }
 
-fn assert_safe(out: &controller_core::StepOutput<f64>, v: Vec2<f64>, fault: Fault) {
+fn assert_safe(out: &ph_formation_core::StepOutput<f64>, v: Vec2<f64>, fault: Fault) {
     assert_eq!(out.status, Status::Safe(fault));
     // Default safe damping 1: U = −v.
     assert!(

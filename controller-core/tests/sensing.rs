@@ -2,7 +2,7 @@
 
 mod testkit;
 
-use controller_core::{BearingMeasurement, Measurements, Vec2};
+use ph_formation_core::{BearingMeasurement, Measurements, Vec2};
 use testkit::{rng, strip, strip_positions, Formation};
 
 #[test]
@@ -11,7 +11,7 @@ fn finite_difference_rate_tracks_a_rotating_bearing_across_missed_ticks() {
     let mut f = Formation::random(4, strip(4), &strip_positions(4, 0.1, &mut r), &mut r);
     f.leader = None;
     let mut c = f.config(0);
-    c.bearing_filter = controller_core::BearingFilter::FiniteDifference;
+    c.bearing_filter = ph_formation_core::BearingFilter::FiniteDifference;
     let mut a = testkit::HostAgent::<f64>::new(c).expect("valid");
     let (omega, dt) = (0.8, 0.01);
     let bearing = |k: usize, to: u8| {

@@ -6,7 +6,7 @@
 
 mod testkit;
 
-use controller_core::{law, EstimatorMode, Measurements, Real, Status, Vec2};
+use ph_formation_core::{law, EstimatorMode, Measurements, Real, Status, Vec2};
 use rand::seq::SliceRandom;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
@@ -63,7 +63,7 @@ fn compare<T: Real>(f: &Formation, q0: &[Vec2<f64>], seed: u64) -> (usize, usize
         let owned: Vec<_> = a.owned_estimates().collect();
         for e in owned {
             let value = T::lit(r.random_range(0.05..3.0));
-            assert!(a.set_estimate(&controller_core::OwnedEstimate { value, ..e }));
+            assert!(a.set_estimate(&ph_formation_core::OwnedEstimate { value, ..e }));
         }
     }
     let s0 = random_state(q0, &mut r);
@@ -145,7 +145,7 @@ fn compare<T: Real>(f: &Formation, q0: &[Vec2<f64>], seed: u64) -> (usize, usize
                         want
                     );
                     assert!(reference
-                        .set_estimate(&controller_core::OwnedEstimate { value: want, ..*e }));
+                        .set_estimate(&ph_formation_core::OwnedEstimate { value: want, ..*e }));
                 }
             }
             Err(fault) => {

@@ -5,9 +5,9 @@
 
 mod testkit;
 
-use controller_core::geometry::{bearing_rate, perp};
-use controller_core::tracker::{RelativeVelocity, Track, TrackLimits};
-use controller_core::{BearingFilter, ConfigError, TrackerConfig, Vec2};
+use ph_formation_core::geometry::{bearing_rate, perp};
+use ph_formation_core::tracker::{RelativeVelocity, Track, TrackLimits};
+use ph_formation_core::{BearingFilter, ConfigError, TrackerConfig, Vec2};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

@@ -5,11 +5,11 @@
 
 mod testkit;
 
-use controller_core::wire::{
+use ph_formation_core::wire::{
     check_frame, decode_frame, mode_byte, mode_with_items, quant, FrameWriter, Integrity,
     MAX_FRAME_LEN,
 };
-use controller_core::{EstimatorMode, FrameError, Measurements, Vec2};
+use ph_formation_core::{EstimatorMode, FrameError, Measurements, Vec2};
 use proptest::prelude::*;
 use testkit::{
     bearings, fan, fan_positions, rng, sense_and_exchange, strip, strip_positions, Formation,
@@ -392,7 +392,7 @@ proptest! {
     #[test]
     fn crc_matches_the_crc_crate(bytes in proptest::collection::vec(any::<u8>(), 0..80)) {
         let reference = crc::Crc::<u16>::new(&crc::CRC_16_IBM_SDLC);
-        prop_assert_eq!(controller_core::crc16::checksum(&bytes), reference.checksum(&bytes));
+        prop_assert_eq!(ph_formation_core::crc16::checksum(&bytes), reference.checksum(&bytes));
     }
 
     /// Frames are exactly the documented bytes (checked by an independent decoder and the
@@ -491,7 +491,7 @@ proptest! {
     /// back into exactly the frames, and the corrupt chunk is reported, not fatal.
     #[test]
     fn cobs_stream_round_trip(frames in proptest::collection::vec(proptest::collection::vec(any::<u8>(), 1..=MAX_FRAME_LEN), 1..5)) {
-        use controller_core::wire::{cobs_encode, CobsAccumulator, MAX_COBS_LEN};
+        use ph_formation_core::wire::{cobs_encode, CobsAccumulator, MAX_COBS_LEN};
         let mut stream = Vec::new();
         for f in &frames {
             let mut buf = [0u8; MAX_COBS_LEN];
@@ -520,15 +520,15 @@ proptest! {
 
 #[test]
 fn link_messages_round_trip_within_their_size_limit() {
-    use controller_core::link::{HostMsg, LinkBearing, LinkStep, MAX_LINK_BEARINGS, MAX_LINK_MSG};
+    use ph_formation_core::link::{HostMsg, LinkBearing, LinkStep, MAX_LINK_BEARINGS, MAX_LINK_MSG};
     // The largest configuration the HIL link carries: 4 triangles, leader, schedules full.
     let mut r = rng(1);
     let f = Formation::random(6, fan(4), &fan_positions(4, 0.1, &mut r), &mut r);
     let mut cfg = f.config::<f32>(0);
-    let full = |c: &mut controller_core::Schedule<f32>| {
+    let full = |c: &mut ph_formation_core::Schedule<f32>| {
         while c
             .steps
-            .push(controller_core::ScheduleStep {
+            .push(ph_formation_core::ScheduleStep {
                 from: 1.5,
                 value: [1.0, -2.0],
             })
@@ -539,11 +539,11 @@ fn link_messages_round_trip_within_their_size_limit() {
     if let Some(l) = cfg.leader.as_mut() {
         full(&mut l.displacement);
     }
-    let small: controller_core::AgentConfig<f32, 4> = controller_core::AgentConfig {
+    let small: ph_formation_core::AgentConfig<f32, 4> = ph_formation_core::AgentConfig {
         triangles: cfg.triangles.iter().copied().collect(),
-        ..controller_core::AgentConfig::new(cfg.id)
+        ..ph_formation_core::AgentConfig::new(cfg.id)
     };
-    let small = controller_core::AgentConfig {
+    let small = ph_formation_core::AgentConfig {
         leader: cfg.leader.clone(),
         velocity_reference: cfg.velocity_reference.clone(),
         ..small

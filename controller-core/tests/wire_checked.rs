@@ -4,8 +4,8 @@
 
 mod testkit;
 
-use controller_core::wire::{mode_byte, CrcCheck, FrameWriter, Integrity, MAX_FRAME_LEN};
-use controller_core::{EstimatorMode, FrameError, Measurements, Vec2};
+use ph_formation_core::wire::{mode_byte, CrcCheck, FrameWriter, Integrity, MAX_FRAME_LEN};
+use ph_formation_core::{EstimatorMode, FrameError, Measurements, Vec2};
 use proptest::prelude::*;
 use testkit::{bearings, rng, strip, strip_positions, Formation, HostAgent, State};
 
@@ -106,7 +106,7 @@ proptest! {
         integrity in prop::sample::select(vec![
             Integrity::Crc16,
             Integrity::Link,
-            Integrity::Auth(controller_core::wire::SwarmKey::new([7; 16])),
+            Integrity::Auth(ph_formation_core::wire::SwarmKey::new([7; 16])),
         ]),
     ) {
         let mut plain = receiver(integrity);
@@ -172,7 +172,7 @@ fn frames_checked_gives_the_frames_and_their_checks() {
     for integrity in [
         Integrity::Crc16,
         Integrity::Link,
-        Integrity::Auth(controller_core::wire::SwarmKey::new([7; 16])),
+        Integrity::Auth(ph_formation_core::wire::SwarmKey::new([7; 16])),
     ] {
         let agent = receiver(integrity);
         let (mut plain, mut checked) = (agent.clone(), agent);

@@ -8,12 +8,12 @@
 //! them and random bytes, for receivers of every mode. And the claim is kept true: the
 //! core depends on postcard while the documents say the frames are postcard.
 
-use controller_core::wire::auth::{self, Counter, TAG_LEN};
-use controller_core::wire::{
+use ph_formation_core::wire::auth::{self, Counter, TAG_LEN};
+use ph_formation_core::wire::{
     check_frame, decode_frame, mode_byte, AngleItem, CounterExt, Frame, FrameHeader, FrameWriter,
     Integrity, SwarmKey, F16, MAX_FRAME_LEN,
 };
-use controller_core::EstimatorMode;
+use ph_formation_core::EstimatorMode;
 use proptest::prelude::*;
 
 const KEY: SwarmKey = SwarmKey::new(*b"postcard swarm k");

@@ -1,7 +1,7 @@
 //! The binary16 rounding of the efforts (`wire::quant`): every code, and random values
 //! over the whole range, against the documented range and error bounds.
 
-use controller_core::wire::quant::{decode, encode, ABS_ERROR, MAX, MIN_NORMAL, REL_ERROR};
+use ph_formation_core::wire::quant::{decode, encode, ABS_ERROR, MAX, MIN_NORMAL, REL_ERROR};
 use proptest::prelude::*;
 
 /// Every one of the 65,536 codes: infinities and NaNs are refused, every finite code

@@ -15,11 +15,11 @@
 #                                                supervisor (crazyflie-app/test/flight_test.c)
 #   (CFAPP_CFLAGS: extra flags for the app, e.g. -DFORMATION_USE_STRUCT)
 #
-# The staticlib: for the firmware `cargo rustc -p controller-ffi --release --lib
+# The staticlib: for the firmware `cargo rustc -p ph-formation-ffi --release --lib
 # --target thumbv7em-none-eabihf --crate-type staticlib` (the staticlib alone: cargo
 # applies the release profile's fat LTO only when the crate is not also built as an
 # rlib; 10 % less code, 5 % fewer instructions per tick); for the host a plain
-# `cargo build -p controller-ffi --release`. The release profile has panic = "abort".
+# `cargo build -p ph-formation-ffi --release`. The release profile has panic = "abort".
 # Prints the path of what it built. Used by controller-ffi/tests/c_host.rs and
 # c_firmware.rs; see docs/c-api.md. Environment: CC (host compiler, default cc),
 # ARM_CC (default arm-none-eabi-gcc), CARGO_TARGET_DIR.
@@ -54,8 +54,8 @@ arm_flags=(-mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard
 
 case $what in
 host)
-    (cd "$root" && "$cargo" build -q -p controller-ffi --release --lib)
-    lib=$target_dir/release/libcontroller_ffi.a
+    (cd "$root" && "$cargo" build -q -p ph-formation-ffi --release --lib)
+    lib=$target_dir/release/libph_formation_ffi.a
     # The host staticlib contains std: link what it needs (rustc
     # --print native-static-libs on linux-gnu: gcc_s, util, rt, pthread, m, dl, c).
     "${CC:-cc}" "${cflags[@]}" -o "$out/c-host-demo" \
@@ -64,9 +64,9 @@ host)
     echo "$out/c-host-demo"
     ;;
 firmware)
-    (cd "$root" && "$cargo" rustc -q -p controller-ffi --release --lib \
+    (cd "$root" && "$cargo" rustc -q -p ph-formation-ffi --release --lib \
         --target thumbv7em-none-eabihf --crate-type staticlib)
-    lib=$target_dir/thumbv7em-none-eabihf/release/libcontroller_ffi.a
+    lib=$target_dir/thumbv7em-none-eabihf/release/libph_formation_ffi.a
     # Hard-float ABI of thumbv7em-none-eabihf; no libc (the staticlib's
     # compiler_builtins provides memcpy/memset), libgcc for any helper.
     "${ARM_CC:-arm-none-eabi-gcc}" "${cflags[@]}" \
@@ -79,17 +79,17 @@ firmware)
     echo "$out/c-firmware.elf"
     ;;
 cfapp-host)
-    (cd "$root" && "$cargo" build -q -p controller-ffi --release --lib)
-    lib=$target_dir/release/libcontroller_ffi.a
+    (cd "$root" && "$cargo" build -q -p ph-formation-ffi --release --lib)
+    lib=$target_dir/release/libph_formation_ffi.a
     "${CC:-cc}" "${cflags[@]}" "${app_cflags[@]}" -o "$out/cfapp-host" \
         "$app/test/host_main.c" "${app_src[@]}" \
         "$lib" -lgcc_s -lutil -lrt -lpthread -lm -ldl
     echo "$out/cfapp-host"
     ;;
 cfapp-firmware)
-    (cd "$root" && "$cargo" rustc -q -p controller-ffi --release --lib \
+    (cd "$root" && "$cargo" rustc -q -p ph-formation-ffi --release --lib \
         --target thumbv7em-none-eabihf --crate-type staticlib)
-    lib=$target_dir/thumbv7em-none-eabihf/release/libcontroller_ffi.a
+    lib=$target_dir/thumbv7em-none-eabihf/release/libph_formation_ffi.a
     "${ARM_CC:-arm-none-eabi-gcc}" "${cflags[@]}" "${app_cflags[@]}" -I"$here/firmware" \
         "${arm_flags[@]}" -Wl,-Map="$out/cfapp-firmware.map" -o "$out/cfapp-firmware.elf" \
         "$here/firmware/startup.c" "$app/test/qemu_main.c" "${app_src[@]}" \
@@ -97,8 +97,8 @@ cfapp-firmware)
     echo "$out/cfapp-firmware.elf"
     ;;
 cfapp-flight)
-    (cd "$root" && "$cargo" build -q -p controller-ffi --release --lib)
-    lib=$target_dir/release/libcontroller_ffi.a
+    (cd "$root" && "$cargo" build -q -p ph-formation-ffi --release --lib)
+    lib=$target_dir/release/libph_formation_ffi.a
     "${CC:-cc}" "${cflags[@]}" "${app_cflags[@]}" -o "$out/cfapp-flight" \
         "$app/test/flight_test.c" "$app/test/firmware_model.c" "$app/src/flight.c" \
         "$app/src/commands.c" "$app/src/epoch.c" "$app/src/formation.c" \

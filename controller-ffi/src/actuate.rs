@@ -1,8 +1,8 @@
-//! Actuation through the virtual mass of SPEC S1 (`controller_core::actuate`): the
+//! Actuation through the virtual mass of SPEC S1 (`ph_formation_core::actuate`): the
 //! force of `ph_step` turned into a velocity setpoint, for vehicles that track velocity
 //! (the Crazyflie app, `crazyflie-app/src/agent_loop.c`).
 
-use controller_core::actuate::{VelocityCommand, VirtualMass};
+use ph_formation_core::actuate::{VelocityCommand, VirtualMass};
 
 use crate::api::{check, input, status, write};
 use crate::status::ph_status;

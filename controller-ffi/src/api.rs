@@ -17,7 +17,7 @@ use crate::tick::{
     ph_measurements, ph_output, stats_from_core, NO_OUTPUT,
 };
 use crate::{PH_ABI_VERSION, PH_AGENT_ALIGN, PH_AGENT_SIZE, PH_MAX_FRAME_LEN, PH_MAX_NEIGHBOURS};
-use controller_core::{BearingMeasurement, Measurements, Vec2};
+use ph_formation_core::{BearingMeasurement, Measurements, Vec2};
 
 /// Called by `ph_frames_cb` with each frame: `bytes[0..len]`, `len ≤ PH_MAX_FRAME_LEN`,
 /// valid only during the call.
@@ -165,7 +165,7 @@ pub unsafe extern "C" fn ph_agent_init(
 }
 
 /// `ph_agent_init` with the configuration in a blob (`blob[0..len]`, written by the
-/// Rust `controller_ffi::encode_blob`, e.g. `host-sim export`). A blob with a wrong
+/// Rust `ph_formation_ffi::encode_blob`, e.g. `host-sim export`). A blob with a wrong
 /// magic, version, length or CRC-32, or one that does not decode, gives its own
 /// `PH_ERR_BLOB_*` status; a configuration the core refuses, its `PH_ERR_CONFIG_*`.
 ///

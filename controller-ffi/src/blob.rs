@@ -26,7 +26,7 @@
 
 use crc::{Crc, NoTable, CRC_32_ISO_HDLC};
 
-use controller_core::ConfigError;
+use ph_formation_core::ConfigError;
 
 use crate::{FfiAgent, FfiConfig};
 

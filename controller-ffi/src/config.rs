@@ -4,7 +4,7 @@
 //! Both directions destructure or build every field by name (no `..`), so a field added
 //! to a core configuration type is a compile error here until it is mapped.
 
-use controller_core::{
+use ph_formation_core::{
     AgentConfig, AngleConfig, BearingFilter, EstimatorMode, Integrity, LeaderConfig, LeaderRole,
     Limits, Schedule, ScheduleStep, SwarmKey, TrackerConfig, TriangleConfig,
 };
@@ -404,7 +404,7 @@ fn filter_from_core(f: &BearingFilter<f32>) -> ph_bearing_filter {
 }
 
 /// The core's configuration of a C configuration. Checks only what the C form can get
-/// wrong (counts, enum values); the core's [`controller_core::Agent::new`] checks the
+/// wrong (counts, enum values); the core's [`ph_formation_core::Agent::new`] checks the
 /// rest.
 pub fn to_core(c: &ph_config) -> Result<FfiConfig, ph_status> {
     let ph_config {

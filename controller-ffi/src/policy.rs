@@ -1,17 +1,17 @@
-//! The safety policies of `controller_core::policy` for C (`crazyflie-app/src/flight.c`):
+//! The safety policies of `ph_formation_core::policy` for C (`crazyflie-app/src/flight.c`):
 //! lost neighbours or radio → hold, then land; flight volume; positioning; low battery;
 //! and the minimum-separation guard on a setpoint. One implementation: the simulator
 //! runs the same (host-sim's controller adapter).
 
-use controller_core::policy::{
+use ph_formation_core::policy::{
     separation_guard, Policy, PolicyAction, PolicyConfig, PolicyCounts, PolicyInputs, PolicyReason,
 };
-use controller_core::Vec2;
+use ph_formation_core::Vec2;
 
 use crate::api::{check, input, status, write};
 use crate::status::ph_status;
 
-/// The policies' settings (`controller_core::policy::PolicyConfig`).
+/// The policies' settings (`ph_formation_core::policy::PolicyConfig`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ph_policy_config {
@@ -211,7 +211,7 @@ pub unsafe extern "C" fn ph_policy_reset(policy: *mut ph_policy) -> ph_status {
     status(r)
 }
 
-/// One tick of the policies (`controller_core::policy::Policy::update`): writes what to
+/// One tick of the policies (`ph_formation_core::policy::Policy::update`): writes what to
 /// do to `*action` and why to `*why`. `PH_ERR_ARGUMENT` (nothing changed) for settings
 /// that are not finite, a fence with `min > max`, a negative voltage or separation, or
 /// a `*policy` with an unknown reason code.
@@ -256,7 +256,7 @@ pub unsafe extern "C" fn ph_policy_update(
     status(r)
 }
 
-/// The minimum-separation guard (`controller_core::policy::separation_guard`):
+/// The minimum-separation guard (`ph_formation_core::policy::separation_guard`):
 /// removes from `setpoint[0..2]` (velocity or force, world frame) its component towards
 /// every neighbour of `neighbours[0..2·count]` (x, y pairs) closer to `own[0..2]` than
 /// `config->min_separation`; a neighbour closer than 1 mm stops it. Counts a change in

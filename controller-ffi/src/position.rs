@@ -1,8 +1,8 @@
-//! The position packet (`controller_core::wire::position`) for C: one type for the C
+//! The position packet (`ph_formation_core::wire::position`) for C: one type for the C
 //! API, the Crazyflie app (`crazyflie-app/src/formation.c`) and host-sim's model of it,
 //! protected with the agent's integrity mode (`crc16`, `link` or `auth`).
 
-use controller_core::wire::position::{accept_counter, PositionError, PositionPacket};
+use ph_formation_core::wire::position::{accept_counter, PositionError, PositionPacket};
 
 use crate::api::{check, input, status, write};
 use crate::status::ph_status;
@@ -10,7 +10,7 @@ use crate::storage::{self, ph_agent};
 
 /// Longest position packet (with `PH_INTEGRITY_AUTH`), bytes.
 pub const PH_MAX_POSITION_LEN: usize = 27;
-const _: () = assert!(PH_MAX_POSITION_LEN == controller_core::wire::position::MAX_POSITION_LEN);
+const _: () = assert!(PH_MAX_POSITION_LEN == ph_formation_core::wire::position::MAX_POSITION_LEN);
 
 /// What a receiver keeps of one sender's position packets: the last accepted `auth`
 /// counter (replays are refused). Zero it before the first packet.

@@ -4,7 +4,7 @@
 //! The matches are exhaustive: a variant added to a core error type is a compile error
 //! here until it has its code.
 
-use controller_core::{ConfigError, FrameError};
+use ph_formation_core::{ConfigError, FrameError};
 
 use crate::blob::BlobError;
 

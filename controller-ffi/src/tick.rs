@@ -3,7 +3,7 @@
 //! Exhaustive matches and destructuring: a new core variant or field is a compile error
 //! here.
 
-use controller_core::{
+use ph_formation_core::{
     BearingMeasurement, Fault, FrameStats, MeasurementError, OwnedEstimate, Status, StepOutput,
     Vec2,
 };

@@ -1,13 +1,13 @@
 //! `ph_actuator_init` / `ph_actuate`: the C API's virtual-mass actuation is the core's
-//! (`controller_core::actuate`), takes the agent's friction, starts from the measured
+//! (`ph_formation_core::actuate`), takes the agent's friction, starts from the measured
 //! velocity, and refuses what it must.
 
-use controller_core::actuate::{VelocityCommand, VirtualMass};
-use controller_ffi::actuate::{ph_actuate, ph_actuator_init};
-use controller_ffi::api::ph_agent_init;
-use controller_ffi::config::default_config;
-use controller_ffi::storage::ph_agent;
-use controller_ffi::{ph_actuator, ph_config, ph_status, PH_AGENT_SIZE};
+use ph_formation_core::actuate::{VelocityCommand, VirtualMass};
+use ph_formation_ffi::actuate::{ph_actuate, ph_actuator_init};
+use ph_formation_ffi::api::ph_agent_init;
+use ph_formation_ffi::config::default_config;
+use ph_formation_ffi::storage::ph_agent;
+use ph_formation_ffi::{ph_actuator, ph_config, ph_status, PH_AGENT_SIZE};
 
 #[repr(C, align(8))]
 struct Memory([u8; PH_AGENT_SIZE]);

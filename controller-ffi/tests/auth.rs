@@ -2,14 +2,14 @@
 //! round trips, refusal of a key with another integrity, the boot epoch, and the new
 //! frame statuses and counters.
 
-use controller_core::{Integrity, SwarmKey};
-use controller_ffi::api::{
+use ph_formation_core::{Integrity, SwarmKey};
+use ph_formation_ffi::api::{
     ph_agent_init, ph_agent_set_boot_epoch, ph_frames, ph_receive, ph_stats,
 };
-use controller_ffi::config::{default_config, from_core, ph_integrity};
-use controller_ffi::storage::ph_agent;
-use controller_ffi::tick::ph_frame_stats;
-use controller_ffi::{decode_blob, encode_blob, ph_config, ph_status, to_core, PH_AGENT_SIZE};
+use ph_formation_ffi::config::{default_config, from_core, ph_integrity};
+use ph_formation_ffi::storage::ph_agent;
+use ph_formation_ffi::tick::ph_frame_stats;
+use ph_formation_ffi::{decode_blob, encode_blob, ph_config, ph_status, to_core, PH_AGENT_SIZE};
 
 const KEY: [u8; 16] = *b"ffi swarm key 16";
 

@@ -2,14 +2,14 @@
 //! size bound, and the pinned bytes of one blob (a change of the core's configuration
 //! layout must come with a new `BLOB_VERSION`).
 
-use controller_core::{
+use ph_formation_core::{
     AgentConfig, AngleConfig, EstimatorMode, LeaderConfig, LeaderRole, Schedule, ScheduleStep,
     TriangleConfig, MAX_SCHEDULE_STEPS,
 };
-use controller_ffi::api::ph_agent_init_blob;
-use controller_ffi::blob::{BLOB_VERSION, PH_MAX_BLOB_LEN};
-use controller_ffi::storage::ph_agent;
-use controller_ffi::{decode_blob, encode_blob, ph_status, BlobError, FfiConfig, PH_AGENT_SIZE};
+use ph_formation_ffi::api::ph_agent_init_blob;
+use ph_formation_ffi::blob::{BLOB_VERSION, PH_MAX_BLOB_LEN};
+use ph_formation_ffi::storage::ph_agent;
+use ph_formation_ffi::{decode_blob, encode_blob, ph_status, BlobError, FfiConfig, PH_AGENT_SIZE};
 
 /// Agent 1 of the paper's formation (firmware-example/src/paper.rs).
 fn paper_agent_1() -> FfiConfig {
@@ -234,7 +234,7 @@ fn every_defect_has_its_status() {
     assert_eq!(
         encode_blob(&bad, &mut [0u8; PH_MAX_BLOB_LEN]),
         Err(BlobError::Config(
-            controller_core::ConfigError::NotInTriangle { triangle: 0 }
+            ph_formation_core::ConfigError::NotInTriangle { triangle: 0 }
         ))
     );
 }

@@ -16,7 +16,7 @@
 //!
 //! Ignored by default: they need `arm-none-eabi-gcc` (scripts/firmware-deps.sh) and
 //! `qemu-system-arm`. Run them with
-//! `cargo test -p controller-ffi --test c_firmware -- --include-ignored`.
+//! `cargo test -p ph-formation-ffi --test c_firmware -- --include-ignored`.
 //! Environment: `QEMU_TIMEOUT` (seconds, default 120), `QEMU_SYSTEM_ARM`,
 //! `ARM_NM` (default arm-none-eabi-nm).
 
@@ -171,9 +171,9 @@ fn text_by_origin(map: &str) -> BTreeMap<&'static str, u64> {
         let Ok(size) = u64::from_str_radix(size.trim_start_matches("0x"), 16) else {
             continue;
         };
-        let origin = if file.contains("libcontroller_ffi.a(compiler_builtins") {
+        let origin = if file.contains("libph_formation_ffi.a(compiler_builtins") {
             "Rust compiler_builtins (memcpy, memset, ...)"
-        } else if file.contains("libcontroller_ffi.a") {
+        } else if file.contains("libph_formation_ffi.a") {
             "controller (Rust: controller-ffi, controller-core, deps)"
         } else if file.contains("libgcc") {
             "libgcc"

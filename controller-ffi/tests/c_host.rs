@@ -19,7 +19,7 @@ use std::process::{Command, Output};
 use std::sync::OnceLock;
 
 use common::{build, max_difference, parse_demo_final, scratch, SQUARE, TOLERANCE};
-use controller_ffi::{config::to_core, encode_blob, ph_config};
+use ph_formation_ffi::{config::to_core, encode_blob, ph_config};
 
 fn program() -> &'static Path {
     static BUILT: OnceLock<std::path::PathBuf> = OnceLock::new();
@@ -88,7 +88,7 @@ fn blobs_give_the_same_run_as_c_structs() {
         // (same layout: repr(C)); every field is an integer or a float.
         let c: ph_config = unsafe { std::ptr::read_unaligned(raw.as_ptr().cast()) };
         let config = to_core(&c).unwrap_or_else(|e| panic!("agent {i}: {e:?}"));
-        let mut blob = [0u8; controller_ffi::blob::PH_MAX_BLOB_LEN];
+        let mut blob = [0u8; ph_formation_ffi::blob::PH_MAX_BLOB_LEN];
         let n = encode_blob(&config, &mut blob).expect("encode");
         let path = dir.join(format!("agent{i}.blob"));
         std::fs::write(&path, &blob[..n]).expect("write blob");

@@ -33,7 +33,7 @@
 //!   (`stub/param.h`, `stub/log.h`), with the expected number of entries.
 //!
 //! The ignored tests need `arm-none-eabi-gcc` and `qemu-system-arm`
-//! (scripts/firmware-deps.sh): `cargo test -p controller-ffi --test crazyflie_app --
+//! (scripts/firmware-deps.sh): `cargo test -p ph-formation-ffi --test crazyflie_app --
 //! --include-ignored`.
 
 mod common;

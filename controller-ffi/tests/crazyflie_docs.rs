@@ -7,9 +7,9 @@
 
 use std::path::PathBuf;
 
-use controller_ffi::api::{ph_agent_init_blob, ph_frames};
-use controller_ffi::storage::ph_agent;
-use controller_ffi::{ph_status, PH_AGENT_SIZE, PH_MAX_FRAMES_PER_TICK, PH_MAX_FRAME_LEN};
+use ph_formation_ffi::api::{ph_agent_init_blob, ph_frames};
+use ph_formation_ffi::storage::ph_agent;
+use ph_formation_ffi::{ph_status, PH_AGENT_SIZE, PH_MAX_FRAMES_PER_TICK, PH_MAX_FRAME_LEN};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
@@ -159,7 +159,7 @@ fn c_api_doc_states_the_blob_version() {
     let doc = read("docs/c-api.md");
     assert_eq!(
         after(&doc, "| 4 | format version ("),
-        f64::from(controller_ffi::blob::BLOB_VERSION),
+        f64::from(ph_formation_ffi::blob::BLOB_VERSION),
         "docs/c-api.md blob layout"
     );
 }

@@ -1,6 +1,6 @@
 //! `include/ph_formation.h` is what cbindgen generates from the sources now.
 //!
-//! Regenerate it with `PH_BLESS=1 cargo test -p controller-ffi --test header`.
+//! Regenerate it with `PH_BLESS=1 cargo test -p ph-formation-ffi --test header`.
 
 use std::path::Path;
 
@@ -28,7 +28,7 @@ fn header_is_up_to_date() {
     let checked_in = std::fs::read_to_string(&path).unwrap_or_default();
     assert!(
         checked_in == fresh,
-        "{} is out of date: regenerate it with `PH_BLESS=1 cargo test -p controller-ffi --test header` and commit it",
+        "{} is out of date: regenerate it with `PH_BLESS=1 cargo test -p ph-formation-ffi --test header` and commit it",
         path.display()
     );
 }
@@ -45,11 +45,11 @@ fn header_lists_every_status_code() {
         .count();
     assert_eq!(
         in_header,
-        controller_ffi::status::ALL.len(),
+        ph_formation_ffi::status::ALL.len(),
         "status::ALL must list every ph_status"
     );
-    for s in controller_ffi::status::ALL {
-        assert_eq!(controller_ffi::ph_status::from_code(s as i32), Some(s));
+    for s in ph_formation_ffi::status::ALL {
+        assert_eq!(ph_formation_ffi::ph_status::from_code(s as i32), Some(s));
     }
 }
 

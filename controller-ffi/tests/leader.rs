@@ -1,10 +1,10 @@
 //! `ph_leader_partner`: the leader partner of an agent (what the Crazyflie app needs to
 //! find the partner offset among its neighbours' positions), none for a follower.
 
-use controller_ffi::api::{ph_agent_init, ph_leader_partner};
-use controller_ffi::config::default_config;
-use controller_ffi::storage::ph_agent;
-use controller_ffi::{ph_config, ph_status, PH_AGENT_SIZE};
+use ph_formation_ffi::api::{ph_agent_init, ph_leader_partner};
+use ph_formation_ffi::config::default_config;
+use ph_formation_ffi::storage::ph_agent;
+use ph_formation_ffi::{ph_config, ph_status, PH_AGENT_SIZE};
 
 #[repr(C, align(8))]
 struct Memory([u8; PH_AGENT_SIZE]);

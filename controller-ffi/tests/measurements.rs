@@ -3,11 +3,11 @@
 //! `PH_FAULT_NON_FINITE_MEASUREMENT`; and `ph_limits.bearing_hold` reaches the agent
 //! (SPEC §12): a bearing missing for a tick is held with a hold, missing without.
 
-use controller_ffi::api::{ph_agent_init, ph_receive, ph_step};
-use controller_ffi::config::default_config;
-use controller_ffi::storage::ph_agent;
-use controller_ffi::tick::{ph_bearing, ph_fault, ph_measurements, ph_output, ph_output_status};
-use controller_ffi::{ph_config, ph_status, PH_AGENT_SIZE};
+use ph_formation_ffi::api::{ph_agent_init, ph_receive, ph_step};
+use ph_formation_ffi::config::default_config;
+use ph_formation_ffi::storage::ph_agent;
+use ph_formation_ffi::tick::{ph_bearing, ph_fault, ph_measurements, ph_output, ph_output_status};
+use ph_formation_ffi::{ph_config, ph_status, PH_AGENT_SIZE};
 
 #[repr(C, align(8))]
 struct Memory([u8; PH_AGENT_SIZE]);
@@ -25,8 +25,8 @@ fn config(id: u8, hold: f32) -> ph_config {
         a.damping = 0.5;
         a.estimator_gain = 1.0;
     }
-    c.bearing_filter = controller_ffi::config::ph_bearing_filter {
-        kind: controller_ffi::config::ph_filter_kind::PH_FILTER_FINITE_DIFFERENCE as u8,
+    c.bearing_filter = ph_formation_ffi::config::ph_bearing_filter {
+        kind: ph_formation_ffi::config::ph_filter_kind::PH_FILTER_FINITE_DIFFERENCE as u8,
         ..Default::default()
     };
     c.limits.bearing_hold = hold;
@@ -89,10 +89,10 @@ fn second_step(hold: f32, dt: f32, b1: &[ph_bearing]) -> ph_output {
         }
         let mut frames = Vec::new();
         for &a in &agents {
-            let mut buf = [[0u8; controller_ffi::PH_MAX_FRAME_LEN]; 3];
+            let mut buf = [[0u8; ph_formation_ffi::PH_MAX_FRAME_LEN]; 3];
             let mut lens = [0u8; 3];
             let mut n = 0;
-            controller_ffi::api::ph_frames(a, buf.as_mut_ptr(), lens.as_mut_ptr(), 3, &mut n);
+            ph_formation_ffi::api::ph_frames(a, buf.as_mut_ptr(), lens.as_mut_ptr(), 3, &mut n);
             for k in 0..n {
                 frames.push(buf[k][..usize::from(lens[k])].to_vec());
             }

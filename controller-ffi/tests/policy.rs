@@ -1,8 +1,8 @@
 //! `ph_policy_*` and `ph_separation_guard`: the core's policies through the C API
 //! (`src/policy.rs`), state kept in the caller's `ph_policy` between calls.
 
-use controller_ffi::ph_status;
-use controller_ffi::policy::{
+use ph_formation_ffi::ph_status;
+use ph_formation_ffi::policy::{
     ph_policy, ph_policy_action, ph_policy_config, ph_policy_init, ph_policy_input,
     ph_policy_reason, ph_policy_reset, ph_policy_update, ph_separation_guard,
 };

@@ -1,15 +1,15 @@
 //! `ph_position_encode`, `ph_position_decode`, `ph_position_sender`: the core's
-//! position packet (`controller_core::wire::position`) with the agent's integrity mode;
+//! position packet (`ph_formation_core::wire::position`) with the agent's integrity mode;
 //! under `auth` a spoofed or replayed packet is refused.
 
-use controller_ffi::api::ph_agent_init;
-use controller_ffi::config::{default_config, ph_integrity};
-use controller_ffi::position::{
+use ph_formation_ffi::api::ph_agent_init;
+use ph_formation_ffi::config::{default_config, ph_integrity};
+use ph_formation_ffi::position::{
     ph_position_decode, ph_position_encode, ph_position_peer, ph_position_sender,
     PH_MAX_POSITION_LEN,
 };
-use controller_ffi::storage::ph_agent;
-use controller_ffi::{ph_config, ph_status, PH_AGENT_SIZE};
+use ph_formation_ffi::storage::ph_agent;
+use ph_formation_ffi::{ph_config, ph_status, PH_AGENT_SIZE};
 
 fn config(id: u8, auth: bool) -> ph_config {
     let mut c = default_config(id);

@@ -1,12 +1,12 @@
 //! `ph_actuator_set_second_lead` (SPEC S21b): the C API's second-order lead is the
 //! core's, kept across calls in the `ph_actuator`, and refuses what it must.
 
-use controller_core::actuate::{VelocityCommand, VirtualMass};
-use controller_ffi::actuate::{ph_actuate, ph_actuator_init, ph_actuator_set_second_lead};
-use controller_ffi::api::ph_agent_init;
-use controller_ffi::config::default_config;
-use controller_ffi::storage::ph_agent;
-use controller_ffi::{ph_actuator, ph_config, ph_status, PH_AGENT_SIZE};
+use ph_formation_core::actuate::{VelocityCommand, VirtualMass};
+use ph_formation_ffi::actuate::{ph_actuate, ph_actuator_init, ph_actuator_set_second_lead};
+use ph_formation_ffi::api::ph_agent_init;
+use ph_formation_ffi::config::default_config;
+use ph_formation_ffi::storage::ph_agent;
+use ph_formation_ffi::{ph_actuator, ph_config, ph_status, PH_AGENT_SIZE};
 
 #[repr(C, align(8))]
 struct Memory([u8; PH_AGENT_SIZE]);

@@ -22,7 +22,7 @@
 
 use core::ops::ControlFlow;
 
-use controller_core::{Agent, BearingMeasurement, Measurements, Status, StepOutput, Vec2};
+use ph_formation_core::{Agent, BearingMeasurement, Measurements, Status, StepOutput, Vec2};
 
 use crate::hal::{Actuator, Bearing, BearingSensor, Clock, Radio, VelocitySource, MAX_FRAME_LEN};
 

@@ -1,5 +1,5 @@
 //! Where a real board keeps the `auth` swarm key and its boot epoch
-//! ([`controller_core::Integrity::Auth`], [`controller_core::wire::auth`]).
+//! ([`ph_formation_core::Integrity::Auth`], [`ph_formation_core::wire::auth`]).
 //!
 //! * **The key** is a per-deployment secret shared by every robot of the
 //!   swarm. Never compile it into firmware that leaves the lab and never log
@@ -11,7 +11,7 @@
 //!   secure element (ATECC608, SE050) keeps it there instead.
 //! * **The boot epoch** must be larger at every boot than at any earlier one
 //!   (receivers reject every counter not above the last one they accepted
-//!   from a robot, see [`controller_core::Agent::set_boot_epoch`]). A real
+//!   from a robot, see [`ph_formation_core::Agent::set_boot_epoch`]). A real
 //!   board keeps a `u32` in flash (an append-only log of words in one sector:
 //!   the epoch is the number of programmed words, one word programmed per
 //!   boot, the sector erased when full after writing the next value into a
@@ -21,7 +21,7 @@
 //! The QEMU binaries have no persistent storage: they use the placeholders
 //! below.
 
-use controller_core::SwarmKey;
+use ph_formation_core::SwarmKey;
 
 /// PLACEHOLDER swarm key for the QEMU binaries and the measurements ONLY.
 ///

@@ -31,7 +31,7 @@ mod firmware {
     use super::{CLOCK_HZ, CONTROL_HZ, RUN_TICKS};
     use core::ops::ControlFlow;
 
-    use controller_core::{Agent, Integrity};
+    use ph_formation_core::{Agent, Integrity};
     use cortex_m_rt::entry;
     use firmware_example::app::{run_agent, Board};
     use firmware_example::paper;

@@ -10,7 +10,7 @@
 //! The desired angles enter the controller as cosines; they are constants
 //! here (no trigonometry on target).
 
-use controller_core::{
+use ph_formation_core::{
     AgentConfig, AgentId, AngleConfig, LeaderConfig, LeaderRole, Schedule, TriangleConfig,
 };
 

@@ -33,7 +33,7 @@
 //! The bench then holds the centre's state, the frames its neighbours
 //! broadcast in the measured tick and its own measurements.
 
-use controller_core::{
+use ph_formation_core::{
     Agent, AgentConfig, AgentId, AngleConfig, BearingMeasurement, ConfigError, Integrity,
     LeaderConfig, LeaderRole, Measurements, Real, Schedule, Status, StepOutput, TriangleConfig,
     Vec2,
@@ -55,7 +55,7 @@ pub struct StepConfig {
     /// tracker (SPEC §11, the default): the `_fd` rows, the wire's own cost.
     pub finite_difference: bool,
     /// The bearing to the last rim agent is missing in the measured tick and held
-    /// ([`controller_core::Limits::bearing_hold`], SPEC §12): the `_held` rows.
+    /// ([`ph_formation_core::Limits::bearing_hold`], SPEC §12): the `_held` rows.
     pub held: bool,
 }
 
@@ -465,7 +465,7 @@ impl Fan {
         c.limits.max_force = 1.0e5;
         c.integrity = self.integrity;
         if self.finite_difference {
-            c.bearing_filter = controller_core::BearingFilter::FiniteDifference;
+            c.bearing_filter = ph_formation_core::BearingFilter::FiniteDifference;
         }
         if self.held {
             // Five ticks (SPEC §12).
@@ -643,14 +643,14 @@ impl StepCtx<'_> {
         self.agent.frames(|bytes| tx.push(bytes)) as u8
     }
 
-    /// The frame CRCs alone: [`controller_core::crc16::checksum`] of every frame the
+    /// The frame CRCs alone: [`ph_formation_core::crc16::checksum`] of every frame the
     /// step decodes and encodes (the part of the wire cost no codec can avoid).
     #[inline(always)]
     pub fn crc_all(&self) -> u16 {
         self.rx
             .iter()
             .chain(self.tx.iter())
-            .fold(0, |acc, f| acc ^ controller_core::crc16::checksum(f))
+            .fold(0, |acc, f| acc ^ ph_formation_core::crc16::checksum(f))
     }
 
     /// The whole measured step: [`StepCtx::receive_all`],

@@ -14,17 +14,17 @@
 //!   0.5°, velocities 0.01 m/s): every agent draws from its own stream of the tick
 //!   (`Sensors::stream`), on whichever thread ticks it.
 //!
-//! `cargo bench -p host-sim --bench agent_steps -- --quick` runs all in a few minutes;
+//! `cargo bench -p ph-formation-sim --bench agent_steps -- --quick` runs all in a few minutes;
 //! docs/performance.md has the figures and the log-log slope.
 
 // `criterion_group!` generates an undocumented public function.
 #![allow(missing_docs)]
 
 use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion, Throughput};
-use host_sim::engine::SampledSim;
-use host_sim::load;
-use host_sim::model::Model;
-use host_sim::scenario::strip_model;
+use ph_formation_sim::engine::SampledSim;
+use ph_formation_sim::load;
+use ph_formation_sim::model::Model;
+use ph_formation_sim::scenario::strip_model;
 use std::cell::OnceCell;
 use std::hint::black_box;
 use std::time::Duration;

@@ -12,9 +12,9 @@
 //! Everything runs on one thread (a one-thread rayon pool): the counts do not depend on
 //! the machine or on scheduling.
 
-use host_sim::engine::{run, NullRecorder, SampledSim};
-use host_sim::model::Model;
-use host_sim::scenario::strip_model;
+use ph_formation_sim::engine::{run, NullRecorder, SampledSim};
+use ph_formation_sim::model::Model;
+use ph_formation_sim::scenario::strip_model;
 use std::process::ExitCode;
 
 /// The counted part: `ticks` control periods of `sim` from `start` (or, with no
@@ -49,7 +49,7 @@ fn case(args: &[String]) -> Result<u64, String> {
         }
         Some("paper") => {
             let duration = number(1, "DURATION")?;
-            let model = host_sim::load("paper", &[format!("duration={duration}")])
+            let model = ph_formation_sim::load("paper", &[format!("duration={duration}")])
                 .map_err(|e| e.to_string())?;
             counted(&model, None, 0.0, 0);
             // Per agent-step of the run: its instructions over N · (duration / period).
@@ -61,7 +61,7 @@ fn case(args: &[String]) -> Result<u64, String> {
             // headings, own clocks, noisy bearings, the shared channel), whole.
             let duration = number(1, "DURATION")?;
             let strip20 = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/strip20.toml");
-            let model = host_sim::load(
+            let model = ph_formation_sim::load(
                 strip20,
                 &["world=crazyflie".to_owned(), format!("duration={duration}")],
             )

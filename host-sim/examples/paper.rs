@@ -2,18 +2,18 @@
 //! written), and read the outcome, the summary and the time series.
 //!
 //! ```sh
-//! cargo run -p host-sim --release --example paper
+//! cargo run -p ph-formation-sim --release --example paper
 //! ```
 //!
 //! Exits with an error unless the formation converges (`tests/api.rs` runs it).
 
-use host_sim::{Outcome, Simulation};
+use ph_formation_sim::{Outcome, Simulation};
 
 /// Runs `paper` for 60 s and prints what it found.
 pub fn main() -> Result<(), Box<dyn std::error::Error>> {
-    // A file path, a built-in name or (`host_sim::load_toml`) TOML text; overrides as
+    // A file path, a built-in name or (`ph_formation_sim::load_toml`) TOML text; overrides as
     // with `--set`.
-    let model = host_sim::load("paper", &["duration=60".to_owned()])?;
+    let model = ph_formation_sim::load("paper", &["duration=60".to_owned()])?;
     let run = Simulation::new(&model).run()?;
 
     let r = &run.result;

@@ -3,9 +3,9 @@
 //! meant to be others.
 //!
 //! ```no_run
-//! # fn main() -> Result<(), host_sim::Error> {
-//! let model = host_sim::load("paper", &["radio.loss=0.1".to_owned()])?;
-//! let run = host_sim::Simulation::new(&model).run()?;
+//! # fn main() -> Result<(), ph_formation_sim::Error> {
+//! let model = ph_formation_sim::load("paper", &["radio.loss=0.1".to_owned()])?;
+//! let run = ph_formation_sim::Simulation::new(&model).run()?;
 //! println!("{}: {}", run.result.outcome, run.result.reason);
 //! let series = run.series.as_ref().expect("kept by default");
 //! let v = series.column("V").expect("column V");

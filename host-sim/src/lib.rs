@@ -1,7 +1,7 @@
 //! # host-sim
 //!
 //! N `controller-core` agents over simulated dynamics (S1 of `docs/spec.md`, fixed-step RK4) and simulated
-//! radio links. Each agent is one [`controller_core::Agent`] behind the
+//! radio links. Each agent is one [`ph_formation_core::Agent`] behind the
 //! [`engine::AgentController`] trait: it sees only what its own sensors measure and the
 //! frames its radio delivers, as real postcard bytes.
 //!
@@ -11,7 +11,7 @@
 //! [`Simulation`] runs it, in memory unless asked to write (`write_to`), and returns a
 //! [`Run`]: the [`RunResult`] (outcome, reason, errors, extremes, counters), the
 //! [`TimeSeries`] and `summary.json` as a value. `examples/paper.rs` shows it:
-//! `cargo run -p host-sim --release --example paper`.
+//! `cargo run -p ph-formation-sim --release --example paper`.
 //!
 //! ## The layers (`docs/architecture.md`), lowest first
 //!

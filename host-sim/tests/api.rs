@@ -2,7 +2,7 @@
 //! files, TOML text and built-in names, errors keep their exit codes, and the example in
 //! `examples/paper.rs` runs.
 
-use host_sim::{exit_code, load, load_toml, Error, Outcome, Simulation};
+use ph_formation_sim::{exit_code, load, load_toml, Error, Outcome, Simulation};
 
 #[path = "../examples/paper.rs"]
 mod paper_example;
@@ -17,7 +17,7 @@ fn the_series_in_memory_is_the_csv_that_is_written() {
     let m = load("paper", &["duration=2".to_owned()]).expect("paper");
     let dir = tempfile::tempdir().expect("tempdir");
     let run = Simulation::new(&m)
-        .write_to(dir.path(), host_sim::WriteOptions::without_plots())
+        .write_to(dir.path(), ph_formation_sim::WriteOptions::without_plots())
         .run()
         .expect("run");
     let series = run.series.as_ref().expect("kept by default");
@@ -54,7 +54,7 @@ fn the_series_in_memory_is_the_csv_that_is_written() {
 
 #[test]
 fn scenarios_load_from_text_files_and_names() {
-    let text = host_sim::BUILTINS[2].text;
+    let text = ph_formation_sim::BUILTINS[2].text;
     let from_text = load_toml(text, "inline", &[]).expect("toml");
     let from_name = load("formation-only", &[]).expect("builtin");
     assert_eq!(from_text.agents, from_name.agents);
@@ -81,7 +81,7 @@ fn a_failed_run_is_an_outcome_and_an_unwritable_directory_an_error() {
     let file = dir.path().join("a-file");
     std::fs::write(&file, "").expect("write");
     let e = Simulation::new(&m)
-        .write_to(file.join("sub"), host_sim::WriteOptions::without_plots())
+        .write_to(file.join("sub"), ph_formation_sim::WriteOptions::without_plots())
         .run()
         .expect_err("not a directory");
     assert!(matches!(e, Error::Output(_)), "{e:?}");

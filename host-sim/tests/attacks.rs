@@ -9,7 +9,7 @@
 //!   shows it.
 //! * Bad `[[attacks]]` entries get errors naming the file, the field and the reason.
 
-use host_sim::{load_toml, Model, Outcome, RunResult, Simulation};
+use ph_formation_sim::{load_toml, Model, Outcome, RunResult, Simulation};
 
 const PAPER: &str = include_str!("../scenarios/paper.toml");
 

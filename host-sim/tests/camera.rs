@@ -4,12 +4,12 @@
 //! on 1 and 4 threads, and bad settings are refused with file, field and reason.
 
 mod support;
-use controller_core::Vec2;
-use host_sim::engine::sensors::{BearingKind, BearingSensor, Camera, Sensors, World};
-use host_sim::engine::PARALLEL_MIN_AGENTS;
-use host_sim::load;
-use host_sim::model::{BearingRate, CameraModel, SensorModel};
-use host_sim::scenario::strip_model;
+use ph_formation_core::Vec2;
+use ph_formation_sim::engine::sensors::{BearingKind, BearingSensor, Camera, Sensors, World};
+use ph_formation_sim::engine::PARALLEL_MIN_AGENTS;
+use ph_formation_sim::load;
+use ph_formation_sim::model::{BearingRate, CameraModel, SensorModel};
+use ph_formation_sim::scenario::strip_model;
 
 const PERIOD: f64 = 0.01;
 const KIND: BearingKind = BearingKind {

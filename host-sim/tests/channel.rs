@@ -1,9 +1,9 @@
 //! Issue 9 §2 and §3: broadcasting every k-th control tick, and the shared radio channel
 //! (`docs/radio.md`). The figures asserted here are the ones measured there.
 
-use host_sim::engine::{self as sim, NullRecorder, RunResult};
-use host_sim::model::{Access, Model};
-use host_sim::{load, Outcome, Simulation};
+use ph_formation_sim::engine::{self as sim, NullRecorder, RunResult};
+use ph_formation_sim::model::{Access, Model};
+use ph_formation_sim::{load, Outcome, Simulation};
 
 fn model(name: &str, overrides: &[&str]) -> Model {
     let o: Vec<String> = overrides.iter().map(|s| (*s).to_owned()).collect();
@@ -146,7 +146,7 @@ fn the_old_bandwidth_keys_are_refused_naming_the_new_ones() {
     // In a file: the file, the line and the field.
     let text = include_str!("../scenarios/paper-lossy.toml")
         .replace("bandwidth_bps = 160000.0", "bandwidth = 20000.0");
-    let e = host_sim::load_toml(&text, "old.toml", &[])
+    let e = ph_formation_sim::load_toml(&text, "old.toml", &[])
         .expect_err("old key accepted")
         .to_string();
     assert!(
@@ -239,10 +239,10 @@ fn every_agent_gets_the_swarm_integrity_and_its_broadcast_phase() {
     );
     for i in 0..m.n() {
         let c = m.agent_config(i).expect("config");
-        assert_eq!(c.integrity, controller_core::Integrity::Link);
+        assert_eq!(c.integrity, ph_formation_core::Integrity::Link);
         assert_eq!((c.comm_every, c.comm_phase), (4, (i % 4) as u16));
         // The emulated firmware's configuration carries the same (host-in-the-loop).
-        let t = host_sim::engine::hil::target_config(&m, i).expect("target");
+        let t = ph_formation_sim::engine::hil::target_config(&m, i).expect("target");
         assert_eq!(
             (t.integrity, t.comm_every, t.comm_phase),
             (c.integrity, 4, c.comm_phase)
@@ -252,7 +252,7 @@ fn every_agent_gets_the_swarm_integrity_and_its_broadcast_phase() {
     let c = m.agent_config(0).expect("config");
     assert_eq!(
         (c.integrity, c.comm_every, c.comm_phase),
-        (controller_core::Integrity::Crc16, 1, 0)
+        (ph_formation_core::Integrity::Crc16, 1, 0)
     );
 }
 
@@ -270,7 +270,7 @@ fn the_summary_table_shows_the_channel_only_when_used() {
     );
     let r = run(&m);
     let c = r.channel.expect("channel");
-    let text = host_sim::report::summary_table(&m, &r, out, 0);
+    let text = ph_formation_sim::report::summary_table(&m, &r, out, 0);
     for row in [
         "broadcast",
         "every 2 tick(s) (0.0200 s), integrity crc16",
@@ -286,7 +286,7 @@ fn the_summary_table_shows_the_channel_only_when_used() {
         assert!(text.contains(row), "no `{row}` in\n{text}");
     }
     let m = model("paper", &["duration=1.0"]);
-    let text = host_sim::report::summary_table(&m, &run(&m), out, 0);
+    let text = ph_formation_sim::report::summary_table(&m, &run(&m), out, 0);
     for row in ["broadcast", "channel", "collisions", "neighbour data age"] {
         assert!(!text.contains(row), "`{row}` in\n{text}");
     }
@@ -311,7 +311,7 @@ fn a_channel_run_is_reproducible_bit_for_bit() {
         let out = dir.path().join(format!("run{k}"));
         let r = Simulation::new(&m)
             .keep_series(false)
-            .write_to(&out, host_sim::WriteOptions::without_plots())
+            .write_to(&out, ph_formation_sim::WriteOptions::without_plots())
             .run()
             .expect("run");
         assert!(r.result.channel.expect("channel").collided > 0);

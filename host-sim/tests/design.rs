@@ -1,7 +1,7 @@
-//! `host_sim::design`: constructions over every generator, refusals, scale, rendering
+//! `ph_formation_sim::design`: constructions over every generator, refusals, scale, rendering
 //! through the scenario loader, wire ids on the constructed graphs.
 
-use host_sim::design::{
+use ph_formation_sim::design::{
     adjacency_from_triangles, check_distance2, compare, construct, distance2_colouring,
     render_scenario, verify, Construction, DesignError, DesignOptions, Generator, Perturbation,
     Point, Scale, ScenarioOptions, Template, VerifyError,
@@ -26,7 +26,7 @@ fn check(p: &[Point], c: &Construction, opts: &DesignOptions, what: &str) {
     assert_eq!(c.triangles.len(), n - 2, "{what}: M = N − 2");
     let tris: Vec<[usize; 3]> = c.triangles.iter().map(|t| t.vertices).collect();
     // The scenario loader's own triangulated-Laman check (SPEC §3).
-    host_sim::model::graph::laman_order(n, &tris).unwrap_or_else(|e| panic!("{what}: {e:?}"));
+    ph_formation_sim::model::graph::laman_order(n, &tris).unwrap_or_else(|e| panic!("{what}: {e:?}"));
     let margin = opts.margin_deg.to_radians();
     let mut per_agent = vec![0usize; n];
     for t in &c.triangles {
@@ -343,11 +343,11 @@ fn square_lattice(k: usize) -> Vec<[usize; 3]> {
 
 /// The rendered scenario without `[target]` (the loader does not know it yet), through
 /// the loader's parser and validator.
-fn load(text: &str) -> host_sim::model::Model {
+fn load(text: &str) -> ph_formation_sim::model::Model {
     let mut table: toml::Table = toml::from_str(text).expect("rendered TOML parses");
     table.remove("target");
     let stripped = toml::to_string(&table).expect("re-serialises");
-    host_sim::load_toml(&stripped, "rendered", &[])
+    ph_formation_sim::load_toml(&stripped, "rendered", &[])
         .unwrap_or_else(|e| panic!("{e}\n{}", &text[..text.len().min(3000)]))
 }
 
@@ -476,13 +476,13 @@ fn points_files() {
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("shape.csv");
     std::fs::write(&csv, "x,y\n0,0\n2,0\n1,1.7\n3,1.7\n").unwrap();
-    let p = host_sim::design::read_points(&csv).unwrap();
+    let p = ph_formation_sim::design::read_points(&csv).unwrap();
     assert_eq!(p.len(), 4);
     let c = construct(&p, &DesignOptions::default()).unwrap();
     assert_eq!(c.triangles.len(), 2);
     let other = dir.path().join("shape.txt");
     std::fs::write(&other, "0,0\n").unwrap();
-    let msg = host_sim::design::read_points(&other)
+    let msg = ph_formation_sim::design::read_points(&other)
         .unwrap_err()
         .to_string();
     assert!(msg.contains("shape.txt") && msg.contains(".csv"), "{msg}");
@@ -496,7 +496,7 @@ fn points_files() {
     )
     .unwrap();
     std::fs::write(&toml_path, text).unwrap();
-    assert_eq!(host_sim::design::read_points(&toml_path).unwrap(), p);
+    assert_eq!(ph_formation_sim::design::read_points(&toml_path).unwrap(), p);
 }
 
 /// Points on a circle: grown with the default 5° margin the construction's smallest
@@ -525,7 +525,7 @@ fn thin_constructions_are_grown_again_with_a_higher_margin() {
             c.margin_deg
         );
         assert!(
-            c.figures.min_controlled_deg >= host_sim::design::laman::RAISE_BELOW_DEG,
+            c.figures.min_controlled_deg >= ph_formation_sim::design::laman::RAISE_BELOW_DEG,
             "{}: {:?}",
             g.describe(),
             c.figures
@@ -558,7 +558,7 @@ fn spacing_perturbation_is_local() {
         rotate: false,
         seed: 5,
     };
-    let init = host_sim::design::initial_positions(&p, &c, &pert, 5.0, 0.05).unwrap();
+    let init = ph_formation_sim::design::initial_positions(&p, &c, &pert, 5.0, 0.05).unwrap();
     assert!(
         (init.max_displacement - 0.1).abs() < 1e-9,
         "{}",
@@ -576,6 +576,6 @@ fn spacing_perturbation_is_local() {
         scale: Scale::Size,
         ..pert
     };
-    let init = host_sim::design::initial_positions(&p, &c, &size, 5.0, 0.05).unwrap();
+    let init = ph_formation_sim::design::initial_positions(&p, &c, &size, 5.0, 0.05).unwrap();
     assert!(init.max_displacement > 3.0, "{}", init.max_displacement);
 }

@@ -159,9 +159,9 @@ fn ids_are_any_integers_or_names_and_wire_ids_are_assigned() {
         .iter()
         .map(|s| format!("\"{s}\""))
         .collect();
-    let m = host_sim::load_toml(&strip_scenario(&names), "names", &[]).unwrap();
+    let m = ph_formation_sim::load_toml(&strip_scenario(&names), "names", &[]).unwrap();
     assert_eq!(m.agents[1].name, "b-2");
-    let run = host_sim::Simulation::new(&m).run().unwrap();
+    let run = ph_formation_sim::Simulation::new(&m).run().unwrap();
     let json = run.summary_json(&m).to_string();
     assert!(
         json.contains("\"agents\":[\"alpha\",\"b-2\",\"c.3\",\"d\",\"e\"]"),
@@ -172,7 +172,7 @@ fn ids_are_any_integers_or_names_and_wire_ids_are_assigned() {
 
     // 1,000 agents with ids 1000, 1001, …: wire ids repeat, but never within two hops.
     let ids: Vec<String> = (0..1000).map(|i| (1000 + i).to_string()).collect();
-    let m = host_sim::load_toml(&strip_scenario(&ids), "big", &[]).unwrap();
+    let m = ph_formation_sim::load_toml(&strip_scenario(&ids), "big", &[]).unwrap();
     assert_eq!(m.agents[999].name, "1999");
     for i in 0..m.n() {
         for &j in m.graph.radio.of(i) {
@@ -189,7 +189,7 @@ fn ids_are_any_integers_or_names_and_wire_ids_are_assigned() {
         .iter()
         .map(|s| s.to_string())
         .collect();
-    let e = host_sim::load_toml(&strip_scenario(&bad), "bad", &[])
+    let e = ph_formation_sim::load_toml(&strip_scenario(&bad), "bad", &[])
         .unwrap_err()
         .to_string();
     assert!(
@@ -222,10 +222,10 @@ fn capacity_errors_name_the_agent_and_the_fix() {
             i + 1
         );
     }
-    let e = host_sim::load_toml(&s, "fan", &[]).unwrap_err().to_string();
+    let e = ph_formation_sim::load_toml(&s, "fan", &[]).unwrap_err().to_string();
     assert!(
         e.contains("agent hub belongs to 10 triangles")
-            && e.contains("at most 8 (controller_core::MAX_TRIANGLES)")
+            && e.contains("at most 8 (ph_formation_core::MAX_TRIANGLES)")
             && e.contains("move 2 of them"),
         "{e}"
     );
@@ -237,7 +237,7 @@ fn a_hundred_thousand_agents_load_with_wire_ids_unique_within_two_hops() {
     let n = 100_000;
     let ids: Vec<String> = (0..n).map(|i| format!("\"r{i}\"")).collect();
     let m =
-        host_sim::load_toml(&strip_scenario(&ids), "huge", &[]).unwrap_or_else(|e| panic!("{e}"));
+        ph_formation_sim::load_toml(&strip_scenario(&ids), "huge", &[]).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(m.n(), n);
     assert_eq!(m.agents[n - 1].name, format!("r{}", n - 1));
     // The strip's square has degree 4 on each side: 5 wire ids do.

@@ -3,10 +3,10 @@
 //! fresh `Diagnostics`, on the paper formation and, on two threads, on a formation large
 //! enough for the parallel terms.
 
-use host_sim::analysis::Diagnostics;
-use host_sim::engine::{Engine, SampledSim};
-use host_sim::scenario::strip_model;
-use host_sim::{load, Model};
+use ph_formation_sim::analysis::Diagnostics;
+use ph_formation_sim::engine::{Engine, SampledSim};
+use ph_formation_sim::scenario::strip_model;
+use ph_formation_sim::{load, Model};
 
 fn reused_equals_fresh(model: &Model) {
     let mut sim = SampledSim::new(model).expect("sim");

@@ -14,11 +14,11 @@
 mod common;
 
 use common::{build, max_difference, parse_demo_final, scratch, SQUARE, TOLERANCE};
-use controller_ffi::blob::{decode_blob, BlobError};
+use ph_formation_ffi::blob::{decode_blob, BlobError};
 use std::path::PathBuf;
 use std::process::Command;
 
-fn host_sim(args: &[&str]) -> std::process::Output {
+fn ph_formation_sim(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_host-sim"))
         .args(args)
         .output()
@@ -28,7 +28,7 @@ fn host_sim(args: &[&str]) -> std::process::Output {
 /// Exports agent `id` of the paper scenario into `dir`; returns the file.
 fn export(dir: &std::path::Path, id: &str) -> PathBuf {
     let path = dir.join(format!("agent{id}.blob"));
-    let out = host_sim(&[
+    let out = ph_formation_sim(&[
         "export",
         "--agent",
         id,
@@ -47,7 +47,7 @@ fn export(dir: &std::path::Path, id: &str) -> PathBuf {
 #[test]
 fn blobs_decode_to_the_scenarios_configuration() {
     let dir = scratch("export-decode");
-    let model = host_sim::load("paper", &[]).expect("paper");
+    let model = ph_formation_sim::load("paper", &[]).expect("paper");
     for (i, a) in model.agents.iter().enumerate() {
         let blob = std::fs::read(export(&dir, &a.id.to_string())).expect("blob");
         let decoded = decode_blob(&blob).expect("decodes");
@@ -93,7 +93,7 @@ fn the_c_demo_configured_by_exported_blobs_converges() {
 
 #[test]
 fn an_unknown_agent_is_a_usage_error() {
-    let out = host_sim(&["export", "--agent", "9", "paper"]);
+    let out = ph_formation_sim(&["export", "--agent", "9", "paper"]);
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
@@ -107,7 +107,7 @@ fn an_unknown_agent_is_a_usage_error() {
 fn c_source_output_holds_the_same_bytes() {
     let dir = scratch("export-c-source");
     let raw = std::fs::read(export(&dir, "3")).expect("blob");
-    let out = host_sim(&["-q", "export", "--agent", "3", "--c-array", "paper"]);
+    let out = ph_formation_sim(&["-q", "export", "--agent", "3", "--c-array", "paper"]);
     assert!(out.status.success());
     let c = String::from_utf8_lossy(&out.stdout);
     assert!(

@@ -8,7 +8,7 @@
 //! * `--vehicle crazyflie` refuses the simulator's force limits and a `v*` faster than
 //!   a Crazyflie flies, naming the figure and its source.
 
-use controller_ffi::blob::decode_blob;
+use ph_formation_ffi::blob::decode_blob;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -16,7 +16,7 @@ fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-fn host_sim(args: &[&str]) -> Output {
+fn ph_formation_sim(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_host-sim"))
         .current_dir(root())
         .args(args)
@@ -33,7 +33,7 @@ fn scratch(name: &str) -> PathBuf {
 #[test]
 fn all_writes_every_blob_and_one_c_table() {
     let dir = scratch("export-all-paper");
-    let out = host_sim(&[
+    let out = ph_formation_sim(&[
         "export",
         "--all",
         "paper",
@@ -61,7 +61,7 @@ fn all_writes_every_blob_and_one_c_table() {
             "ph_blobs.h"
         ]
     );
-    let model = host_sim::load("paper", &[]).expect("paper");
+    let model = ph_formation_sim::load("paper", &[]).expect("paper");
     let table = std::fs::read_to_string(dir.join("ph_blobs.c")).expect("ph_blobs.c");
     for (i, agent) in model.agents.iter().enumerate() {
         let blob = std::fs::read(dir.join(format!("agent{}.blob", agent.name))).expect("blob");
@@ -109,7 +109,7 @@ fn the_apps_blobs_are_the_export_of_its_formation() {
     let dir = scratch("export-all-crazyflie");
     let scenario = "crazyflie-app/formation.toml";
     let d = dir.to_str().expect("UTF-8");
-    let out = host_sim(&[
+    let out = ph_formation_sim(&[
         "export",
         "--all",
         scenario,
@@ -142,7 +142,7 @@ fn the_apps_blobs_are_the_export_of_its_formation() {
 }
 
 fn refused(args: &[&str]) -> String {
-    let out = host_sim(args);
+    let out = ph_formation_sim(args);
     assert_eq!(
         out.status.code(),
         Some(2),
@@ -191,7 +191,7 @@ fn the_crazyflie_refuses_what_it_cannot_fly() {
     // Within the limits: exported.
     std::fs::create_dir_all(&dir).expect("scratch directory");
     let blob = dir.join("a.blob");
-    let out = host_sim(&[
+    let out = ph_formation_sim(&[
         "export",
         "--agent",
         "1",

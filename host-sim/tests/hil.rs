@@ -1,8 +1,8 @@
 //! Host-in-the-loop (`host-sim run … --hil ID`, `docs/hil.md`).
 //!
 //! Always run (no QEMU needed): the protocol, lock-step, error paths and exit codes
-//! against the host-side stand-in of the firmware (`host_sim::engine::hil::fake`: an
-//! `Agent<f32, 4, 8>` behind a TCP link speaking `controller_core::link`), and the
+//! against the host-side stand-in of the firmware (`ph_formation_sim::engine::hil::fake`: an
+//! `Agent<f32, 4, 8>` behind a TCP link speaking `ph_formation_core::link`), and the
 //! start-up errors (missing ELF, missing QEMU, bad `--hil` arguments) through the binary.
 //!
 //! Ignored by default (`needs qemu-system-arm and the qemu-uart firmware ELF`): the same
@@ -10,17 +10,17 @@
 //!
 //! ```text
 //! cargo build -p firmware-example --target thumbv7em-none-eabihf --release --bin qemu-uart
-//! cargo test -p host-sim --test hil -- --include-ignored --test-threads=1
+//! cargo test -p ph-formation-sim --test hil -- --include-ignored --test-threads=1
 //! ```
 //!
 //! The QEMU tests also serialize themselves (a lock), so that each one has the machine's
 //! cores to itself.
 
-use host_sim::engine::hil::fake::FakeBehaviour;
-use host_sim::engine::hil::{self, HilError, HilOptions, Launcher, When};
-use host_sim::engine::{self as sim, NullRecorder, RunResult};
-use host_sim::model::Model;
-use host_sim::{exit_code, load, RunError, Simulation};
+use ph_formation_sim::engine::hil::fake::FakeBehaviour;
+use ph_formation_sim::engine::hil::{self, HilError, HilOptions, Launcher, When};
+use ph_formation_sim::engine::{self as sim, NullRecorder, RunResult};
+use ph_formation_sim::model::Model;
+use ph_formation_sim::{exit_code, load, RunError, Simulation};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::sync::Mutex;
@@ -165,7 +165,7 @@ fn stand_in_run_is_deterministic_and_lock_step() {
         let options = fake(&[2, 3], FakeBehaviour::default(), 10.0);
         let run = Simulation::new(&m)
             .keep_series(false)
-            .write_to(&out, host_sim::WriteOptions::without_plots())
+            .write_to(&out, ph_formation_sim::WriteOptions::without_plots())
             .hil(&options)
             .run()
             .expect("run");
@@ -196,7 +196,7 @@ fn stand_in_run_is_deterministic_and_lock_step() {
     // A pure-host summary has no wall-clock figures (same seed, same summary).
     let out = dir.path().join("host");
     Simulation::new(&m)
-        .write_to(&out, host_sim::WriteOptions::without_plots())
+        .write_to(&out, ph_formation_sim::WriteOptions::without_plots())
         .run()
         .expect("host run");
     let s: serde_json::Value =
@@ -344,7 +344,7 @@ angles = [{ apex = 0, desired_deg = 40.0 }, { apex = 5, desired_deg = 70.0 }]
 /// target, the figures and messages name it, and the run matches the pure-host run.
 #[test]
 fn hil_agents_are_named_by_the_scenario_ids() {
-    let text = host_sim::scenario::builtin("paper")
+    let text = ph_formation_sim::scenario::builtin("paper")
         .expect("paper")
         .text
         .replace("id = 3\n", "id = \"carol\"\n")
@@ -352,7 +352,7 @@ fn hil_agents_are_named_by_the_scenario_ids() {
         .replace("vertices = [2, 3, 4]", "vertices = [2, \"carol\", 4]")
         .replace("apex = 3,", "apex = \"carol\",")
         .replace("duration = 100.0", "duration = 3.0");
-    let m = host_sim::load_toml(&text, "named", &[]).expect("named paper");
+    let m = ph_formation_sim::load_toml(&text, "named", &[]).expect("named paper");
     assert_eq!(m.agents[2].name, "carol");
     let named = |ids: &[&str]| HilOptions {
         agents: ids.iter().map(|s| s.to_string()).collect(),

@@ -4,10 +4,10 @@
 //! the first collapse is recorded. On the paper formation, and on a formation large enough
 //! for the monitor to scan its estimates on every thread.
 
-use host_sim::analysis::{Diagnostics, Monitor, Outcome};
-use host_sim::engine::{Engine, SampledSim};
-use host_sim::scenario::strip_model;
-use host_sim::{load, Model};
+use ph_formation_sim::analysis::{Diagnostics, Monitor, Outcome};
+use ph_formation_sim::engine::{Engine, SampledSim};
+use ph_formation_sim::scenario::strip_model;
+use ph_formation_sim::{load, Model};
 
 /// Plays the sequence on `model` with the estimates `roles = [a, b, c, nan]` in the roles
 /// of the paper formation's estimates 0, 1, 3 and 2, on `threads` threads.

@@ -3,7 +3,7 @@
 //! cannot attach by its agent ids and line; an unknown field suggests the nearest known
 //! one. And the README's figures of the paper run stay true.
 
-use host_sim::scenario::GainsSpec;
+use ph_formation_sim::scenario::GainsSpec;
 
 /// formation-only's four agents and two triangles, without `[gains]`.
 const NO_GAINS: &str = r#"
@@ -37,9 +37,9 @@ angles = [{ apex = 2, desired_deg = 45.0 }, { apex = 3, desired_deg = 45.0, damp
 
 #[test]
 fn a_scenario_without_gains_gets_those_of_formation_only() {
-    let m = host_sim::load_toml(NO_GAINS, "no-gains.toml", &[]).expect("valid without [gains]");
-    let reference = host_sim::load("formation-only", &[]).expect("formation-only");
-    let gains = |m: &host_sim::Model| -> Vec<(f64, f64, f64)> {
+    let m = ph_formation_sim::load_toml(NO_GAINS, "no-gains.toml", &[]).expect("valid without [gains]");
+    let reference = ph_formation_sim::load("formation-only", &[]).expect("formation-only");
+    let gains = |m: &ph_formation_sim::Model| -> Vec<(f64, f64, f64)> {
         m.triangles
             .iter()
             .flat_map(|t| &t.angles)
@@ -63,7 +63,7 @@ fn a_scenario_without_gains_gets_those_of_formation_only() {
         "duration = 1.0",
         "duration = 1.0\n[gains]\nstiffness = -1.0",
     );
-    let e = host_sim::load_toml(&text, "bad.toml", &[]).expect_err("negative stiffness");
+    let e = ph_formation_sim::load_toml(&text, "bad.toml", &[]).expect_err("negative stiffness");
     assert_eq!(e.0.len(), 1, "{e}");
     assert_eq!(e.0[0].field, "gains.stiffness");
 }
@@ -95,7 +95,7 @@ angles = [{ apex = 5, desired_deg = 60.0 }, { apex = 6, desired_deg = 60.0 }]
     let line = |needle: &str| text.lines().position(|l| l.contains(needle)).expect("line");
     // The header `[[triangles]]` is the line before `vertices` (1-based: the same index).
     let (l124, l456) = (line("[1, 2, 4]"), line("[4, 5, 6]"));
-    let e = host_sim::load_toml(&text, "non-rigid.toml", &[]).expect_err("not rigid");
+    let e = ph_formation_sim::load_toml(&text, "non-rigid.toml", &[]).expect_err("not rigid");
     assert_eq!(e.0.len(), 1, "{e}");
     let msg = e.to_string();
     let expected = [
@@ -112,7 +112,7 @@ angles = [{ apex = 5, desired_deg = 60.0 }, { apex = 6, desired_deg = 60.0 }]
 #[test]
 fn an_unknown_field_suggests_the_nearest_known_one() {
     let text = NO_GAINS.replace("duration = 1.0", "duration = 1.0\n[gains]\nstifness = 3.0");
-    let e = host_sim::load_toml(&text, "typo.toml", &[]).expect_err("unknown field");
+    let e = ph_formation_sim::load_toml(&text, "typo.toml", &[]).expect_err("unknown field");
     assert_eq!(e.0.len(), 1);
     assert!(
         e.0[0].reason.contains("unknown field `stifness`")
@@ -120,6 +120,6 @@ fn an_unknown_field_suggests_the_nearest_known_one() {
         "{e}"
     );
     // Through --set too.
-    let e = host_sim::load("paper", &["radio.los=0.1".to_owned()]).expect_err("unknown");
+    let e = ph_formation_sim::load("paper", &["radio.los=0.1".to_owned()]).expect_err("unknown");
     assert!(e.to_string().contains("did you mean `loss`?"), "{e}");
 }

@@ -2,12 +2,12 @@
 //! the radio), RK4 steps (sampled and continuous), diagnostics, failure monitor and CSV
 //! rows, once warmed up. A counting global allocator counts this thread's allocations.
 
-use host_sim::analysis::{Diagnostics, Monitor};
-use host_sim::engine::{ContinuousSim, Engine, Recorder, Row, SampledSim};
-use host_sim::load;
-use host_sim::model::Model;
-use host_sim::report::CsvRecorder;
-use host_sim::scenario::strip_model;
+use ph_formation_sim::analysis::{Diagnostics, Monitor};
+use ph_formation_sim::engine::{ContinuousSim, Engine, Recorder, Row, SampledSim};
+use ph_formation_sim::load;
+use ph_formation_sim::model::Model;
+use ph_formation_sim::report::CsvRecorder;
+use ph_formation_sim::scenario::strip_model;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
@@ -150,7 +150,7 @@ fn sampled_and_continuous_loops_do_not_allocate() {
     // Strips (ideal radio: frames straight from the senders' outboxes), one thread.
     for n in [300, 1000] {
         let m = strip_model(n, 10.0).unwrap();
-        assert!(host_sim::engine::direct_radio(&m));
+        assert!(ph_formation_sim::engine::direct_radio(&m));
         let mut sim = SampledSim::new(&m).expect("sim");
         sim.advance_ticks(0.0, 20);
         let n = allocations(|| sim.advance_ticks(0.2, 50));

@@ -2,11 +2,11 @@
 //! promises (continuous mode's output), and the shortcut switches follow the models'
 //! one classification of their fields.
 
-use controller_core::Status;
-use host_sim::engine::sensors::Sensors;
-use host_sim::engine::{direct_radio, run, ContinuousSim, NullRecorder};
-use host_sim::model::{BearingRate, Mode, RadioModel, SensorModel};
-use host_sim::scenario::strip_model;
+use ph_formation_core::Status;
+use ph_formation_sim::engine::sensors::Sensors;
+use ph_formation_sim::engine::{direct_radio, run, ContinuousSim, NullRecorder};
+use ph_formation_sim::model::{BearingRate, Mode, RadioModel, SensorModel};
+use ph_formation_sim::scenario::strip_model;
 
 /// Continuous mode's output is the core's `Agent::output`: an agent whose velocity is not
 /// finite gets the safe command with a zero (finite) force, never a NaN (the continuous

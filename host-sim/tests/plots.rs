@@ -1,6 +1,6 @@
 //! The plot module on a real (short) run and on broken inputs.
 
-use host_sim::report::{plot_run, PlotError};
+use ph_formation_sim::report::{plot_run, PlotError};
 use std::path::Path;
 
 fn run_formation_only(dir: &Path) {
@@ -84,7 +84,7 @@ fn a_missing_column_or_an_empty_csv_is_a_named_error() {
 
 #[test]
 fn two_hundred_agents_get_a_colour_bar_not_a_legend_row_each() {
-    use host_sim::design::{construct, render_scenario, DesignOptions, Generator, ScenarioOptions};
+    use ph_formation_sim::design::{construct, render_scenario, DesignOptions, Generator, ScenarioOptions};
     let p = Generator::TriangularLattice {
         n: 200,
         spacing: 1.0,
@@ -98,10 +98,10 @@ fn two_hundred_agents_get_a_colour_bar_not_a_legend_row_each() {
         ..Default::default()
     };
     let text = render_scenario(&p, &c, &DesignOptions::default(), &so).expect("render");
-    let m = host_sim::load_toml(&text, "lattice", &[]).expect("load");
+    let m = ph_formation_sim::load_toml(&text, "lattice", &[]).expect("load");
     let dir = tempfile::tempdir().expect("tempdir");
-    let run = host_sim::Simulation::new(&m)
-        .write_to(dir.path(), host_sim::WriteOptions::default())
+    let run = ph_formation_sim::Simulation::new(&m)
+        .write_to(dir.path(), ph_formation_sim::WriteOptions::default())
         .run()
         .expect("run");
     assert!(run.plot_error.is_none(), "{:?}", run.plot_error);

@@ -1,13 +1,13 @@
 //! `[policy]` (docs/scenarios.md "Safety policies"): the core's safety policies run in
-//! the simulator's controller adapter (`host_sim::engine::policy`), and the run result
+//! the simulator's controller adapter (`ph_formation_sim::engine::policy`), and the run result
 //! says per agent what they did (`RunResult::policy`). Each check has its negative
 //! control; bad values are refused with file, field and reason.
 
-use controller_core::policy::PolicyReason;
-use host_sim::engine::{self as sim, NullRecorder, RunResult};
-use host_sim::load;
+use ph_formation_core::policy::PolicyReason;
+use ph_formation_sim::engine::{self as sim, NullRecorder, RunResult};
+use ph_formation_sim::load;
 
-fn room(overrides: &[&str]) -> Result<host_sim::model::Model, String> {
+fn room(overrides: &[&str]) -> Result<ph_formation_sim::model::Model, String> {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../crazyflie-app/formation.toml"

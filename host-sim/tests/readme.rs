@@ -45,11 +45,11 @@ fn the_readme_figures_of_the_paper_run_are_true() {
     let z = figure(&text, "|z − z*| ≈", " m");
     let v = figure(&text, "|v − v*| ≈", " m/s");
 
-    let model = host_sim::load("paper", &[]).expect("paper");
+    let model = ph_formation_sim::load("paper", &[]).expect("paper");
     let dir = tempfile::tempdir().expect("tempdir");
-    let run = host_sim::Simulation::new(&model)
+    let run = ph_formation_sim::Simulation::new(&model)
         .keep_series(false)
-        .write_to(dir.path(), host_sim::WriteOptions::default())
+        .write_to(dir.path(), ph_formation_sim::WriteOptions::default())
         .run()
         .expect("run");
     let r = &run.result;

@@ -4,7 +4,7 @@
 //! it in a real browser (`cargo xtask test` runs it; Chromium from
 //! `scripts/browser-deps.sh`).
 
-use host_sim::report::replay::{ReplayData, MAX_AGENTS, MAX_BYTES, MAX_CELLS};
+use ph_formation_sim::report::replay::{ReplayData, MAX_AGENTS, MAX_BYTES, MAX_CELLS};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -195,7 +195,7 @@ fn a_large_run_is_thinned_to_the_budget_with_its_leaders() {
     assert!(data.ids().iter().any(|i| i == "1498") && data.ids().iter().any(|i| i == "1499"));
     assert!(data.frames() >= 2 && data.frames() < rows);
     assert!(data.frames() * 4 * data.ids().len() <= MAX_CELLS);
-    let path = host_sim::report::write_replay(tmp.path()).expect("write");
+    let path = ph_formation_sim::report::write_replay(tmp.path()).expect("write");
     let size = std::fs::metadata(path).expect("size").len() as usize;
     assert!(size <= MAX_BYTES, "{size} bytes");
 }
@@ -408,7 +408,7 @@ fn replay_in_headless_chromium() {
     d["fov"] = serde_json::json!(0.6);
     d["edge_dropped"] = serde_json::json!((0..edge_cells).map(|k| k % 3 == 0).collect::<Vec<_>>());
     let optional = tmp.path().join("optional.html");
-    std::fs::write(&optional, host_sim::report::replay::page(&d.to_string())).expect("write");
+    std::fs::write(&optional, ph_formation_sim::report::replay::page(&d.to_string())).expect("write");
     let dom = browse(&profile, &optional, "probe=last", &["--dump-dom"]);
     assert_eq!(
         pre(&dom, "ph-errors"),

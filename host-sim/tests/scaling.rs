@@ -12,12 +12,12 @@
 //!
 //! That the inner loop allocates nothing per tick is `tests/no_alloc.rs`.
 
-use host_sim::design::{construct, render_scenario, DesignOptions, Generator, ScenarioOptions};
-use host_sim::engine::PARALLEL_MIN_AGENTS;
-use host_sim::engine::{
+use ph_formation_sim::design::{construct, render_scenario, DesignOptions, Generator, ScenarioOptions};
+use ph_formation_sim::engine::PARALLEL_MIN_AGENTS;
+use ph_formation_sim::engine::{
     AgentController, ControlStats, Engine, LocalCore, SampledSim, LOCAL_CAPACITIES,
 };
-use host_sim::scenario::strip_model;
+use ph_formation_sim::scenario::strip_model;
 
 /// Frames broadcast, copies sent and copies delivered per agent-tick over `ticks` ticks.
 fn work_per_agent_tick(n: usize, ticks: usize) -> [f64; 3] {
@@ -56,7 +56,7 @@ fn state(n: usize, ticks: usize, threads: usize) -> Snapshot {
 }
 
 /// A snapshot after `ticks` ticks of `m` on `threads` threads.
-fn on_threads(m: &host_sim::Model, ticks: usize, threads: usize) -> Snapshot {
+fn on_threads(m: &ph_formation_sim::Model, ticks: usize, threads: usize) -> Snapshot {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -65,7 +65,7 @@ fn on_threads(m: &host_sim::Model, ticks: usize, threads: usize) -> Snapshot {
 }
 
 /// The [`Snapshot`] after `ticks` ticks.
-fn snapshot(m: &host_sim::Model, ticks: usize) -> Snapshot {
+fn snapshot(m: &ph_formation_sim::Model, ticks: usize) -> Snapshot {
     snapshot_of(SampledSim::new(m).expect("sim"), ticks)
 }
 
@@ -153,11 +153,11 @@ fn noisy_and_quiet_large_runs_on_two_threads_are_bit_identical_to_one() {
         m.sensors.range_noise = sigma;
         m.sensors.offset_noise = sigma;
         m.sensors.velocity_bias = [0.01, -0.02];
-        m.estimator = host_sim::model::Estimator::Measured;
+        m.estimator = ph_formation_sim::model::Estimator::Measured;
         m.radio.loss = 0.1;
         // Agents 10 and 11 start at one point: neither measures a bearing to the other.
         m.agents[11].position = m.agents[10].position;
-        assert!(!host_sim::engine::direct_radio(&m));
+        assert!(!ph_formation_sim::engine::direct_radio(&m));
         let one = on_threads(&m, 30, 1);
         let two = on_threads(&m, 30, 2);
         assert_eq!(one.1, two.1, "noisy: {noisy}");
@@ -176,7 +176,7 @@ fn direct_delivery_is_what_the_queue_delivers() {
     let run = |latency: f64| {
         let mut m = strip_model(60, 10.0).unwrap();
         m.radio.latency = latency;
-        let direct = host_sim::engine::direct_radio(&m);
+        let direct = ph_formation_sim::engine::direct_radio(&m);
         let (bits, counts, _) = snapshot(&m, 200);
         (direct, bits, counts)
     };
@@ -188,12 +188,12 @@ fn direct_delivery_is_what_the_queue_delivers() {
 }
 
 /// A designed formation from `g` (default design and scenario options).
-fn designed(g: Generator) -> host_sim::Model {
+fn designed(g: Generator) -> ph_formation_sim::Model {
     let p = g.points().expect("points");
     let opts = DesignOptions::default();
     let c = construct(&p, &opts).expect("construct");
     let text = render_scenario(&p, &c, &opts, &ScenarioOptions::default()).expect("render");
-    host_sim::load_toml(&text, "designed", &[]).expect("load")
+    ph_formation_sim::load_toml(&text, "designed", &[]).expect("load")
 }
 
 /// Agents in the smallest capacity that holds them compute what agents of the standard
@@ -245,9 +245,9 @@ fn the_capacity_class_of_an_agent_never_changes_a_result() {
 /// its core as a prefix of its slots.
 #[test]
 fn every_agents_bearings_reach_its_core_in_slot_order() {
-    use controller_core::{BearingMeasurement, Vec2};
-    use host_sim::engine::local_core;
-    use host_sim::engine::slot_order::SlotOrder;
+    use ph_formation_core::{BearingMeasurement, Vec2};
+    use ph_formation_sim::engine::local_core;
+    use ph_formation_sim::engine::slot_order::SlotOrder;
     let b = |id: u8| BearingMeasurement {
         neighbour: id,
         bearing: Vec2::new(1.0, 0.0),

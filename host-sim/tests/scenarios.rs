@@ -1,10 +1,10 @@
 //! The built-in scenarios end as SPEC §9 says, continuous mode keeps V from increasing,
 //! the paper scenario survives a lossy, delayed radio, and runs are reproducible.
 
-use host_sim::engine::{self as sim, NullRecorder, RunResult};
-use host_sim::model::{Mode, Model};
-use host_sim::scenario::strip_model;
-use host_sim::{load, Outcome, Simulation};
+use ph_formation_sim::engine::{self as sim, NullRecorder, RunResult};
+use ph_formation_sim::model::{Mode, Model};
+use ph_formation_sim::scenario::strip_model;
+use ph_formation_sim::{load, Outcome, Simulation};
 
 fn model(name: &str, overrides: &[&str]) -> Model {
     let o: Vec<String> = overrides.iter().map(|s| (*s).to_owned()).collect();
@@ -191,7 +191,7 @@ fn same_seed_same_csv_other_seed_other_csv() {
         let out = dir.path().join(format!("run{k}"));
         let run = Simulation::new(&m)
             .keep_series(false)
-            .write_to(&out, host_sim::WriteOptions::without_plots())
+            .write_to(&out, ph_formation_sim::WriteOptions::without_plots())
             .run()
             .expect("run");
         let r = &run.result;
@@ -221,7 +221,7 @@ fn a_file_with_two_neighbours_sharing_an_id_is_refused_naming_both() {
         "/tests/invalid/duplicate_id.toml"
     );
     let e = load(path, &[]).expect_err("duplicate id accepted");
-    assert!(e.has(host_sim::scenario::ErrorKind::DuplicateId), "{e}");
+    assert!(e.has(ph_formation_sim::scenario::ErrorKind::DuplicateId), "{e}");
     let e = e.to_string();
     assert!(
         e.contains("duplicate_id.toml")

@@ -3,9 +3,9 @@
 //! run that is only noisy `converged` while a collapse is still a collapse. Bad sensor
 //! and tracker settings are refused with their field.
 
-use host_sim::engine::{self as sim, NullRecorder, RunResult};
-use host_sim::model::Model;
-use host_sim::{load, Outcome, Simulation};
+use ph_formation_sim::engine::{self as sim, NullRecorder, RunResult};
+use ph_formation_sim::model::Model;
+use ph_formation_sim::{load, Outcome, Simulation};
 
 fn model(name: &str, overrides: &[&str]) -> Model {
     let o: Vec<String> = overrides.iter().map(|s| (*s).to_owned()).collect();

@@ -3,9 +3,9 @@
 //! whole-formation mirror; a folded triangle is `wrong_shape`, a fold onto a neighbour a
 //! `collision`; designed formations validate and converge.
 
-use host_sim::design::{construct, render_scenario, DesignOptions, Generator, Perturbation, Scale};
-use host_sim::design::{ScenarioOptions, Template};
-use host_sim::{load_toml, Outcome, Simulation};
+use ph_formation_sim::design::{construct, render_scenario, DesignOptions, Generator, Perturbation, Scale};
+use ph_formation_sim::design::{ScenarioOptions, Template};
+use ph_formation_sim::{load_toml, Outcome, Simulation};
 
 fn angle_deg(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     let u = [a[0] - p[0], a[1] - p[1]];
@@ -80,14 +80,14 @@ const FAN: [[f64; 2]; 5] = [
 ];
 const FAN_TRIS: [[usize; 3]; 3] = [[0, 1, 2], [1, 2, 3], [0, 2, 4]];
 
-fn run(text: &str) -> (host_sim::Model, host_sim::Run) {
+fn run(text: &str) -> (ph_formation_sim::Model, ph_formation_sim::Run) {
     let m = load_toml(text, "shape", &[]).unwrap_or_else(|e| panic!("{e}"));
     let r = Simulation::new(&m).keep_series(false).run().unwrap();
     (m, r)
 }
 
 /// `wrong_shape` with every angle satisfied and triangle 2–3–4 named as folded.
-fn assert_folded_234(r: &host_sim::Run) {
+fn assert_folded_234(r: &ph_formation_sim::Run) {
     assert_eq!(r.outcome(), Outcome::WrongShape, "{}", r.result.reason);
     assert!(r.result.final_max_angle_error < 1e-3);
     assert!(
@@ -184,7 +184,7 @@ fn designed(g: &Generator, duration: f64, rotate: bool) -> (Vec<[f64; 2]>, Strin
     let p = g.points().unwrap();
     let opts = DesignOptions::default();
     let c = construct(&p, &opts).unwrap();
-    let template = host_sim::scenario::builtin("formation-only").unwrap();
+    let template = ph_formation_sim::scenario::builtin("formation-only").unwrap();
     let so = ScenarioOptions {
         name: "designed".to_owned(),
         source: g.describe(),
@@ -216,7 +216,7 @@ fn designed_formations_validate_and_the_target_from_angles_is_theirs() {
             table.remove("target");
             let m2 = load_toml(&toml::to_string(&table).unwrap(), "designed", &[]).unwrap();
             let tris: Vec<[usize; 3]> = m2.triangles.iter().map(|t| t.vertices).collect();
-            let c = host_sim::model::shape::compare(&m2.target.positions, &p, &tris).unwrap();
+            let c = ph_formation_sim::model::shape::compare(&m2.target.positions, &p, &tris).unwrap();
             assert!(
                 c.fit.max_rel < 1e-9 && c.folded.is_empty() && !c.fit.reflected,
                 "{}: {:?}",

@@ -5,15 +5,15 @@
 //! settings refused with file, field and reason.
 
 mod support;
-use controller_core::Vec2;
-use host_sim::engine::radio::RadioFrame;
-use host_sim::engine::sensors::{
+use ph_formation_core::Vec2;
+use ph_formation_sim::engine::radio::RadioFrame;
+use ph_formation_sim::engine::sensors::{
     BearingKind, BearingSensor, Sensors, SharedPositions, World, POSITION_VERSION,
 };
-use host_sim::engine::{run, Engine, NullRecorder, SampledSim, PARALLEL_MIN_AGENTS};
-use host_sim::load;
-use host_sim::model::{BearingRate, Model, PositionsModel, SensorModel};
-use host_sim::scenario::strip_model;
+use ph_formation_sim::engine::{run, Engine, NullRecorder, SampledSim, PARALLEL_MIN_AGENTS};
+use ph_formation_sim::load;
+use ph_formation_sim::model::{BearingRate, Model, PositionsModel, SensorModel};
+use ph_formation_sim::scenario::strip_model;
 
 const KIND: BearingKind = BearingKind {
     exact_rate: false,
@@ -249,7 +249,7 @@ fn every_positions_field_can_be_set() {
     );
     let p = m.sensors.positions.clone().expect("shared positions");
     assert_eq!((p.noise, p.max_age, p.packet_bytes), (0.003, 0.25, 16));
-    assert!(!host_sim::engine::direct_radio(&m));
+    assert!(!ph_formation_sim::engine::direct_radio(&m));
     // The source alone: the defaults.
     let p = shared("formation-only", &[])
         .sensors
@@ -258,7 +258,7 @@ fn every_positions_field_can_be_set() {
     assert_eq!((p.noise, p.max_age, p.packet_bytes), (0.0, 0.1, 10));
     let plain = load("formation-only", &[]).expect("load");
     assert!(plain.sensors.positions.is_none());
-    assert!(host_sim::engine::direct_radio(&plain));
+    assert!(ph_formation_sim::engine::direct_radio(&plain));
 }
 
 #[test]

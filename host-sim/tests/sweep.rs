@@ -2,7 +2,7 @@
 //! number of threads, 3 shards + merge = one run, and the aggregation's statistics against
 //! hand-computed values.
 
-use host_sim::sweep::{
+use ph_formation_sim::sweep::{
     aggregate, merge, quantile, run_all, run_seed, wilson, write_all, Manifest, Plan, RunRow,
     Shard, ShardArg, SweepError, SweepSource,
 };
@@ -28,7 +28,7 @@ fn with_axis(axis: &str) -> String {
     format!("[base]\nscenario = \"formation-only\"\n\n[[axes]]\n{axis}\n")
 }
 
-fn run_in_pool(p: &Plan, threads: usize, shard: Shard) -> host_sim::sweep::Finished {
+fn run_in_pool(p: &Plan, threads: usize, shard: Shard) -> ph_formation_sim::sweep::Finished {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()

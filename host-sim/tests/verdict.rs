@@ -3,9 +3,9 @@
 //! nothing, a wrong target, noise too large for the shape to hold — and the genuine
 //! successes, each asserting the exact outcome over several seeds.
 
-use host_sim::engine::{self as sim, drive, NullRecorder, RunResult, SampledSim};
-use host_sim::model::Model;
-use host_sim::{load, Outcome};
+use ph_formation_sim::engine::{self as sim, drive, NullRecorder, RunResult, SampledSim};
+use ph_formation_sim::model::Model;
+use ph_formation_sim::{load, Outcome};
 
 const STRIP: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/strip20.toml");
 
@@ -212,7 +212,7 @@ fn camera_outliers_without_noise_converge_on_the_tracker() {
     assert!(
         matches!(
             m.sensors.bearing_filter,
-            controller_core::BearingFilter::Tracker(_)
+            ph_formation_core::BearingFilter::Tracker(_)
         ),
         "auto must pick the tracker for a lossy camera"
     );

@@ -8,7 +8,7 @@
 //! `host-sim run paper` (seed 1, sampled 100 Hz, finite-difference rates, wire v3) at
 //! commit ff51ecc.
 
-use host_sim::{load, Outcome, Simulation};
+use ph_formation_sim::{load, Outcome, Simulation};
 
 /// Final positions of agents 1–4 in the wire-v3 run.
 const V3_FINAL: [[f64; 2]; 4] = [

@@ -3,10 +3,10 @@
 //! `crazyflie` preset on room-sized formations, the speed-limit warning, and every new
 //! field refused with file, field and reason.
 
-use host_sim::engine::world::{Clocks, Headings, Wind};
-use host_sim::engine::{self as sim, NullRecorder, RunResult};
-use host_sim::model::{ClockModel, HeadingModel, Model, WindModel};
-use host_sim::{load, Outcome};
+use ph_formation_sim::engine::world::{Clocks, Headings, Wind};
+use ph_formation_sim::engine::{self as sim, NullRecorder, RunResult};
+use ph_formation_sim::model::{ClockModel, HeadingModel, Model, WindModel};
+use ph_formation_sim::{load, Outcome};
 
 fn model(name: &str, overrides: &[&str]) -> Model {
     let o: Vec<String> = overrides.iter().map(|s| (*s).to_owned()).collect();
@@ -166,7 +166,7 @@ fn heading_errors_turn_the_leader_edge() {
 /// correlation `e^{−h/τ}` one step apart, over many agents.
 #[test]
 fn gusts_have_their_variance_and_correlation() {
-    let m = host_sim::scenario::strip_model(400, 1.0).unwrap();
+    let m = ph_formation_sim::scenario::strip_model(400, 1.0).unwrap();
     let w = WindModel {
         mean: [0.0; 2],
         gust: 0.3,

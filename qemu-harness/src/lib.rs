@@ -9,7 +9,7 @@
 //! * [`firmware`]: the workspace, the target directory and the release firmware ELFs.
 //! * [`defmt`]: decoding the firmware's defmt log with `defmt-print`.
 //! * `link` (feature `link`): the host end of the UART link session
-//!   (`controller_core::link` messages, postcard in COBS frames).
+//!   (`ph_formation_core::link` messages, postcard in COBS frames).
 //!
 //! Host only (std). Nothing here starts QEMU by itself: the QEMU tests are `#[ignore]`d
 //! and `cargo xtask firmware-check` runs them.

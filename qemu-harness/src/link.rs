@@ -1,4 +1,4 @@
-//! The host end of one emulated UART: `controller_core::link` messages, postcard-encoded
+//! The host end of one emulated UART: `ph_formation_core::link` messages, postcard-encoded
 //! and COBS-framed (one message per `0`-delimited frame), over a TCP stream, with byte
 //! and frame counters and a deadline on every read.
 //!
@@ -6,8 +6,8 @@
 //! its receiver is on), then `Configure` → `Ready`, per tick `Radio`* + `Step` →
 //! `Radio`* [+ `Estimates`] + `Output`, and `Finish` → `Finished` (`docs/firmware.md`).
 
-use controller_core::link::{HostMsg, TargetMsg, MAX_LINK_MSG};
-use controller_core::wire::{cobs_decode, cobs_encode};
+use ph_formation_core::link::{HostMsg, TargetMsg, MAX_LINK_MSG};
+use ph_formation_core::wire::{cobs_decode, cobs_encode};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::io::{self, Read, Write};
@@ -275,7 +275,7 @@ impl Link {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use controller_core::link::LINK_VERSION;
+    use ph_formation_core::link::LINK_VERSION;
     use std::net::TcpListener;
 
     /// A connected (host link, target stream) pair on loopback.

@@ -7,7 +7,7 @@
 //!   relative positions `q_i − q_1` are the paper's square, `(0, 0)`,
 //!   `(−10, 10)`, `(10, 10)`, `(0, 20)`, within [`TOLERANCE`].
 //! * `demo_matches_host_sim`: the same relative positions agree with those of
-//!   `cargo run --release -p host-sim -- run paper --out <tmp> --quiet
+//!   `cargo run --release -p ph-formation-sim -- run paper --out <tmp> --quiet
 //!   --no-plots` (its `summary.json`, `final_positions`) within [`TOLERANCE`].
 //!
 //! Tolerance: 1e-2 m on a square of side 14 m. The demo stops as soon as all
@@ -110,7 +110,7 @@ fn host_sim_final_positions() -> Vec<[f64; 2]> {
                     "run",
                     "--release",
                     "-p",
-                    "host-sim",
+                    "ph-formation-sim",
                     "--",
                     "run",
                     "paper",

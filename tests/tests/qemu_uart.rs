@@ -30,8 +30,8 @@
 use std::net::TcpListener;
 use std::time::{Duration, Instant};
 
-use controller_core::link::{HostMsg, LinkBearing, LinkOutput, LinkStep, TargetMsg, LINK_VERSION};
-use controller_core::{
+use ph_formation_core::link::{HostMsg, LinkBearing, LinkOutput, LinkStep, TargetMsg, LINK_VERSION};
+use ph_formation_core::{
     Agent, AgentConfig, AngleConfig, BearingMeasurement, LeaderConfig, LeaderRole, Measurements,
     Real, Schedule, TriangleConfig, Vec2,
 };
@@ -363,7 +363,7 @@ fn uart_agent_in_the_loop() {
         {
             identical += 1;
         }
-        let nominal = output.status == controller_core::Status::Nominal;
+        let nominal = output.status == ph_formation_core::Status::Nominal;
         if nominal && first_nominal.is_none() {
             first_nominal = Some(k);
         }

@@ -208,7 +208,7 @@ pub fn run(o: &Options) -> Result<bool, String> {
         p => return Err(format!("--profile {p}: expected dev or release")),
     };
     let mut build = cargo();
-    build.args(["build", "-p", "host-sim", "--example", "counts"]);
+    build.args(["build", "-p", "ph-formation-sim", "--example", "counts"]);
     if o.profile == "release" {
         build.arg("--release");
     }

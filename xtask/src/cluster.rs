@@ -56,7 +56,7 @@ pub fn run() -> Result<(), String> {
     let t = Instant::now();
     // The binary `cargo test` builds, so that after the test phase of `cargo xtask test`
     // nothing is rebuilt.
-    let host_sim = tools::host_sim_dev()?;
+    let ph_formation_sim = tools::host_sim_dev()?;
     times.push(("build host-sim (as cargo test does)", t.elapsed()));
     let work = target_dir().join("cluster-test");
     let _ = std::fs::remove_dir_all(&work);
@@ -83,9 +83,9 @@ pub fn run() -> Result<(), String> {
     // 1. The array, merged, against one unsharded run.
     let t = Instant::now();
     let whole = work.join("tiny-whole");
-    sweep_alone(&host_sim, &tiny, &whole)?;
+    sweep_alone(&ph_formation_sim, &tiny, &whole)?;
     let shards = work.join("tiny-shards");
-    let job = cluster.submit(&script, &host_sim, &tiny, &shards, "1-3", None)?;
+    let job = cluster.submit(&script, &ph_formation_sim, &tiny, &shards, "1-3", None)?;
     let states = cluster.wait(&job)?;
     if states.iter().any(|(_, s)| s != "COMPLETED") || states.len() != K as usize {
         return Err(format!(
@@ -95,7 +95,7 @@ pub fn run() -> Result<(), String> {
     }
     println!("cluster-test: job array {job} ran: {states:?}");
     let merged = work.join("tiny-merged");
-    let m = merge(&host_sim, &merged, &shards)?;
+    let m = merge(&ph_formation_sim, &merged, &shards)?;
     if !m.status.success() {
         return Err(format!(
             "merge failed: {}",
@@ -109,9 +109,9 @@ pub fn run() -> Result<(), String> {
     // 2. One task cancelled while it runs, merge names it, resubmitted alone.
     let t = Instant::now();
     let whole = work.join("longer-whole");
-    sweep_alone(&host_sim, &longer, &whole)?;
+    sweep_alone(&ph_formation_sim, &longer, &whole)?;
     let shards = work.join("longer-shards");
-    let job = cluster.submit(&script, &host_sim, &longer, &shards, "1-3", None)?;
+    let job = cluster.submit(&script, &ph_formation_sim, &longer, &shards, "1-3", None)?;
     let started = shards.join("2/sweep.json");
     let deadline = Instant::now() + TIMEOUT;
     while !started.is_file() {
@@ -124,7 +124,7 @@ pub fn run() -> Result<(), String> {
     let states = cluster.wait(&job)?;
     println!("cluster-test: task 2 cancelled while running: {states:?}");
     let merged = work.join("longer-merged");
-    let m = merge(&host_sim, &merged, &shards)?;
+    let m = merge(&ph_formation_sim, &merged, &shards)?;
     let said = String::from_utf8_lossy(&m.stderr).into_owned();
     if m.status.success() || !said.contains("2/3") {
         return Err(format!(
@@ -136,12 +136,12 @@ pub fn run() -> Result<(), String> {
         "cluster-test: merge names it: {}",
         said.trim().replace('\n', " | ")
     );
-    let again = cluster.submit(&script, &host_sim, &longer, &shards, "2", Some(K))?;
+    let again = cluster.submit(&script, &ph_formation_sim, &longer, &shards, "2", Some(K))?;
     let states = cluster.wait(&again)?;
     if states.iter().any(|(_, s)| s != "COMPLETED") {
         return Err(format!("resubmitted task: {states:?}"));
     }
-    let m = merge(&host_sim, &merged, &shards)?;
+    let m = merge(&ph_formation_sim, &merged, &shards)?;
     if !m.status.success() {
         return Err(format!(
             "merge after resubmitting: {}",
@@ -171,9 +171,9 @@ fn write(p: &Path, text: &str) -> Result<(), String> {
     std::fs::write(p, text).map_err(|e| format!("{}: {e}", p.display()))
 }
 
-fn sweep_alone(host_sim: &Path, sweep: &Path, out: &Path) -> Result<(), String> {
+fn sweep_alone(ph_formation_sim: &Path, sweep: &Path, out: &Path) -> Result<(), String> {
     tools::run(
-        Command::new(host_sim)
+        Command::new(ph_formation_sim)
             .args(["-q", "sweep"])
             .arg(sweep)
             .args(["--no-plots", "--jobs", "2", "--out"])
@@ -181,8 +181,8 @@ fn sweep_alone(host_sim: &Path, sweep: &Path, out: &Path) -> Result<(), String> 
     )
 }
 
-fn merge(host_sim: &Path, out: &Path, shards: &Path) -> Result<std::process::Output, String> {
-    let mut c = Command::new(host_sim);
+fn merge(ph_formation_sim: &Path, out: &Path, shards: &Path) -> Result<std::process::Output, String> {
+    let mut c = Command::new(ph_formation_sim);
     c.args(["-q", "sweep", "merge", "--no-plots", "--out"])
         .arg(out);
     for k in 1..=K {

@@ -81,7 +81,7 @@ fn phases(
         )
     })?;
     phase("clippy and builds (thumbv7em-none-eabihf)", &mut || {
-        let core = ["-p", "controller-core"];
+        let core = ["-p", "ph-formation-core"];
         tools::run(cargo().arg("clippy").args(core).args(thumb).args(deny))?;
         tools::run(
             cargo()
@@ -156,7 +156,7 @@ fn phases(
         )
     })?;
     phase("bench-counts (host-sim under callgrind)", &mut || {
-        // The dev profile, but `-p host-sim`'s own feature set (the binary the budgets
+        // The dev profile, but `-p ph-formation-sim`'s own feature set (the binary the budgets
         // were measured on): host-sim and the crates whose features differ from the
         // workspace's (postcard, controller-core, …) compile again (docs/performance.md).
         let o = crate::bench_counts::Options {
@@ -179,7 +179,7 @@ fn phases(
         tools::run(cargo().args(["test", "--test", "replay", "--", "--ignored"]))
     })?;
     phase("host-in-the-loop (host-sim QEMU tests)", &mut || {
-        // No `-p host-sim`: the default members' feature set, as `cargo test` built it.
+        // No `-p ph-formation-sim`: the default members' feature set, as `cargo test` built it.
         tools::run(cargo().args(["test", "--test", "hil", "--", "--include-ignored"]))
     })?;
     Ok(())

@@ -15,10 +15,10 @@
 //! and time steps reach both, and the force stays finite and bounded.
 #![no_main]
 
-use controller_core::wire::{
+use ph_formation_core::wire::{
     auth, check_frame, decode_frame, mode_byte, CounterExt, Frame, Integrity, SwarmKey,
 };
-use controller_core::{
+use ph_formation_core::{
     Agent, AgentConfig, AngleConfig, BearingMeasurement, EstimatorMode, Measurements,
     TriangleConfig, Vec2,
 };
@@ -34,7 +34,7 @@ fn agent(integrity: Integrity) -> Agent<f32, 2, 4> {
     };
     let mut c = AgentConfig::<f32, 2>::new(3);
     if matches!(integrity, Integrity::Link) {
-        c.bearing_filter = controller_core::BearingFilter::FiniteDifference;
+        c.bearing_filter = ph_formation_core::BearingFilter::FiniteDifference;
     }
     c.integrity = integrity;
     let _ = c.triangles.push(TriangleConfig {
@@ -126,7 +126,7 @@ fn sign(bytes: &mut [u8]) {
 }
 
 fn crc16(body: &[u8]) -> [u8; 2] {
-    controller_core::crc16::checksum(body).to_le_bytes()
+    ph_formation_core::crc16::checksum(body).to_le_bytes()
 }
 
 fuzz_target!(|data: &[u8]| {

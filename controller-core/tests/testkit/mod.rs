@@ -4,16 +4,16 @@
 //!
 //! Agent `i` (index) has id `i + 1`.
 
-use controller_core::wire::Integrity;
-use controller_core::{
+use ph_formation_core::wire::Integrity;
+use ph_formation_core::{
     geometry, AgentConfig, AgentId, AngleConfig, BearingMeasurement, EstimatorMode, LeaderConfig,
     LeaderRole, Measurements, Schedule, TriangleConfig, Vec2,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-/// The agent type of the tests: the standard capacities (`controller_core::MAX_TRIANGLES`, `MAX_NEIGHBOURS`).
-pub type HostAgent<T> = controller_core::StandardAgent<T>;
+/// The agent type of the tests: the standard capacities (`ph_formation_core::MAX_TRIANGLES`, `MAX_NEIGHBOURS`).
+pub type HostAgent<T> = ph_formation_core::StandardAgent<T>;
 
 /// One controlled angle: triangle index, apex (agent index), desired cosine, gains.
 #[derive(Clone, Copy, Debug)]
@@ -190,7 +190,7 @@ impl Formation {
     }
 
     /// The configuration of agent index `i` (scalar `T`).
-    pub fn config<T: controller_core::Real>(&self, i: usize) -> controller_core::StandardConfig<T> {
+    pub fn config<T: ph_formation_core::Real>(&self, i: usize) -> ph_formation_core::StandardConfig<T> {
         let t = |x: f64| T::lit(x);
         let mut c = AgentConfig::new(id(i));
         c.estimator = self.mode;
@@ -238,7 +238,7 @@ impl Formation {
     }
 
     /// All agents.
-    pub fn agents<T: controller_core::Real>(&self) -> Vec<HostAgent<T>> {
+    pub fn agents<T: ph_formation_core::Real>(&self) -> Vec<HostAgent<T>> {
         (0..self.n)
             .map(|i| HostAgent::<T>::new(self.config(i)).expect("valid test configuration"))
             .collect()
@@ -268,7 +268,7 @@ impl Formation {
 }
 
 /// Exact bearings (and rates, S2, and ranges) that agent `i` measures.
-pub fn bearings<T: controller_core::Real>(
+pub fn bearings<T: ph_formation_core::Real>(
     f: &Formation,
     s: &State,
     i: usize,
@@ -294,7 +294,7 @@ pub fn bearings<T: controller_core::Real>(
 
 /// Senses the true state on every agent (exact rates, `dt`), then exchanges every
 /// agent's broadcast with its neighbours directly (no wire).
-pub fn sense_and_exchange<T: controller_core::Real>(
+pub fn sense_and_exchange<T: ph_formation_core::Real>(
     f: &Formation,
     s: &State,
     agents: &mut [HostAgent<T>],

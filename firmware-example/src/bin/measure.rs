@@ -39,7 +39,7 @@ pub const REPEATS: u32 = 3;
 #[cfg(target_os = "none")]
 mod firmware {
     use super::REPEATS;
-    use controller_core::StepOutput;
+    use ph_formation_core::StepOutput;
     use cortex_m_rt::entry;
     use firmware_example::measure::{self, MAX_REGIONS};
     use firmware_example::workload::{Bench, StepConfig, StepCtx, StepResult, STEP_CONFIGS};

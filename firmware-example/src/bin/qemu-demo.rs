@@ -1,7 +1,7 @@
 //! `qemu-demo`: the paper's formation (SPEC §9, `paper` gains) simulated
 //! inside the firmware in `f32`.
 //!
-//! Four robots, each its own `controller_core::Agent<f32, 2, 4>` driven
+//! Four robots, each its own `ph_formation_core::Agent<f32, 2, 4>` driven
 //! through the generic control loop ([`ControlLoop`]) at 100 Hz by the demo
 //! board ([`boards::demo`]): RK4 plant at 1 ms, exact bearings (rates by
 //! finite differences in the controller), real encoded frames over an
@@ -47,7 +47,7 @@ pub const LOG_EVERY_S: u32 = 5;
 #[cfg(target_os = "none")]
 mod firmware {
     use super::{ANGLE_TOL, LEADER_TOL, LOG_EVERY_S, MAX_TIME, VELOCITY_TOL};
-    use controller_core::Agent;
+    use ph_formation_core::Agent;
     use cortex_m_rt::entry;
     use firmware_example::app::ControlLoop;
     use firmware_example::boards::demo::{Metrics, World, CONTROL_HZ, N};

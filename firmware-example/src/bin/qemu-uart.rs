@@ -1,7 +1,7 @@
 //! `qemu-uart`: one agent driven by a host over USART1 (host-in-the-loop).
 //!
 //! The host (e.g. the host simulator, or `tests/tests/qemu_uart.rs`) speaks
-//! the lock-step protocol of `controller_core::link` on the serial line; see
+//! the lock-step protocol of `ph_formation_core::link` on the serial line; see
 //! [`boards::uart`] for the messages. Each `Step` runs one tick of the
 //! generic control loop on an `Agent<f32, 4, 8>` configured by the host.
 //! On `Finish` the firmware replies `Finished`, reports its peak stack use

@@ -21,7 +21,7 @@
 //! Each robot runs its own `controller-core` agent through the generic
 //! [`ControlLoop`] at [`CONTROL_HZ`].
 
-use controller_core::Real;
+use ph_formation_core::Real;
 use heapless::{Deque, Vec};
 
 use crate::app::{Board, ControlLoop, TickReport};

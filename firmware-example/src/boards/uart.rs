@@ -1,7 +1,7 @@
 //! The `qemu-uart` board: one robot whose sensors, radio and actuator are a
 //! host at the other end of a serial line (host-in-the-loop).
 //!
-//! The host speaks the lock-step protocol of [`controller_core::link`]:
+//! The host speaks the lock-step protocol of [`ph_formation_core::link`]:
 //! postcard messages, one per COBS frame (`0`-delimited):
 //!
 //! | host → target | target → host |
@@ -36,11 +36,11 @@
 //! `Usart1` (MCU builds only) is the STM32F4 USART1, polled, sleeping in
 //! `wfi` while it waits for a byte.
 
-use controller_core::link::{
+use ph_formation_core::link::{
     link_estimates, HostMsg, LinkError, LinkOutput, LinkStep, TargetMsg, LINK_VERSION, MAX_LINK_MSG,
 };
-use controller_core::wire::{cobs_encode, CobsAccumulator};
-use controller_core::{Agent, AgentId};
+use ph_formation_core::wire::{cobs_encode, CobsAccumulator};
+use ph_formation_core::{Agent, AgentId};
 use heapless::Deque;
 
 use crate::app::{Board, ControlLoop, TickReport};
@@ -190,7 +190,7 @@ impl<P: SerialPort> Session<P> {
     }
 
     #[inline(never)]
-    fn configure(&mut self, config: controller_core::AgentConfig<f32, MT>) -> Event {
+    fn configure(&mut self, config: ph_formation_core::AgentConfig<f32, MT>) -> Event {
         self.control = None;
         self.radio.clear();
         self.clock_us = None;

@@ -2,7 +2,7 @@
 //! by cause, and the first agents that gave them (counted by the engine, judged by
 //! [`super::Monitor::verdict`]).
 
-use controller_core::Fault;
+use ph_formation_core::Fault;
 
 /// How many kinds of [`Fault`] [`FaultTally`] tells apart.
 pub const FAULT_KINDS: usize = 8;
@@ -11,7 +11,7 @@ pub const FAULT_EXAMPLES: usize = 8;
 
 /// One fault of each kind, in [`fault_kind`]'s order (for words and keys by kind).
 pub const FAULT_SAMPLES: [Fault; FAULT_KINDS] = [
-    Fault::Measurement(controller_core::MeasurementError::NonFinite),
+    Fault::Measurement(ph_formation_core::MeasurementError::NonFinite),
     Fault::MissingBearing(0),
     Fault::Stale(0),
     Fault::MissingData(0),

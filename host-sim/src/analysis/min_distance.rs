@@ -1,6 +1,6 @@
 //! The closest pair of agents, in expected linear time.
 
-use controller_core::Vec2;
+use ph_formation_core::Vec2;
 use rayon::prelude::*;
 
 /// Exact minimum pairwise distance on a uniform grid: agents are keyed by their cell

@@ -6,7 +6,7 @@ use super::outcome::{Event, Outcome};
 use super::snapshot::{Diagnostics, Snapshot};
 use super::steady::{schedule_integral, Instant, Series};
 use crate::model::Model;
-use controller_core::Vec2;
+use ph_formation_core::Vec2;
 use rayon::prelude::*;
 
 /// Watches the snapshots of a run for failures and keeps the run's extremes.

@@ -5,7 +5,7 @@
 use super::min_distance::MinDistance;
 use crate::model::geometry::interior_angle;
 use crate::model::{EstimateInfo, Model, TriangleModel};
-use controller_core::{energy, Vec2};
+use ph_formation_core::{energy, Vec2};
 use rayon::prelude::*;
 
 /// From this many triangles on, the per-agent, per-angle and per-estimate terms are

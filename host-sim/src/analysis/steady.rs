@@ -199,9 +199,9 @@ pub fn quantile(v: &mut [f64], p: f64) -> Option<f64> {
     Some(v[rank - 1])
 }
 
-/// `∫₀ᵗ` of a piecewise-constant schedule (`controller_core::Schedule::at`: the first
+/// `∫₀ᵗ` of a piecewise-constant schedule (`ph_formation_core::Schedule::at`: the first
 /// value before the first step).
-pub fn schedule_integral(s: &controller_core::Schedule<f64>, t: f64) -> [f64; 2] {
+pub fn schedule_integral(s: &ph_formation_core::Schedule<f64>, t: f64) -> [f64; 2] {
     let steps = s.steps.as_slice();
     let Some(first) = steps.first() else {
         return [0.0; 2];
@@ -229,7 +229,7 @@ pub fn schedule_integral(s: &controller_core::Schedule<f64>, t: f64) -> [f64; 2]
 #[cfg(test)]
 mod tests {
     use super::*;
-    use controller_core::{Schedule, ScheduleStep};
+    use ph_formation_core::{Schedule, ScheduleStep};
 
     fn series(values: &[(f64, f64)]) -> Series {
         Series {

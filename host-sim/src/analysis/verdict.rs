@@ -13,7 +13,7 @@ use super::shape_check::{folded_names, shape_check};
 use super::snapshot::Snapshot;
 use super::steady::{Quantity, Window};
 use crate::model::Model;
-use controller_core::{Fault, Vec2};
+use ph_formation_core::{Fault, Vec2};
 
 /// What the verdict found.
 #[derive(Clone, Debug, PartialEq)]

@@ -82,10 +82,10 @@ pub struct DesignArgs {
     #[arg(long, value_name = "DEG")]
     pub margin: Option<f64>,
     /// Triangles per agent at most [default: the controller's capacity].
-    #[arg(long, value_name = "K", default_value_t = controller_core::MAX_TRIANGLES)]
+    #[arg(long, value_name = "K", default_value_t = ph_formation_core::MAX_TRIANGLES)]
     pub max_triangles: usize,
     /// Neighbours per agent at most [default: the controller's capacity].
-    #[arg(long, value_name = "K", default_value_t = controller_core::MAX_NEIGHBOURS)]
+    #[arg(long, value_name = "K", default_value_t = ph_formation_core::MAX_NEIGHBOURS)]
     pub max_neighbours: usize,
     /// Scenario name (output directory `out/<name>/`) [default: the shape or file stem].
     #[arg(long)]

@@ -15,8 +15,8 @@
 use super::ExportArgs;
 use crate::exit_code;
 use crate::model::Model;
-use controller_ffi::blob::{encode_blob, PH_MAX_BLOB_LEN};
-use controller_ffi::PH_MAX_TRIANGLES;
+use ph_formation_ffi::blob::{encode_blob, PH_MAX_BLOB_LEN};
+use ph_formation_ffi::PH_MAX_TRIANGLES;
 use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -38,7 +38,7 @@ pub(super) enum ExportError {
         /// The agent's id.
         agent: String,
         /// The encoder's reason.
-        error: controller_ffi::blob::BlobError,
+        error: ph_formation_ffi::blob::BlobError,
     },
     /// `--all` without `-o DIR`.
     #[error("--all writes several files: give the directory with -o DIR")]
@@ -135,7 +135,7 @@ pub(super) fn export_command(args: &ExportArgs, quiet: bool) -> u8 {
                 e.id,
                 model.source,
                 e.blob.len(),
-                controller_ffi::blob::BLOB_VERSION,
+                ph_formation_ffi::blob::BLOB_VERSION,
                 e.triangles,
             );
         }

@@ -8,7 +8,7 @@ use crate::exit_code;
 use crate::model::VehicleModel;
 use crate::report::plot::{plot_xy, XyChart, XyLine, XyPanel, XyPoint};
 use clap::{Args, Subcommand};
-use controller_core::Vec2;
+use ph_formation_core::Vec2;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 

@@ -1,6 +1,6 @@
 //! `host-sim export --vehicle NAME`: the limits of a real vehicle, checked before a
 //! configuration is flashed. The controller's force `U` acts on the virtual mass of
-//! SPEC S1 (`controller_core::actuate`), so a force limit `max_force` asks the vehicle
+//! SPEC S1 (`ph_formation_core::actuate`), so a force limit `max_force` asks the vehicle
 //! for accelerations up to `max_force / m`, and the reference velocity `v*` is a speed
 //! it must fly. Each figure is sourced from the vehicle's firmware (docs/crazyflie.md).
 

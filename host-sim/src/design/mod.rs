@@ -12,7 +12,7 @@
 //!   which triangles are folded.
 //!
 //! ```
-//! use host_sim::design::{construct, render_scenario, DesignOptions, Generator, ScenarioOptions};
+//! use ph_formation_sim::design::{construct, render_scenario, DesignOptions, Generator, ScenarioOptions};
 //! let points = Generator::TriangularLattice { n: 10, spacing: 1.0 }.points().unwrap();
 //! let c = construct(&points, &DesignOptions::default()).unwrap();
 //! assert_eq!(c.triangles.len(), 8);

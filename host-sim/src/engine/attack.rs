@@ -18,8 +18,8 @@
 
 use super::radio::{Radio, RadioFrame};
 use crate::model::{AttackKind, AttackModel, IntegrityMode, Model};
-use controller_core::wire::{offset, quant, ANGLE_ITEM_LEN, FIXED_LEN};
-use controller_core::{crc16, Vec2, MAX_FRAME_LEN};
+use ph_formation_core::wire::{offset, quant, ANGLE_ITEM_LEN, FIXED_LEN};
+use ph_formation_core::{crc16, Vec2, MAX_FRAME_LEN};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::collections::VecDeque;

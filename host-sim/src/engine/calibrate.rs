@@ -13,7 +13,7 @@ use crate::analysis::bands::{caps, Bands, Calibration};
 use crate::analysis::steady::{Quantity, Window};
 use crate::model::shape::fit_similarity;
 use crate::model::{Mode, Model};
-use controller_core::{Schedule, Vec2};
+use ph_formation_core::{Schedule, Vec2};
 
 /// Mixed into the run's seed: the calibration draws other noise than the run.
 const SEED_MIX: u64 = 0x9E37_79B9_7F4A_7C15;

@@ -15,7 +15,7 @@ use super::stats::{ControlStats, FrameCounts};
 use crate::model::{
     resolve_estimates, BearingRate, CoreAgent, EstimateInfo, Estimator, Model, SensorModel,
 };
-use controller_core::{
+use ph_formation_core::{
     law, BearingMeasurement, Fault, LawOutput, Measurements, OwnedEstimate, StepOutput, Vec2,
 };
 
@@ -128,7 +128,7 @@ impl Rhs {
 
 impl Rhs {
     /// Agent `i`'s output at this stage, from its sensing and `evaluate`, through the
-    /// core's own [`Agent::output`](controller_core::Agent::output) (saturation, and on a
+    /// core's own [`Agent::output`](ph_formation_core::Agent::output) (saturation, and on a
     /// fault the safe command, zero for a non-finite velocity `v`), and the rates of its
     /// owned estimates into `rates` (zero on a fault: the estimates hold still).
     fn output(&mut self, i: usize, v: &Vec2<f64>, rates: &mut [f64]) -> StepOutput<f64> {

@@ -10,7 +10,7 @@
 use crate::engine::hil::{HilError, LinkStats};
 use crate::engine::radio::RadioFrame;
 use crate::model::{Model, ModelError, MT, NB};
-use controller_core::{Agent, FrameStats, Measurements, OwnedEstimate, StepOutput};
+use ph_formation_core::{Agent, FrameStats, Measurements, OwnedEstimate, StepOutput};
 
 /// The frames an agent takes in at one tick, in arrival order: what the radio delivered
 /// to it, then (direct delivery, [`crate::engine::sampled::direct_radio`]) its radio
@@ -92,7 +92,7 @@ pub trait AgentController: Send {
     fn frame_stats(&self) -> FrameStats;
 
     /// The wire ids of the agent's neighbours in its core's slot order
-    /// (`controller_core::Agent::neighbours`), if known: the simulator hands it its
+    /// (`ph_formation_core::Agent::neighbours`), if known: the simulator hands it its
     /// bearings in that order. The default (`None`) keeps the measurement order.
     fn neighbour_order(&self) -> Option<Vec<u8>> {
         None

@@ -14,7 +14,7 @@ use super::stats::{ControlStats, FrameCounts};
 
 use crate::analysis::{Diagnostics, Monitor};
 use crate::model::{geometry, EstimateInfo, Mode, Model};
-use controller_core::Vec2;
+use ph_formation_core::Vec2;
 use std::time::Instant;
 
 /// A simulation engine the driver advances: sampled or continuous.
@@ -59,7 +59,7 @@ pub trait Engine {
         None
     }
     /// What the safety policies did, per agent (empty without `[policy]`).
-    fn policy_counts(&self) -> Vec<controller_core::policy::PolicyCounts> {
+    fn policy_counts(&self) -> Vec<ph_formation_core::policy::PolicyCounts> {
         Vec::new()
     }
     /// A controller failure that ends the run (a host-in-the-loop target that stopped

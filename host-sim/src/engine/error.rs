@@ -36,16 +36,16 @@ pub enum SetupError {
     TooManyNeighbours {
         /// The largest number of triangle neighbours of an agent.
         degree: usize,
-        /// `controller_core::MAX_NEIGHBOURS`.
+        /// `ph_formation_core::MAX_NEIGHBOURS`.
         max: usize,
     },
-    /// An agent's virtual mass (`controller_core::actuate`) refused its plant's figures.
+    /// An agent's virtual mass (`ph_formation_core::actuate`) refused its plant's figures.
     #[error("agent {agent}: the vehicle's virtual mass refused its figures: {error:?}")]
     Vehicle {
         /// The agent index.
         agent: usize,
         /// What the core refused.
-        error: controller_core::actuate::ActuateError,
+        error: ph_formation_core::actuate::ActuateError,
     },
 }
 

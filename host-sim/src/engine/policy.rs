@@ -1,5 +1,5 @@
 //! The vehicles' safety policies in the simulator (`[policy]`): the core's
-//! [`controller_core::policy`], the same code the Crazyflie app runs through the C API
+//! [`ph_formation_core::policy`], the same code the Crazyflie app runs through the C API
 //! (`crazyflie-app/src/flight.c`), applied to each agent's force after its tick.
 //!
 //! * **Fly**: the controller's force, through the minimum-separation guard against its
@@ -13,10 +13,10 @@
 //! What the policies did is [`PolicyRun::counts`], per agent, on the run result
 //! ([`crate::engine::RunResult::policy`]).
 
-use controller_core::policy::{
+use ph_formation_core::policy::{
     separation_guard, Policy, PolicyAction, PolicyConfig, PolicyCounts, PolicyInputs,
 };
-use controller_core::{Status, StepOutput, Vec2};
+use ph_formation_core::{Status, StepOutput, Vec2};
 
 /// Every agent's policies.
 #[derive(Clone, Debug)]

@@ -18,8 +18,8 @@
 use super::channel::{Channel, ChannelStats};
 use crate::model::graph::Adjacency;
 use crate::model::RadioModel;
-use controller_core::wire::CrcCheck;
-use controller_core::{Vec2, MAX_FRAME_LEN};
+use ph_formation_core::wire::CrcCheck;
+use ph_formation_core::{Vec2, MAX_FRAME_LEN};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::cmp::Ordering;
@@ -35,7 +35,7 @@ const EXTERNAL: usize = u32::MAX as usize;
 /// One frame on the air: up to [`MAX_FRAME_LEN`] bytes, stored inline (no heap), with
 /// its CRC check ([`CrcCheck`], for `crc16` frames), done once when the frame is made
 /// (or corrupted) instead of once by every receiver: every copy of a broadcast carries
-/// it ([`Self::crc_check`], `controller_core::Agent::receive_checked`).
+/// it ([`Self::crc_check`], `ph_formation_core::Agent::receive_checked`).
 ///
 /// 64 bytes, aligned to 64: one cache line per frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -73,7 +73,7 @@ impl RadioFrame {
     }
 
     /// A frame of `bytes` whose CRC check its writer gave
-    /// (`controller_core::Agent::frames_checked`).
+    /// (`ph_formation_core::Agent::frames_checked`).
     pub fn checked(bytes: &[u8], crc: Option<CrcCheck>) -> Self {
         let mut f = Self::copy(bytes);
         f.crc = crc;

@@ -3,7 +3,7 @@
 
 use super::stats::FrameCounts;
 use crate::analysis::Snapshot;
-use controller_core::Vec2;
+use ph_formation_core::Vec2;
 use std::io;
 
 /// One logged instant.

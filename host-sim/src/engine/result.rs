@@ -64,7 +64,7 @@ pub struct RunResult {
     /// What the safety policies did, per agent in agent order: ticks holding, landings
     /// and the last one's reason, setpoints the separation guard changed (empty
     /// without `[policy]`; `crate::engine::policy`).
-    pub policy: Vec<controller_core::policy::PolicyCounts>,
+    pub policy: Vec<ph_formation_core::policy::PolicyCounts>,
     /// Things the user should know (ignored settings, …).
     pub warnings: Vec<String>,
     /// RK4 steps taken.

@@ -32,7 +32,7 @@ use super::stats::{ControlStats, FrameCounts, FrameReasons};
 use super::world::{Clocks, Headings, Wind};
 use crate::model::graph::Adjacency;
 use crate::model::{resolve_estimates, BearingRate, EstimateInfo, Estimator, Model};
-use controller_core::{BearingMeasurement, StepOutput, Vec2, MAX_NEIGHBOURS};
+use ph_formation_core::{BearingMeasurement, StepOutput, Vec2, MAX_NEIGHBOURS};
 use tick::{world_force, AgentSlots, AgentTick, Walk};
 
 /// Whether every frame of a tick arrives, unchanged and in sender order, at the next tick:
@@ -96,7 +96,7 @@ pub struct SampledSim<'m> {
 
 /// Frames one agent emits per tick, at most, in the standard capacity (used to
 /// preallocate; an outbox holds one tick's frames).
-const FRAMES_PER_TICK: usize = controller_core::StandardAgent::<f64>::MAX_FRAMES_PER_TICK;
+const FRAMES_PER_TICK: usize = ph_formation_core::StandardAgent::<f64>::MAX_FRAMES_PER_TICK;
 
 impl<'m> SampledSim<'m> {
     /// A sampled simulation with a [`LocalCore`](super::LocalCore) for every agent, each
@@ -580,7 +580,7 @@ impl Engine for SampledSim<'_> {
         self.stats
     }
 
-    fn policy_counts(&self) -> Vec<controller_core::policy::PolicyCounts> {
+    fn policy_counts(&self) -> Vec<ph_formation_core::policy::PolicyCounts> {
         self.policy
             .as_ref()
             .map_or_else(Vec::new, super::policy::PolicyRun::counts)

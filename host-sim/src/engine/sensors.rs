@@ -23,7 +23,7 @@ pub use source::{bearing_sensor, BearingKind, BearingSensor, World};
 
 use super::world::{stream, stream_key, Turn};
 use crate::model::SensorModel;
-use controller_core::{geometry, BearingMeasurement, Vec2};
+use ph_formation_core::{geometry, BearingMeasurement, Vec2};
 use rand::Rng;
 use rand_distr::StandardNormal;
 use rand_xoshiro::Xoshiro256PlusPlus;

@@ -1,5 +1,5 @@
 //! Bearings in the order each agent's core keeps its neighbours (its slots,
-//! `controller_core::Agent::neighbours`). A core takes bearings in slot order in one pass;
+//! `ph_formation_core::Agent::neighbours`). A core takes bearings in slot order in one pass;
 //! in any other order it searches for each one (same result, more work). The sensors
 //! measure in graph order, the order their random stream is drawn in (which fixes every
 //! noisy run's result), so the measurements are put in slot order afterwards. A designed
@@ -7,7 +7,7 @@
 //! strip's are.
 
 use crate::model::Model;
-use controller_core::{BearingMeasurement, MAX_NEIGHBOURS};
+use ph_formation_core::{BearingMeasurement, MAX_NEIGHBOURS};
 
 /// Per agent, the permutation from measurement order to slot order (empty: already in
 /// slot order, or unknown).
@@ -111,7 +111,7 @@ impl SlotOrder {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use controller_core::Vec2;
+    use ph_formation_core::Vec2;
 
     fn b(id: u8) -> BearingMeasurement<f64> {
         BearingMeasurement {

@@ -1,9 +1,9 @@
 //! Counters of a run: frames through the radio and what the controllers did.
 
-use controller_core::FrameStats;
+use ph_formation_core::FrameStats;
 
 use crate::analysis::control::WindowCounts;
-use controller_core::{Fault, Status};
+use ph_formation_core::{Fault, Status};
 
 /// Cumulative frame counters of a run (link copies; see `docs/outputs.md`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -192,7 +192,7 @@ impl ControlStats {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use controller_core::Fault;
+    use ph_formation_core::Fault;
 
     /// The window counts only outputs at or after its start, directly or through a
     /// tick's merged per-agent sums; the examples name each agent once, in order.

@@ -4,7 +4,7 @@
 //! on the order in which agents are visited or on the number of threads.
 
 use crate::model::{ClockModel, HeadingModel, Model, WindModel};
-use controller_core::Vec2;
+use ph_formation_core::Vec2;
 use rand::{Rng, RngCore, SeedableRng};
 use rand_distr::StandardNormal;
 use rand_xoshiro::{SplitMix64, Xoshiro256PlusPlus};

@@ -36,7 +36,7 @@ impl Access {
 }
 
 /// How frames are protected, the same for the whole swarm (the core's
-/// `controller_core::Integrity`).
+/// `ph_formation_core::Integrity`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum IntegrityMode {
@@ -61,12 +61,12 @@ impl IntegrityMode {
     }
 
     /// The core's value (`key`: the swarm key of `auth`).
-    pub fn core(self, key: &[u8; 16]) -> controller_core::Integrity {
+    pub fn core(self, key: &[u8; 16]) -> ph_formation_core::Integrity {
         match self {
-            IntegrityMode::Crc16 => controller_core::Integrity::Crc16,
-            IntegrityMode::Link => controller_core::Integrity::Link,
+            IntegrityMode::Crc16 => ph_formation_core::Integrity::Crc16,
+            IntegrityMode::Link => ph_formation_core::Integrity::Link,
             IntegrityMode::Auth => {
-                controller_core::Integrity::Auth(controller_core::wire::auth::SwarmKey::new(*key))
+                ph_formation_core::Integrity::Auth(ph_formation_core::wire::auth::SwarmKey::new(*key))
             }
         }
     }

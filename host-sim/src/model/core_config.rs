@@ -2,19 +2,19 @@
 //! (the host simulates `Agent<f64, MT, NB>`).
 
 use super::{AngleModel, Estimator, Model, ModelError};
-use controller_core::{
+use ph_formation_core::{
     AgentConfig, AngleConfig, BearingFilter, EstimatorMode, LeaderConfig, LeaderRole, Limits,
     Schedule, ScheduleStep, TrackerConfig, TriangleConfig,
 };
 
-/// Triangle capacity of one host agent (`MT` of `controller_core::Agent`): the core's
-/// standard capacity, stated once in `controller_core::MAX_TRIANGLES`.
-pub const MT: usize = controller_core::MAX_TRIANGLES;
-/// Neighbour capacity of one host agent (`NB` of `controller_core::Agent`): the core's
-/// `controller_core::MAX_NEIGHBOURS`.
-pub const NB: usize = controller_core::MAX_NEIGHBOURS;
+/// Triangle capacity of one host agent (`MT` of `ph_formation_core::Agent`): the core's
+/// standard capacity, stated once in `ph_formation_core::MAX_TRIANGLES`.
+pub const MT: usize = ph_formation_core::MAX_TRIANGLES;
+/// Neighbour capacity of one host agent (`NB` of `ph_formation_core::Agent`): the core's
+/// `ph_formation_core::MAX_NEIGHBOURS`.
+pub const NB: usize = ph_formation_core::MAX_NEIGHBOURS;
 /// The controller-core agent the host simulates.
-pub type CoreAgent = controller_core::Agent<f64, MT, NB>;
+pub type CoreAgent = ph_formation_core::Agent<f64, MT, NB>;
 
 impl Model {
     /// Core estimator mode.
@@ -167,9 +167,9 @@ impl Model {
     pub fn core_agent_in<const M: usize, const N: usize>(
         &self,
         i: usize,
-    ) -> Result<controller_core::Agent<f64, M, N>, ModelError> {
+    ) -> Result<ph_formation_core::Agent<f64, M, N>, ModelError> {
         let c = self.agent_config_in::<M>(i)?;
-        controller_core::Agent::new(c).map_err(|error| ModelError::CoreRefused { index: i, error })
+        ph_formation_core::Agent::new(c).map_err(|error| ModelError::CoreRefused { index: i, error })
     }
 }
 

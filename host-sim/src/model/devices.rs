@@ -1,7 +1,7 @@
 //! What the agents' sensors and radios get wrong, in SI units.
 
 use super::{BearingRate, ChannelModel};
-use controller_core::BearingFilter;
+use ph_formation_core::BearingFilter;
 
 /// Sensor imperfections, in SI units.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,7 +1,7 @@
 //! Why a model could not be turned into the agents' controller configurations (typed, so
 //! that callers can tell the cases apart; the messages are the old texts).
 
-use controller_core::ConfigError;
+use ph_formation_core::ConfigError;
 use thiserror::Error;
 
 /// Why [`super::Model`] could not configure or resolve an agent's controller.
@@ -33,7 +33,7 @@ pub enum ModelError {
     /// `comm_every` does not fit the core's `u16`.
     #[error("comm_every = {0} exceeds 65535")]
     CommEvery(usize),
-    /// `controller_core::Agent::new` refused the configuration.
+    /// `ph_formation_core::Agent::new` refused the configuration.
     #[error("controller-core refused agent index {index}: {error:?}")]
     CoreRefused {
         /// The agent index.

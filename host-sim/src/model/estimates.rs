@@ -3,7 +3,7 @@
 //! are resolved to agent indices (for the diagnostics, the CSV columns and the summary).
 
 use super::{Model, ModelError};
-use controller_core::OwnedEstimate;
+use ph_formation_core::OwnedEstimate;
 
 /// Where one owned estimate belongs (by agent index).
 #[derive(Clone, Copy, Debug, PartialEq)]

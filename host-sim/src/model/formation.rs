@@ -1,7 +1,7 @@
 //! The formation, by agent index: the agents' plants and initial states, the triangles
 //! with their controlled angles, and the leader edge.
 
-use controller_core::Schedule;
+use ph_formation_core::Schedule;
 
 /// One agent's plant and initial state.
 #[derive(Clone, Debug, PartialEq)]

@@ -39,7 +39,7 @@ pub use world::{
     ClockModel, CrazyfliePid, HeadingModel, VehicleModel, VelocityTracking, WindModel, WorldModel,
 };
 
-use controller_core::{Limits, Schedule};
+use ph_formation_core::{Limits, Schedule};
 
 /// A validated, resolved scenario.
 #[derive(Clone, Debug, PartialEq)]
@@ -100,7 +100,7 @@ pub struct Model {
     /// The robot's world: vehicle, wind, headings, clocks (`docs/world.md`).
     pub world: WorldModel,
     /// The vehicles' safety policies (`[policy]`; `None`: none run).
-    pub policy: Option<controller_core::policy::PolicyConfig<f64>>,
+    pub policy: Option<ph_formation_core::policy::PolicyConfig<f64>>,
 }
 
 impl Model {

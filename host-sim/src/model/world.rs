@@ -9,7 +9,7 @@ pub enum VehicleModel {
     PointMass,
     /// A vehicle whose own controller tracks a velocity setpoint (a Crazyflie in
     /// position/velocity mode, a rover's wheel controller); the agent's force becomes the
-    /// setpoint through the virtual mass of `controller_core::actuate`.
+    /// setpoint through the virtual mass of `ph_formation_core::actuate`.
     VelocityTracking(VelocityTracking),
     /// A Crazyflie 2.x flying its firmware's PID cascade in velocity mode
     /// (`engine::plant::CrazyfliePidPlant`); the agent's force becomes the setpoint as for

@@ -136,7 +136,7 @@ pub fn summary_json(model: &Model, r: &RunResult, estimates: &[EstimateInfo]) ->
         // Only when they apply, so that a noise-free run's summary is what it always was
         // (but for `verdict` and `pose`).
         super::verdict::add_json(obj, model, r);
-        if let controller_core::BearingFilter::Tracker(t) = &model.sensors.bearing_filter {
+        if let ph_formation_core::BearingFilter::Tracker(t) = &model.sensors.bearing_filter {
             obj.insert(
                 "bearing_filter".to_owned(),
                 json!({

@@ -233,7 +233,7 @@ pub struct TrackerSpec {
 
 impl Default for TrackerSpec {
     fn default() -> Self {
-        let c = controller_core::TrackerConfig::<f64>::default();
+        let c = ph_formation_core::TrackerConfig::<f64>::default();
         Self {
             bearing_noise_deg: None,
             rate_noise: c.rate_noise,

@@ -13,7 +13,7 @@ use crate::model::graph::{strip_triangles, Graph};
 use crate::model::{AgentModel, AngleModel, Model, RadioModel, SensorModel, TriangleModel};
 use crate::model::{BearingRate, Criteria, Estimator, IntegrityMode, Mode, Target};
 use crate::scenario::{check_model, ScenarioErrors};
-use controller_core::{Limits, Schedule};
+use ph_formation_core::{Limits, Schedule};
 
 /// A strip of `n ≥ 3` agents, printed-paper gains (c = 10, d = 1, c_e = 10), desired
 /// angles 60°, initial positions perturbed from the equilateral strip, no maneuvers;

@@ -240,7 +240,7 @@ fn check(src: &SweepSource, f: SweepFile, runs: Option<u64>) -> Result<Plan, Swe
 fn resolve_base(src: &SweepSource, f: &SweepFile) -> Result<Base, SweepError> {
     let file = src.label.as_str();
     if f.base.design.is_some() {
-        // The hook for a design generator as the base: `host_sim::design` renders a
+        // The hook for a design generator as the base: `ph_formation_sim::design` renders a
         // scenario's TOML from a generator; the sweep would take that text here.
         return Err(SweepError::new(
             SCHEMA,

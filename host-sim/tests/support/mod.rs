@@ -1,8 +1,8 @@
 //! Helpers shared by the integration tests of bearing sensors (`camera.rs`,
 //! `shared_positions.rs`).
 
-use host_sim::engine::{Engine, SampledSim};
-use host_sim::model::Model;
+use ph_formation_sim::engine::{Engine, SampledSim};
+use ph_formation_sim::model::Model;
 
 /// The bits of positions, velocities and estimates after `ticks` ticks of `m` on
 /// `threads` threads.

@@ -5,7 +5,7 @@ use super::*;
 #[test]
 fn command_line_runs_a_sweep_and_refuses_a_bad_one() {
     use clap::Parser;
-    use host_sim::cli::{Cli, Command};
+    use ph_formation_sim::cli::{Cli, Command};
     let cli = Cli::try_parse_from(["host-sim", "sweep", "merge", "--out", "m", "a", "b"]).unwrap();
     assert!(matches!(cli.command, Some(Command::Sweep(_))));
     let cli = Cli::try_parse_from(["host-sim", "sweep", "basin", "--shard", "2/3"]).unwrap();

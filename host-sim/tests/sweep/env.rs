@@ -2,7 +2,7 @@
 //! variables; a missing or inconsistent variable is an error, never shard 1.
 
 use super::*;
-use host_sim::sweep::ShardError;
+use ph_formation_sim::sweep::ShardError;
 
 fn auto(shards: Option<u64>, vars: &[(&str, &str)]) -> Result<Shard, ShardError> {
     Shard::from_env(shards, |name| {

@@ -172,7 +172,7 @@ fn command_line_overrides_join_the_base_and_the_fingerprint() {
 #[test]
 fn a_base_scenario_file_is_found_next_to_the_sweep_file() {
     let tmp = tempfile::tempdir().unwrap();
-    let text = host_sim::BUILTINS
+    let text = ph_formation_sim::BUILTINS
         .iter()
         .find(|b| b.name == "formation-only")
         .unwrap()

@@ -316,7 +316,7 @@ fn more_stretches_than_open_files_are_merged_in_passes() {
     let line = |r: u64| format!("0,{r},{tail}\n");
     let down: String = (0..300).rev().map(line).collect();
     std::fs::write(dir.join("runs.csv"), format!("{header}\n{down}")).unwrap();
-    const { assert!(300 > host_sim::sweep::journal::FAN_IN) };
+    const { assert!(300 > ph_formation_sim::sweep::journal::FAN_IN) };
     let r = resume(&dir, &[]);
     assert_eq!(code(&r), Some(0), "{}", String::from_utf8_lossy(&r.stderr));
     let up: String = (0..300).map(line).collect();
@@ -344,11 +344,11 @@ fn a_huge_sweep_is_refused_before_it_allocates() {
     // One run more than the limit allows in time, one less passes (the estimate is
     // linear in the runs).
     let p = Plan::load("basin", Some(100_000_000)).unwrap();
-    let e = host_sim::sweep::estimate(&p, Shard::ALL, 2);
+    let e = ph_formation_sim::sweep::estimate(&p, Shard::ALL, 2);
     assert_eq!(e.runs, 600_000_000);
     assert!(e.check("basin").is_err());
     let small = Plan::load("basin", Some(100)).unwrap();
-    assert!(host_sim::sweep::estimate(&small, Shard::ALL, 2)
+    assert!(ph_formation_sim::sweep::estimate(&small, Shard::ALL, 2)
         .check("basin")
         .is_ok());
 }

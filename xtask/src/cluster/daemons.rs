@@ -105,7 +105,7 @@ impl Cluster {
     pub fn submit(
         &self,
         script: &Path,
-        host_sim: &Path,
+        ph_formation_sim: &Path,
         sweep: &Path,
         shards: &Path,
         array: &str,
@@ -116,7 +116,7 @@ impl Cluster {
         c.args(["--parsable", &format!("--array={array}")])
             .arg(format!("--chdir={}", dir.display()))
             .arg(script)
-            .env("HOST_SIM", host_sim)
+            .env("HOST_SIM", ph_formation_sim)
             .env("SWEEP", sweep)
             .env("SHARDS", shards);
         match shards_n {

@@ -266,14 +266,14 @@ fn qemu_tests(c: &mut Checker, peaks: &mut BTreeMap<&str, u64>, out: &Path) -> R
 /// The host simulator's `paper` run that `demo_matches_host_sim` compares the demo with
 /// (its `summary.json`, passed as `PH_HOST_SIM_SUMMARY`): run by the dev binary `cargo
 /// test` built ([`tools::host_sim_dev`]) rather than by the test's own `cargo run
-/// --release -p host-sim`, a release build (fat LTO) of the simulator and its
+/// --release -p ph-formation-sim`, a release build (fat LTO) of the simulator and its
 /// dependencies for a run of about a second. The same code and the same `f64` results.
 fn host_sim_paper(out: &Path) -> Result<PathBuf, String> {
-    let host_sim = tools::host_sim_dev()?;
+    let ph_formation_sim = tools::host_sim_dev()?;
     let dir = out.join("host-sim-paper");
     let _ = std::fs::remove_dir_all(&dir);
     tools::run(
-        std::process::Command::new(host_sim)
+        std::process::Command::new(ph_formation_sim)
             .args(["run", "paper", "--quiet", "--no-plots", "--out"])
             .arg(&dir),
     )?;

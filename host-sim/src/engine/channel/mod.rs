@@ -31,7 +31,7 @@ use super::radio::RadioFrame;
 use crate::model::graph::Adjacency;
 use crate::model::{Access, ChannelModel};
 use age::Ages;
-use controller_core::{Vec2, MAX_FRAME_LEN};
+use ph_formation_core::{Vec2, MAX_FRAME_LEN};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

@@ -4,7 +4,7 @@ use crate::engine::channel::ChannelStats;
 use crate::engine::radio::{Radio, RadioFrame, RadioStats};
 use crate::model::graph::{strip_triangles, Adjacency, Graph};
 use crate::model::{Access, ChannelModel, RadioModel};
-use controller_core::Vec2;
+use ph_formation_core::Vec2;
 
 const PERIOD: f64 = 0.01;
 
@@ -19,7 +19,7 @@ fn channel(access: Access, bit_rate: f64) -> ChannelModel {
         aloha_window: PERIOD,
         slot: 0.0,
     };
-    c.slot = c.turnaround + c.air_time(controller_core::MAX_FRAME_LEN);
+    c.slot = c.turnaround + c.air_time(ph_formation_core::MAX_FRAME_LEN);
     c
 }
 

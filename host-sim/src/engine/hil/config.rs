@@ -5,7 +5,7 @@ use super::error::HilError;
 use super::link::TARGET_MT;
 use super::options::TARGET_NB;
 use crate::model::Model;
-use controller_core::{Agent, AgentConfig};
+use ph_formation_core::{Agent, AgentConfig};
 
 /// Agent `i`'s configuration for the firmware: the host's `AgentConfig<f64, 8>` (built as
 /// for every simulated agent) rounded to `f32`, checked against the firmware's capacity

@@ -8,8 +8,8 @@
 //! protocol: the port sees every message the session writes (one COBS frame per write)
 //! and counts the `Output`s to know which tick an answer belongs to.
 
-use controller_core::link::{TargetMsg, LINK_VERSION, MAX_LINK_MSG};
-use controller_core::wire::{cobs_decode, cobs_encode};
+use ph_formation_core::link::{TargetMsg, LINK_VERSION, MAX_LINK_MSG};
+use ph_formation_core::wire::{cobs_decode, cobs_encode};
 use firmware_example::boards::uart::{self, Event, SerialPort, Session};
 use std::io::{BufReader, Read, Write};
 use std::net::TcpStream;
@@ -70,7 +70,7 @@ pub fn serve(stream: TcpStream, behaviour: FakeBehaviour) -> std::io::Result<()>
 fn closed_line_message() -> Vec<u8> {
     let mut raw = [0u8; MAX_LINK_MSG];
     let mut out = vec![0u8; MAX_LINK_MSG + 4];
-    let msg = controller_core::link::HostMsg::<{ uart::MT }>::Finish;
+    let msg = ph_formation_core::link::HostMsg::<{ uart::MT }>::Finish;
     let n = postcard::to_slice(&msg, &mut raw).map_or(0, |b| b.len());
     let n = raw
         .get(..n)

@@ -3,7 +3,7 @@
 //! simulates the plant, the sensors, the radio and the other agents (`docs/hil.md`).
 //!
 //! * One QEMU per emulated agent; its USART1 is a TCP connection on loopback carrying the
-//!   lock-step protocol of [`controller_core::link`] (postcard messages, one per COBS
+//!   lock-step protocol of [`ph_formation_core::link`] (postcard messages, one per COBS
 //!   frame): `Configure` → `Ready` once, then per tick `Radio`* + `Step` →
 //!   `Radio`* [+ `Estimates`] + `Output`, and `Finish` → `Finished` at the end.
 //! * Lock-step: the simulator integrates past a control instant only after every
@@ -113,7 +113,7 @@ fn launch(
 /// agent of the same configuration: the estimate layout, its frame slots and the
 /// neighbour slots (wire ids).
 type TargetOrder = (
-    Vec<controller_core::OwnedEstimate<f64>>,
+    Vec<ph_formation_core::OwnedEstimate<f64>>,
     Vec<EstimateSlot>,
     Vec<u8>,
 );

@@ -24,8 +24,8 @@
 use super::{Held, Plant};
 use crate::engine::error::SetupError;
 use crate::model::{CrazyfliePid, Model};
-use controller_core::actuate::{VelocityCommand, VirtualMass};
-use controller_core::Vec2;
+use ph_formation_core::actuate::{VelocityCommand, VirtualMass};
+use ph_formation_core::Vec2;
 
 /// Standard gravity (m/s²).
 const G: f64 = 9.806_65;

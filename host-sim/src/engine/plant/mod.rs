@@ -17,7 +17,7 @@ pub use velocity_tracking::{tracking_acceleration, VelocityTrackingPlant};
 
 use super::error::SetupError;
 use crate::model::{Model, VehicleModel};
-use controller_core::Vec2;
+use ph_formation_core::Vec2;
 
 /// What the plant holds between ticks: every agent's last force (N, world frame) and
 /// the wind's acceleration on it (m/s²; empty: no wind).
@@ -71,7 +71,7 @@ pub fn new_plant(model: &Model) -> Result<Box<dyn Plant>, SetupError> {
 /// (`command`, SPEC S20 with the leads of S21/S21b) integrates S1 over `period` under
 /// `force` from the vehicle's velocity `v`. The one implementation both such plants call.
 pub(crate) fn command_setpoint(
-    command: &mut [controller_core::actuate::VelocityCommand<f64>],
+    command: &mut [ph_formation_core::actuate::VelocityCommand<f64>],
     v: &[Vec2<f64>],
     setpoint: &mut [Vec2<f64>],
     i: usize,

@@ -4,7 +4,7 @@
 
 use super::{Held, Plant};
 use crate::model::Model;
-use controller_core::Vec2;
+use ph_formation_core::Vec2;
 use rayon::prelude::*;
 
 /// Positions and velocities of all agents, with their masses and friction.

@@ -6,14 +6,14 @@
 //! (first order with time constant `τ`, the acceleration limited in norm to `a_max`, the
 //! wind `a_w` acting on top: a proportional velocity loop leaves a steady error `τ a_w`).
 //! At each of its ticks the agent's force `U` becomes the setpoint through the virtual
-//! mass of SPEC S20 with the lead of S21 (`controller_core::actuate::VelocityCommand`,
+//! mass of SPEC S20 with the lead of S21 (`ph_formation_core::actuate::VelocityCommand`,
 //! the same code the Crazyflie app calls through `ph_actuate`), limited to `v_max`.
 
 use super::{Held, Plant};
 use crate::engine::error::SetupError;
 use crate::model::{Model, VelocityTracking};
-use controller_core::actuate::{VelocityCommand, VirtualMass};
-use controller_core::Vec2;
+use ph_formation_core::actuate::{VelocityCommand, VirtualMass};
+use ph_formation_core::Vec2;
 
 /// Every agent's velocity-tracking vehicle.
 #[derive(Clone, Debug)]

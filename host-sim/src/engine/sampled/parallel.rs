@@ -12,7 +12,7 @@ use crate::engine::controller::AgentController;
 use crate::engine::radio::RadioFrame;
 use crate::engine::speed::CHUNK;
 use crate::engine::stats::ControlStats;
-use controller_core::Vec2;
+use ph_formation_core::Vec2;
 
 /// What the parallel walk of a tick sums over the agents (in agent order).
 #[derive(Clone, Copy, Debug, Default)]

@@ -11,7 +11,7 @@ use crate::engine::slot_order::SlotOrder;
 use crate::engine::speed::prefetch::{self, Footprint};
 use crate::engine::world::Headings;
 use crate::model::graph::Adjacency;
-use controller_core::{BearingMeasurement, Measurements, StepOutput, Vec2, MAX_NEIGHBOURS};
+use ph_formation_core::{BearingMeasurement, Measurements, StepOutput, Vec2, MAX_NEIGHBOURS};
 
 /// When one agent ticks: its clock's reading, the time since its previous tick by its
 /// clock, and the index of its tick (of its random streams).

@@ -25,7 +25,7 @@ use super::occlusion::Occluders;
 use super::source::{BearingKind, BearingSensor, World};
 use super::{Draws, Sight};
 use crate::model::CameraModel;
-use controller_core::{BearingMeasurement, Vec2};
+use ph_formation_core::{BearingMeasurement, Vec2};
 use std::f64::consts::TAU;
 
 /// Every agent's camera and what it keeps between ticks.

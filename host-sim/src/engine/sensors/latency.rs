@@ -11,7 +11,7 @@
 //! taken to have stood still before the run).
 
 use super::source::World;
-use controller_core::Vec2;
+use ph_formation_core::Vec2;
 use std::f64::consts::{PI, TAU};
 
 /// The state of the last control ticks and the delayed image.

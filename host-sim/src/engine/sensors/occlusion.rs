@@ -9,7 +9,7 @@
 //! segment): a tick's occlusion tests cost about linear time in `N` for a formation whose
 //! neighbours are near each other.
 
-use controller_core::Vec2;
+use ph_formation_core::Vec2;
 use rstar::primitives::GeomWithData;
 use rstar::{RTree, AABB};
 

@@ -35,7 +35,7 @@ use super::source::{BearingKind, BearingSensor, World};
 use super::{Draws, Sensors, Sight};
 use crate::engine::radio::RadioFrame;
 use crate::model::{Model, PositionsModel};
-use controller_core::{BearingMeasurement, Vec2};
+use ph_formation_core::{BearingMeasurement, Vec2};
 
 /// The first byte of a position packet: its layout version (formation.h's
 /// `FORMATION_POSITION_VERSION`).
@@ -131,7 +131,7 @@ impl SharedPositions {
 
     /// Agent `i`'s position packet of this tick (its estimate, tagged with its id).
     pub fn packet(&self, i: usize) -> RadioFrame {
-        let mut bytes = [0u8; controller_core::MAX_FRAME_LEN];
+        let mut bytes = [0u8; ph_formation_core::MAX_FRAME_LEN];
         let p = self.own.get(i).copied().unwrap_or_else(Vec2::zeros);
         bytes[0] = POSITION_VERSION;
         bytes[1] = self.ids.get(i).copied().unwrap_or(0);
@@ -185,7 +185,7 @@ impl BearingSensor for SharedPositions {
     ) -> Option<BearingMeasurement<f64>> {
         let other = self.fresh(i, j)?;
         // Coincident positions give no bearing: the core's one rule, as the app's.
-        if (other - self.own[i]).norm() < controller_core::policy::COINCIDENT {
+        if (other - self.own[i]).norm() < ph_formation_core::policy::COINCIDENT {
             return None;
         }
         let sight = Sight {

@@ -25,7 +25,7 @@ use super::camera::Camera;
 use super::shared_positions::SharedPositions;
 use super::Draws;
 use crate::model::Model;
-use controller_core::{BearingMeasurement, Vec2};
+use ph_formation_core::{BearingMeasurement, Vec2};
 
 /// The true state of every agent at a control tick, as a bearing sensor reads it (world
 /// frame).

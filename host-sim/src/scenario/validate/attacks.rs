@@ -5,7 +5,7 @@ use super::checker::Checker;
 use crate::model::{AttackKind, AttackModel};
 use crate::scenario::error::ErrorKind::InvalidValue;
 use crate::scenario::ScenarioFile;
-use controller_core::MAX_FRAME_LEN;
+use ph_formation_core::MAX_FRAME_LEN;
 use std::collections::HashMap;
 
 /// Checks every attacker; returns those that resolved.

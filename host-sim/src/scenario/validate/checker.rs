@@ -2,7 +2,7 @@
 
 use crate::scenario::error::{ErrorKind, ScenarioError};
 use crate::scenario::ScheduleSpec;
-use controller_core::{Schedule, ScheduleStep, MAX_SCHEDULE_STEPS};
+use ph_formation_core::{Schedule, ScheduleStep, MAX_SCHEDULE_STEPS};
 
 /// Collects errors while checking.
 pub(super) struct Checker<'a> {

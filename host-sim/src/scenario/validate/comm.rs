@@ -6,7 +6,7 @@ use crate::model::channel::{CRAZYFLIE_BIT_RATE, CRAZYFLIE_OVERHEAD_BYTES, CRAZYF
 use crate::model::{Access, ChannelModel, IntegrityMode};
 use crate::scenario::error::ErrorKind::InvalidValue;
 use crate::scenario::ScenarioFile;
-use controller_core::MAX_FRAME_LEN;
+use ph_formation_core::MAX_FRAME_LEN;
 
 /// Ticks per broadcast from `controller.comm_rate_hz` (1 when absent or invalid).
 pub(super) fn comm_every(c: &mut Checker<'_>, s: &ScenarioFile, period: f64) -> usize {

@@ -149,7 +149,7 @@ fn unattached(
 }
 
 /// Checks every agent's triangles and radio neighbours against the controller's
-/// capacity (`MT`, `NB`: `controller_core::{MAX_TRIANGLES, MAX_NEIGHBOURS}`).
+/// capacity (`MT`, `NB`: `ph_formation_core::{MAX_TRIANGLES, MAX_NEIGHBOURS}`).
 pub(super) fn capacity(c: &mut Checker<'_>, agents: &[AgentModel], graph: &Graph) {
     let id_of = |i: usize| agent_id(agents, i);
     for i in 0..agents.len() {
@@ -160,7 +160,7 @@ pub(super) fn capacity(c: &mut Checker<'_>, agents: &[AgentModel], graph: &Graph
                 InvalidValue,
                 &format!("agents[{i}]"),
                 format!(
-                    "agent {} belongs to {} triangles ({}); the controller holds at most {MT} (controller_core::MAX_TRIANGLES): move {} of them to other agents, e.g. regenerate with `host-sim design`",
+                    "agent {} belongs to {} triangles ({}); the controller holds at most {MT} (ph_formation_core::MAX_TRIANGLES): move {} of them to other agents, e.g. regenerate with `host-sim design`",
                     id_of(i),
                     tris.len(),
                     shown.join(", "),
@@ -175,7 +175,7 @@ pub(super) fn capacity(c: &mut Checker<'_>, agents: &[AgentModel], graph: &Graph
                 InvalidValue,
                 &format!("agents[{i}]"),
                 format!(
-                    "agent {} has {} neighbours ({}); the controller holds at most {NB} (controller_core::MAX_NEIGHBOURS): remove triangles through it so that it has {} fewer",
+                    "agent {} has {} neighbours ({}); the controller holds at most {NB} (ph_formation_core::MAX_NEIGHBOURS): remove triangles through it so that it has {} fewer",
                     id_of(i),
                     nb.len(),
                     shown.join(", "),

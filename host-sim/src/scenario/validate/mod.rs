@@ -22,7 +22,7 @@ use crate::model::{Graph, Model, RadioModel, SensorModel};
 use crate::scenario::error::ScenarioErrors;
 use crate::scenario::ScenarioFile;
 use checker::Checker;
-use controller_core::{BearingFilter, Limits, TrackerConfig};
+use ph_formation_core::{BearingFilter, Limits, TrackerConfig};
 pub use model::check_model;
 
 /// Validates a parsed scenario file. `file` labels errors; `default_name` is used when the

@@ -8,7 +8,7 @@
 //!
 //! A frame names its sender by a one-byte id, and its angle items name the triangle's
 //! other vertices by their ids. A receiver looks its neighbours up by id in its own table
-//! (`controller_core`), so it must tell apart itself and every agent it hears, and the
+//! (`ph_formation_core`), so it must tell apart itself and every agent it hears, and the
 //! agents that a neighbour's frames name: ids must differ between any two agents within
 //! two hops of the radio graph (neighbours, or neighbours of one agent). Farther apart an
 //! id may repeat, which is how formations of more than 256 agents get their ids

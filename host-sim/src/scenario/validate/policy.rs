@@ -4,7 +4,7 @@ use super::checker::Checker;
 use crate::model::Mode;
 use crate::scenario::error::ErrorKind::InvalidValue;
 use crate::scenario::ScenarioFile;
-use controller_core::policy::PolicyConfig;
+use ph_formation_core::policy::PolicyConfig;
 
 /// The policies of `s`, if it has a `[policy]` table.
 pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile) -> Option<PolicyConfig<f64>> {

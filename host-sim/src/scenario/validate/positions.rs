@@ -7,7 +7,7 @@ use crate::model::{BearingRate, Mode, PositionsModel};
 use crate::scenario::error::ErrorKind::InvalidValue;
 use crate::scenario::settings::BearingSource;
 use crate::scenario::ScenarioFile;
-use controller_core::MAX_FRAME_LEN;
+use ph_formation_core::MAX_FRAME_LEN;
 
 /// The position packet's own bytes: layout version, sender id, `x` and `y` as `f32`
 /// (docs/core.md "Position packets").

@@ -20,7 +20,7 @@ pub(super) struct Timing {
 }
 
 /// The largest bearing noise a scenario may declare (degrees): 0.5 rad, the tracker's
-/// limit ([`controller_core::TrackerConfig::is_valid`]).
+/// limit ([`ph_formation_core::TrackerConfig::is_valid`]).
 pub(super) const MAX_BEARING_NOISE_DEG: f64 = 28.0;
 
 /// `[sensors.tracker]`: each setting in the range the core accepts.

@@ -12,8 +12,8 @@ pub use tick::step_output;
 
 use super::link::{Link, LinkCounters, RecvError, TARGET_MT};
 use super::{HilError, LinkStats, When};
-use controller_core::link::{HostMsg, LinkError, TargetMsg, LINK_VERSION};
-use controller_core::{AgentConfig, EstimatorMode, Integrity, OwnedEstimate};
+use ph_formation_core::link::{HostMsg, LinkError, TargetMsg, LINK_VERSION};
+use ph_formation_core::{AgentConfig, EstimatorMode, Integrity, OwnedEstimate};
 use std::time::{Duration, Instant};
 
 /// Where one owned estimate of the HIL agent sits: its frame item `(far, other)` ids and
@@ -181,7 +181,7 @@ impl HilController {
     }
 
     /// The target's neighbour slots in order (wire ids, as
-    /// `controller_core::Agent::neighbours` gives them for its configuration): the
+    /// `ph_formation_core::Agent::neighbours` gives them for its configuration): the
     /// simulator then sends the bearings in that order, the one the target's core takes
     /// in one pass.
     pub fn with_neighbour_order(mut self, order: Vec<u8>) -> Self {

@@ -6,9 +6,9 @@ use super::{HilController, TargetHandle};
 use crate::engine::controller::{AgentController, Inbox};
 use crate::engine::hil::{HilError, LinkStats, When};
 use crate::engine::radio::RadioFrame;
-use controller_core::link::{HostMsg, LinkBearing, LinkError, LinkOutput, LinkStep, TargetMsg};
-use controller_core::wire::decode_frame;
-use controller_core::{Fault, FrameStats, Measurements, OwnedEstimate, Status, StepOutput, Vec2};
+use ph_formation_core::link::{HostMsg, LinkBearing, LinkError, LinkOutput, LinkStep, TargetMsg};
+use ph_formation_core::wire::decode_frame;
+use ph_formation_core::{Fault, FrameStats, Measurements, OwnedEstimate, Status, StepOutput, Vec2};
 use std::time::{Duration, Instant};
 
 impl HilController {
