@@ -233,7 +233,10 @@ fn the_finite_difference_holds_a_missing_bearing_and_its_rate_until_the_hold() {
 #[test]
 fn without_a_hold_a_bearing_missing_for_one_tick_is_missing() {
     // The default (0): what the agent did before the hold existed.
-    assert_eq!(ph_formation_core::Limits::<f64>::default().bearing_hold, 0.0);
+    assert_eq!(
+        ph_formation_core::Limits::<f64>::default().bearing_hold,
+        0.0
+    );
     for filter in [
         BearingFilter::FiniteDifference,
         BearingFilter::Tracker(TrackerConfig::default()),

@@ -2,8 +2,8 @@
 
 mod testkit;
 
-use ph_formation_core::Vec2;
 use nalgebra::Rotation2;
+use ph_formation_core::Vec2;
 use rand::Rng;
 use testkit::{rng, sense_and_exchange, strip, strip_positions, Formation, HostAgent, State};
 

@@ -520,7 +520,9 @@ proptest! {
 
 #[test]
 fn link_messages_round_trip_within_their_size_limit() {
-    use ph_formation_core::link::{HostMsg, LinkBearing, LinkStep, MAX_LINK_BEARINGS, MAX_LINK_MSG};
+    use ph_formation_core::link::{
+        HostMsg, LinkBearing, LinkStep, MAX_LINK_BEARINGS, MAX_LINK_MSG,
+    };
     // The largest configuration the HIL link carries: 4 triangles, leader, schedules full.
     let mut r = rng(1);
     let f = Formation::random(6, fan(4), &fan_positions(4, 0.1, &mut r), &mut r);

@@ -31,7 +31,6 @@ mod firmware {
     use super::{CLOCK_HZ, CONTROL_HZ, RUN_TICKS};
     use core::ops::ControlFlow;
 
-    use ph_formation_core::{Agent, Integrity};
     use cortex_m_rt::entry;
     use firmware_example::app::{run_agent, Board};
     use firmware_example::paper;
@@ -39,6 +38,7 @@ mod firmware {
         FixedBearings, FixedVelocity, LoopbackRadio, PollClock, RecordingActuator,
     };
     use firmware_example::{keys, rt, stack};
+    use ph_formation_core::{Agent, Integrity};
 
     #[entry]
     fn main() -> ! {

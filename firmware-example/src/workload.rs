@@ -33,12 +33,12 @@
 //! The bench then holds the centre's state, the frames its neighbours
 //! broadcast in the measured tick and its own measurements.
 
+use heapless::Vec;
 use ph_formation_core::{
     Agent, AgentConfig, AgentId, AngleConfig, BearingMeasurement, ConfigError, Integrity,
     LeaderConfig, LeaderRole, Measurements, Real, Schedule, Status, StepOutput, TriangleConfig,
     Vec2,
 };
-use heapless::Vec;
 
 use crate::hal::MAX_FRAME_LEN;
 

@@ -190,7 +190,10 @@ impl Formation {
     }
 
     /// The configuration of agent index `i` (scalar `T`).
-    pub fn config<T: ph_formation_core::Real>(&self, i: usize) -> ph_formation_core::StandardConfig<T> {
+    pub fn config<T: ph_formation_core::Real>(
+        &self,
+        i: usize,
+    ) -> ph_formation_core::StandardConfig<T> {
         let t = |x: f64| T::lit(x);
         let mut c = AgentConfig::new(id(i));
         c.estimator = self.mode;

@@ -39,11 +39,11 @@ pub const REPEATS: u32 = 3;
 #[cfg(target_os = "none")]
 mod firmware {
     use super::REPEATS;
-    use ph_formation_core::StepOutput;
     use cortex_m_rt::entry;
     use firmware_example::measure::{self, MAX_REGIONS};
     use firmware_example::workload::{Bench, StepConfig, StepCtx, StepResult, STEP_CONFIGS};
     use firmware_example::{rt, stack};
+    use ph_formation_core::StepOutput;
 
     /// Region id of the empty calibration region (marker overhead only).
     const OVERHEAD_ID: u8 = 0;

@@ -47,11 +47,11 @@ pub const LOG_EVERY_S: u32 = 5;
 #[cfg(target_os = "none")]
 mod firmware {
     use super::{ANGLE_TOL, LEADER_TOL, LOG_EVERY_S, MAX_TIME, VELOCITY_TOL};
-    use ph_formation_core::Agent;
     use cortex_m_rt::entry;
     use firmware_example::app::ControlLoop;
     use firmware_example::boards::demo::{Metrics, World, CONTROL_HZ, N};
     use firmware_example::{paper, rt, stack};
+    use ph_formation_core::Agent;
 
     /// The agents of the demo: 2 triangles, 4 neighbours at most.
     type DemoLoop = ControlLoop<2, 4>;

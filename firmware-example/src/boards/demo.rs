@@ -21,8 +21,8 @@
 //! Each robot runs its own `controller-core` agent through the generic
 //! [`ControlLoop`] at [`CONTROL_HZ`].
 
-use ph_formation_core::Real;
 use heapless::{Deque, Vec};
+use ph_formation_core::Real;
 
 use crate::app::{Board, ControlLoop, TickReport};
 use crate::hal::{

@@ -36,12 +36,12 @@
 //! `Usart1` (MCU builds only) is the STM32F4 USART1, polled, sleeping in
 //! `wfi` while it waits for a byte.
 
+use heapless::Deque;
 use ph_formation_core::link::{
     link_estimates, HostMsg, LinkError, LinkOutput, LinkStep, TargetMsg, LINK_VERSION, MAX_LINK_MSG,
 };
 use ph_formation_core::wire::{cobs_encode, CobsAccumulator};
 use ph_formation_core::{Agent, AgentId};
-use heapless::Deque;
 
 use crate::app::{Board, ControlLoop, TickReport};
 use crate::hal::{

@@ -65,9 +65,9 @@ impl IntegrityMode {
         match self {
             IntegrityMode::Crc16 => ph_formation_core::Integrity::Crc16,
             IntegrityMode::Link => ph_formation_core::Integrity::Link,
-            IntegrityMode::Auth => {
-                ph_formation_core::Integrity::Auth(ph_formation_core::wire::auth::SwarmKey::new(*key))
-            }
+            IntegrityMode::Auth => ph_formation_core::Integrity::Auth(
+                ph_formation_core::wire::auth::SwarmKey::new(*key),
+            ),
         }
     }
 }

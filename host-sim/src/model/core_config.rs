@@ -169,7 +169,8 @@ impl Model {
         i: usize,
     ) -> Result<ph_formation_core::Agent<f64, M, N>, ModelError> {
         let c = self.agent_config_in::<M>(i)?;
-        ph_formation_core::Agent::new(c).map_err(|error| ModelError::CoreRefused { index: i, error })
+        ph_formation_core::Agent::new(c)
+            .map_err(|error| ModelError::CoreRefused { index: i, error })
     }
 }
 

@@ -22,8 +22,8 @@ use crate::model::{Graph, Model, RadioModel, SensorModel};
 use crate::scenario::error::ScenarioErrors;
 use crate::scenario::ScenarioFile;
 use checker::Checker;
-use ph_formation_core::{BearingFilter, Limits, TrackerConfig};
 pub use model::check_model;
+use ph_formation_core::{BearingFilter, Limits, TrackerConfig};
 
 /// Validates a parsed scenario file. `file` labels errors; `default_name` is used when the
 /// file has no `name`.
