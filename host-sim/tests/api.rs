@@ -81,7 +81,10 @@ fn a_failed_run_is_an_outcome_and_an_unwritable_directory_an_error() {
     let file = dir.path().join("a-file");
     std::fs::write(&file, "").expect("write");
     let e = Simulation::new(&m)
-        .write_to(file.join("sub"), ph_formation_sim::WriteOptions::without_plots())
+        .write_to(
+            file.join("sub"),
+            ph_formation_sim::WriteOptions::without_plots(),
+        )
         .run()
         .expect_err("not a directory");
     assert!(matches!(e, Error::Output(_)), "{e:?}");

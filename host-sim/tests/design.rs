@@ -26,7 +26,8 @@ fn check(p: &[Point], c: &Construction, opts: &DesignOptions, what: &str) {
     assert_eq!(c.triangles.len(), n - 2, "{what}: M = N − 2");
     let tris: Vec<[usize; 3]> = c.triangles.iter().map(|t| t.vertices).collect();
     // The scenario loader's own triangulated-Laman check (SPEC §3).
-    ph_formation_sim::model::graph::laman_order(n, &tris).unwrap_or_else(|e| panic!("{what}: {e:?}"));
+    ph_formation_sim::model::graph::laman_order(n, &tris)
+        .unwrap_or_else(|e| panic!("{what}: {e:?}"));
     let margin = opts.margin_deg.to_radians();
     let mut per_agent = vec![0usize; n];
     for t in &c.triangles {
@@ -496,7 +497,10 @@ fn points_files() {
     )
     .unwrap();
     std::fs::write(&toml_path, text).unwrap();
-    assert_eq!(ph_formation_sim::design::read_points(&toml_path).unwrap(), p);
+    assert_eq!(
+        ph_formation_sim::design::read_points(&toml_path).unwrap(),
+        p
+    );
 }
 
 /// Points on a circle: grown with the default 5° margin the construction's smallest

@@ -222,7 +222,9 @@ fn capacity_errors_name_the_agent_and_the_fix() {
             i + 1
         );
     }
-    let e = ph_formation_sim::load_toml(&s, "fan", &[]).unwrap_err().to_string();
+    let e = ph_formation_sim::load_toml(&s, "fan", &[])
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("agent hub belongs to 10 triangles")
             && e.contains("at most 8 (ph_formation_core::MAX_TRIANGLES)")
@@ -236,8 +238,8 @@ fn capacity_errors_name_the_agent_and_the_fix() {
 fn a_hundred_thousand_agents_load_with_wire_ids_unique_within_two_hops() {
     let n = 100_000;
     let ids: Vec<String> = (0..n).map(|i| format!("\"r{i}\"")).collect();
-    let m =
-        ph_formation_sim::load_toml(&strip_scenario(&ids), "huge", &[]).unwrap_or_else(|e| panic!("{e}"));
+    let m = ph_formation_sim::load_toml(&strip_scenario(&ids), "huge", &[])
+        .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(m.n(), n);
     assert_eq!(m.agents[n - 1].name, format!("r{}", n - 1));
     // The strip's square has degree 4 on each side: 5 wire ids do.

@@ -37,7 +37,8 @@ angles = [{ apex = 2, desired_deg = 45.0 }, { apex = 3, desired_deg = 45.0, damp
 
 #[test]
 fn a_scenario_without_gains_gets_those_of_formation_only() {
-    let m = ph_formation_sim::load_toml(NO_GAINS, "no-gains.toml", &[]).expect("valid without [gains]");
+    let m =
+        ph_formation_sim::load_toml(NO_GAINS, "no-gains.toml", &[]).expect("valid without [gains]");
     let reference = ph_formation_sim::load("formation-only", &[]).expect("formation-only");
     let gains = |m: &ph_formation_sim::Model| -> Vec<(f64, f64, f64)> {
         m.triangles

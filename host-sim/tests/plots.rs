@@ -84,7 +84,9 @@ fn a_missing_column_or_an_empty_csv_is_a_named_error() {
 
 #[test]
 fn two_hundred_agents_get_a_colour_bar_not_a_legend_row_each() {
-    use ph_formation_sim::design::{construct, render_scenario, DesignOptions, Generator, ScenarioOptions};
+    use ph_formation_sim::design::{
+        construct, render_scenario, DesignOptions, Generator, ScenarioOptions,
+    };
     let p = Generator::TriangularLattice {
         n: 200,
         spacing: 1.0,

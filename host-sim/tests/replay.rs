@@ -408,7 +408,11 @@ fn replay_in_headless_chromium() {
     d["fov"] = serde_json::json!(0.6);
     d["edge_dropped"] = serde_json::json!((0..edge_cells).map(|k| k % 3 == 0).collect::<Vec<_>>());
     let optional = tmp.path().join("optional.html");
-    std::fs::write(&optional, ph_formation_sim::report::replay::page(&d.to_string())).expect("write");
+    std::fs::write(
+        &optional,
+        ph_formation_sim::report::replay::page(&d.to_string()),
+    )
+    .expect("write");
     let dom = browse(&profile, &optional, "probe=last", &["--dump-dom"]);
     assert_eq!(
         pre(&dom, "ph-errors"),

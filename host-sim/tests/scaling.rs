@@ -12,7 +12,9 @@
 //!
 //! That the inner loop allocates nothing per tick is `tests/no_alloc.rs`.
 
-use ph_formation_sim::design::{construct, render_scenario, DesignOptions, Generator, ScenarioOptions};
+use ph_formation_sim::design::{
+    construct, render_scenario, DesignOptions, Generator, ScenarioOptions,
+};
 use ph_formation_sim::engine::PARALLEL_MIN_AGENTS;
 use ph_formation_sim::engine::{
     AgentController, ControlStats, Engine, LocalCore, SampledSim, LOCAL_CAPACITIES,

@@ -221,7 +221,10 @@ fn a_file_with_two_neighbours_sharing_an_id_is_refused_naming_both() {
         "/tests/invalid/duplicate_id.toml"
     );
     let e = load(path, &[]).expect_err("duplicate id accepted");
-    assert!(e.has(ph_formation_sim::scenario::ErrorKind::DuplicateId), "{e}");
+    assert!(
+        e.has(ph_formation_sim::scenario::ErrorKind::DuplicateId),
+        "{e}"
+    );
     let e = e.to_string();
     assert!(
         e.contains("duplicate_id.toml")

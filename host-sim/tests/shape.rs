@@ -3,7 +3,9 @@
 //! whole-formation mirror; a folded triangle is `wrong_shape`, a fold onto a neighbour a
 //! `collision`; designed formations validate and converge.
 
-use ph_formation_sim::design::{construct, render_scenario, DesignOptions, Generator, Perturbation, Scale};
+use ph_formation_sim::design::{
+    construct, render_scenario, DesignOptions, Generator, Perturbation, Scale,
+};
 use ph_formation_sim::design::{ScenarioOptions, Template};
 use ph_formation_sim::{load_toml, Outcome, Simulation};
 
@@ -216,7 +218,8 @@ fn designed_formations_validate_and_the_target_from_angles_is_theirs() {
             table.remove("target");
             let m2 = load_toml(&toml::to_string(&table).unwrap(), "designed", &[]).unwrap();
             let tris: Vec<[usize; 3]> = m2.triangles.iter().map(|t| t.vertices).collect();
-            let c = ph_formation_sim::model::shape::compare(&m2.target.positions, &p, &tris).unwrap();
+            let c =
+                ph_formation_sim::model::shape::compare(&m2.target.positions, &p, &tris).unwrap();
             assert!(
                 c.fit.max_rel < 1e-9 && c.folded.is_empty() && !c.fit.reflected,
                 "{}: {:?}",

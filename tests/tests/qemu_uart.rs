@@ -30,7 +30,9 @@
 use std::net::TcpListener;
 use std::time::{Duration, Instant};
 
-use ph_formation_core::link::{HostMsg, LinkBearing, LinkOutput, LinkStep, TargetMsg, LINK_VERSION};
+use ph_formation_core::link::{
+    HostMsg, LinkBearing, LinkOutput, LinkStep, TargetMsg, LINK_VERSION,
+};
 use ph_formation_core::{
     Agent, AgentConfig, AngleConfig, BearingMeasurement, LeaderConfig, LeaderRole, Measurements,
     Real, Schedule, TriangleConfig, Vec2,

@@ -181,7 +181,11 @@ fn sweep_alone(ph_formation_sim: &Path, sweep: &Path, out: &Path) -> Result<(), 
     )
 }
 
-fn merge(ph_formation_sim: &Path, out: &Path, shards: &Path) -> Result<std::process::Output, String> {
+fn merge(
+    ph_formation_sim: &Path,
+    out: &Path,
+    shards: &Path,
+) -> Result<std::process::Output, String> {
     let mut c = Command::new(ph_formation_sim);
     c.args(["-q", "sweep", "merge", "--no-plots", "--out"])
         .arg(out);

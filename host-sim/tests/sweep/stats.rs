@@ -75,7 +75,10 @@ fn aggregation_counts_every_outcome_with_intervals_and_settle_quantiles() {
     assert_eq!(s.len(), 3);
     assert_eq!((s[0].n, s[0].errors), (10, 1), "errors are not in n");
     let names: Vec<&str> = s[0].fractions.iter().map(|f| f.outcome).collect();
-    let all: Vec<&str> = ph_formation_sim::Outcome::ALL.iter().map(|o| o.as_str()).collect();
+    let all: Vec<&str> = ph_formation_sim::Outcome::ALL
+        .iter()
+        .map(|o| o.as_str())
+        .collect();
     assert_eq!(
         names, all,
         "every outcome the analysis defines, in its order"
