@@ -38,9 +38,14 @@ what=$1
 out=$2
 mkdir -p "$out"
 
+# Every test build has the simulated Crazyflie (`sim-vehicle`: ph_vehicle_*, which the
+# app's tests fly); one feature set for all of them, so that no build overwrites the
+# library another test is linking. The flight build (crazyflie-app/Kbuild) leaves it off.
+features=(--features sim-vehicle)
+
 # Warnings are errors; the C is C11 with GNU attributes (aligned, section).
 cflags=(-std=gnu11 -O2 -g -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes
-    -fno-math-errno -I"$root/controller-ffi/include" -I"$here/demo")
+    -fno-math-errno -DPH_SIM_VEHICLE -I"$root/controller-ffi/include" -I"$here/demo")
 demo=("$here/demo/paper_demo.c" "$here/demo/print.c")
 # The Crazyflie app's portable code against the firmware stub (crazyflie-app/test).
 app=$root/crazyflie-app
@@ -54,7 +59,7 @@ arm_flags=(-mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard
 
 case $what in
 host)
-    (cd "$root" && "$cargo" build -q -p ph-formation-ffi --release --lib)
+    (cd "$root" && "$cargo" build -q -p ph-formation-ffi --release --lib "${features[@]}")
     lib=$target_dir/release/libph_formation_ffi.a
     # The host staticlib contains std: link what it needs (rustc
     # --print native-static-libs on linux-gnu: gcc_s, util, rt, pthread, m, dl, c).
@@ -64,7 +69,7 @@ host)
     echo "$out/c-host-demo"
     ;;
 firmware)
-    (cd "$root" && "$cargo" rustc -q -p ph-formation-ffi --release --lib \
+    (cd "$root" && "$cargo" rustc -q -p ph-formation-ffi --release --lib "${features[@]}" \
         --target thumbv7em-none-eabihf --crate-type staticlib)
     lib=$target_dir/thumbv7em-none-eabihf/release/libph_formation_ffi.a
     # Hard-float ABI of thumbv7em-none-eabihf; no libc (the staticlib's
@@ -79,7 +84,7 @@ firmware)
     echo "$out/c-firmware.elf"
     ;;
 cfapp-host)
-    (cd "$root" && "$cargo" build -q -p ph-formation-ffi --release --lib)
+    (cd "$root" && "$cargo" build -q -p ph-formation-ffi --release --lib "${features[@]}")
     lib=$target_dir/release/libph_formation_ffi.a
     "${CC:-cc}" "${cflags[@]}" "${app_cflags[@]}" -o "$out/cfapp-host" \
         "$app/test/host_main.c" "${app_src[@]}" \
@@ -87,7 +92,7 @@ cfapp-host)
     echo "$out/cfapp-host"
     ;;
 cfapp-firmware)
-    (cd "$root" && "$cargo" rustc -q -p ph-formation-ffi --release --lib \
+    (cd "$root" && "$cargo" rustc -q -p ph-formation-ffi --release --lib "${features[@]}" \
         --target thumbv7em-none-eabihf --crate-type staticlib)
     lib=$target_dir/thumbv7em-none-eabihf/release/libph_formation_ffi.a
     "${ARM_CC:-arm-none-eabi-gcc}" "${cflags[@]}" "${app_cflags[@]}" -I"$here/firmware" \
@@ -97,7 +102,7 @@ cfapp-firmware)
     echo "$out/cfapp-firmware.elf"
     ;;
 cfapp-flight)
-    (cd "$root" && "$cargo" build -q -p ph-formation-ffi --release --lib)
+    (cd "$root" && "$cargo" build -q -p ph-formation-ffi --release --lib "${features[@]}")
     lib=$target_dir/release/libph_formation_ffi.a
     "${CC:-cc}" "${cflags[@]}" "${app_cflags[@]}" -o "$out/cfapp-flight" \
         "$app/test/flight_test.c" "$app/test/firmware_model.c" "$app/src/flight.c" \

@@ -128,6 +128,13 @@
  */
 #define PH_BEARING_HAS_RANGE 2
 
+#if defined(PH_SIM_VEHICLE)
+/**
+ * Words of a `ph_vehicle`'s cascade state.
+ */
+#define PH_VEHICLE_STATE_LEN 16
+#endif
+
 /**
  * What an entry point did: `PH_OK` (0) or why it refused. Returned as an `int32_t`.
  *
@@ -1159,6 +1166,31 @@ typedef struct {
   uint64_t counter;
 } ph_position_peer;
 
+#if defined(PH_SIM_VEHICLE)
+/**
+ * One simulated Crazyflie (plain data: copy it freely). Fill it with
+ * `ph_vehicle_init`; read `q`, `v` and `tilt` after each `ph_vehicle_step`.
+ */
+typedef struct {
+  /**
+   * Position (m, world frame).
+   */
+  float q[2];
+  /**
+   * Velocity (m/s, world frame).
+   */
+  float v[2];
+  /**
+   * Total tilt from vertical (rad).
+   */
+  float tilt;
+  /**
+   * The cascade's state (opaque; any content steps without fault).
+   */
+  double state[PH_VEHICLE_STATE_LEN];
+} ph_vehicle;
+#endif
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -1478,6 +1510,32 @@ ph_status ph_position_decode(const ph_agent *agent,
  * `bytes` NULL or `len` readable bytes; `sender` NULL or writable.
  */
 ph_status ph_position_sender(const uint8_t *bytes, size_t len, uint8_t *sender);
+
+#if defined(PH_SIM_VEHICLE)
+/**
+ * Fills `*vehicle` with a level Crazyflie at `q[0..2]` (m) moving with `v[0..2]`
+ * (m/s), its controllers' integrals empty. `PH_ERR_ARGUMENT` for a value that is not
+ * finite.
+ *
+ * # Safety
+ * `vehicle` is NULL or writable; `q` and `v` are NULL or point to 2 readable floats.
+ */
+ph_status ph_vehicle_init(ph_vehicle *vehicle, const float *q, const float *v);
+#endif
+
+#if defined(PH_SIM_VEHICLE)
+/**
+ * Flies `*vehicle` for `dt` seconds (> 0, finite; split at the firmware's 500 Hz
+ * attitude ticks) toward the velocity setpoint `setpoint[0..2]` (m/s, world frame), as
+ * the commander's velocity-mode setpoint. `PH_ERR_ARGUMENT` (nothing written) for a bad
+ * `dt` or a setpoint that is not finite.
+ *
+ * # Safety
+ * `vehicle` is NULL or points to a `ph_vehicle`; `setpoint` is NULL or points to 2
+ * readable floats.
+ */
+ph_status ph_vehicle_step(ph_vehicle *vehicle, const float *setpoint, float dt);
+#endif
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -53,6 +53,9 @@ pub mod position;
 pub mod status;
 pub mod storage;
 pub mod tick;
+// The simulated Crazyflie of the app's C tests: never in the flight build.
+#[cfg(feature = "sim-vehicle")]
+pub mod vehicle;
 
 pub use actuate::ph_actuator;
 pub use blob::{decode_blob, encode_blob, BlobError};
@@ -104,7 +107,8 @@ const _: () = assert!(
         == PH_MAX_TRIANGLES.div_ceil(ph_formation_core::wire::Integrity::Crc16.max_angles()) + 1
 );
 const _: () = assert!(
-    ph_formation_core::wire::Integrity::Auth(ph_formation_core::SwarmKey::new([0; 16])).max_angles()
+    ph_formation_core::wire::Integrity::Auth(ph_formation_core::SwarmKey::new([0; 16]))
+        .max_angles()
         == ph_formation_core::wire::Integrity::Crc16.max_angles()
 );
 const _: () = assert!(PH_MAX_SCHEDULE_STEPS == ph_formation_core::MAX_SCHEDULE_STEPS);

@@ -90,3 +90,43 @@ fn header_compiles_as_pedantic_c99() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// The flight build carries no vehicle model: `sim-vehicle` is off by default, the
+/// Crazyflie firmware's build of the library (crazyflie-app/Kbuild) does not turn it on,
+/// and the header declares `ph_vehicle_*` only under `PH_SIM_VEHICLE`.
+#[test]
+fn flight_build_has_no_vehicle_model() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let manifest = std::fs::read_to_string(dir.join("Cargo.toml")).expect("Cargo.toml");
+    assert!(
+        manifest.contains("\ndefault = []\n"),
+        "ph-formation-ffi's default features must stay empty"
+    );
+    let kbuild = std::fs::read_to_string(dir.join("../crazyflie-app/Kbuild")).expect("Kbuild");
+    let build = kbuild
+        .lines()
+        .find(|l| l.contains("cargo rustc -p ph-formation-ffi"))
+        .expect("crazyflie-app/Kbuild builds the library with cargo rustc");
+    assert!(
+        !kbuild.contains("sim-vehicle") && !build.contains("--features"),
+        "{build}"
+    );
+    let header = generate();
+    let mut guarded = false;
+    for line in header.lines() {
+        if line.starts_with("#if defined(PH_SIM_VEHICLE)") {
+            guarded = true;
+        } else if line.starts_with("#endif") {
+            guarded = false;
+        } else if line.contains("ph_vehicle") && line.starts_with("ph_status ") {
+            assert!(
+                guarded,
+                "{line} is declared outside #if defined(PH_SIM_VEHICLE)"
+            );
+        }
+    }
+    assert!(
+        header.contains("ph_status ph_vehicle_step("),
+        "the test sees the declarations"
+    );
+}

@@ -26,6 +26,8 @@ ph_status agent_loop_init(agent_loop *loop, uint8_t *memory, size_t size, uint8_
         s = ph_actuator_init(&loop->actuator, loop->agent, FORMATION_MASS, FORMATION_MAX_SPEED,
                              FORMATION_LEAD);
     if (s == PH_OK)
+        s = ph_actuator_set_second_lead(&loop->actuator, FORMATION_SECOND_LEAD);
+    if (s == PH_OK)
         s = formation_state_init(&loop->formation, loop->agent);
     return s;
 }

@@ -27,17 +27,24 @@
 /* The plant model the controller assumes (SPEC S1, per axis): m dv/dt = -D^r v + U,
  * integrated into velocity setpoints by ph_actuate(); D^r is the agent's friction. */
 #define FORMATION_MASS 1.0f /* kg (virtual) */
-/* Largest velocity setpoint (m/s): the Crazyflie's position-mode limit
- * (crazyflie-firmware src/platform/interface/platform_defaults_cf2.h,
- * PID_POS_VEL_X_MAX / _Y_MAX = 1.0; docs/crazyflie.md). */
+/* Largest velocity setpoint (m/s): the app's own limit. The firmware sets none in
+ * velocity mode (PID_POS_VEL_X_MAX / _Y_MAX of platform_defaults_cf2.h bound only the
+ * position loop's output, which the app does not use; docs/world.md). */
 #ifndef FORMATION_MAX_SPEED
 #define FORMATION_MAX_SPEED 1.0f
 #endif
 /* Lead of the setpoints (s, SPEC S21): the time constant of the Crazyflie's velocity
  * loop, derived from PID_VEL_X_KP = PID_VEL_Y_KP = 25 deg per m/s
- * (platform_defaults_cf2.h): 1 / (g tan(25 deg)/(m/s)) ~ 0.23 s (docs/world.md). */
+ * (platform_defaults_cf2.h): 1 / (g K_p pi/180) = 0.2337 s (docs/world.md,
+ * ph-formation-vehicle's derived_lead). */
 #ifndef FORMATION_LEAD
-#define FORMATION_LEAD 0.23f
+#define FORMATION_LEAD 0.2337f
+#endif
+/* Second-order lead (s^2, SPEC S21b): the attitude loop behind the velocity loop,
+ * FORMATION_LEAD / PID_ROLL_KP (6 1/s) = 0.03895 s^2 (docs/world.md,
+ * derived_second_lead). 0 turns it off. */
+#ifndef FORMATION_SECOND_LEAD
+#define FORMATION_SECOND_LEAD 0.03895f
 #endif
 /* P2P port of the position packets (the formation's frames use port 0). */
 #define FORMATION_POSITION_PORT 1u

@@ -7,7 +7,6 @@
 #include "log.h"
 
 #define TICK_S 0.01f
-#define SUBSTEPS 10
 #define INBOX 16
 
 typedef struct {
@@ -28,6 +27,10 @@ static ph_config scratch;
  * initial positions. */
 static float q[SWARM_N][2] = {{0.45f, 1.1f}, {1.1f, 1.4f}, {0.9f, 0.55f}, {1.55f, 0.95f}};
 static float v[SWARM_N][2];
+/* The simulated Crazyflies (the firmware's PID cascade, ph_vehicle_* of the C API's
+ * sim-vehicle build: the one model host-sim's world = "crazyflie" flies too); q and v
+ * above are their positions and velocities after each tick. */
+static ph_vehicle vehicles[SWARM_N];
 /* Inboxes: filled during a tick, delivered at the next one. */
 static inbox air[2][SWARM_N];
 static int current;   /* the robot whose app runs (its state estimator) */
@@ -98,6 +101,8 @@ ph_status swarm_init(void)
     for (int i = 0; i < SWARM_N; i++) {
         ph_status s =
             agent_loop_init(&loops[i], memory[i], sizeof memory[i], (uint8_t)(i + 1), &scratch);
+        if (s == PH_OK)
+            s = ph_vehicle_init(&vehicles[i], q[i], v[i]);
         if (s != PH_OK)
             return s;
     }
@@ -180,14 +185,17 @@ static void run(uint32_t max_ticks, int stop_when_converged, swarm_result *r,
             if (speed > r->max_setpoint_speed)
                 r->max_setpoint_speed = speed;
         }
-        /* The vehicles track their setpoints for one tick. */
-        for (int n = 0; n < SUBSTEPS; n++)
-            for (int i = 0; i < SWARM_N; i++)
-                for (int k = 0; k < 2; k++) {
-                    float h = TICK_S / SUBSTEPS;
-                    v[i][k] += h / SWARM_TAU * (loops[i].setpoint[k] - v[i][k]);
-                    q[i][k] += h * v[i][k];
-                }
+        /* The vehicles fly toward their setpoints for one tick (the cascade's own
+         * 100 Hz and 500 Hz ticks inside). */
+        for (int i = 0; i < SWARM_N; i++) {
+            ph_status s = ph_vehicle_step(&vehicles[i], loops[i].setpoint, TICK_S);
+            if (s != PH_OK && r->error == PH_OK)
+                r->error = s;
+            for (int k = 0; k < 2; k++) {
+                q[i][k] = vehicles[i].q[k];
+                v[i][k] = vehicles[i].v[k];
+            }
+        }
         if (tick + 1000u >= max_ticks) { /* the last 10 s */
             float e = shape_error();
             sum_sq += e * e;

@@ -5,9 +5,9 @@
  * (host_main.c) and on the STM32F405 under QEMU (qemu_main.c), by
  * controller-ffi/tests/crazyflie_app.rs.
  *
- * Vehicles: each tracks its velocity setpoint with a first-order lag
- * (SWARM_TAU), integrated at 1 ms; the state estimator reads the true position
- * and velocity. Radio: every packet a vehicle sends reaches the three others at
+ * Vehicles: each is a Crazyflie flying the firmware's PID cascade in velocity
+ * mode (ph_vehicle_*, the C API's sim-vehicle build; docs/world.md); the state
+ * estimator reads the true position and velocity. Radio: every packet a vehicle sends reaches the three others at
  * the next tick (10 ms), as P2P broadcast does.
  */
 #ifndef SWARM_H
@@ -18,11 +18,6 @@
 #include "ph_formation.h"
 
 #define SWARM_N 4
-/* Velocity tracking lag of the simulated Crazyflie (s): the value derived from the
- * firmware's velocity gain (FORMATION_LEAD, docs/world.md), not a measurement. */
-#ifndef SWARM_TAU
-#define SWARM_TAU FORMATION_LEAD
-#endif
 /* Give up after this many simulated seconds. */
 #define SWARM_MAX_TIME_S 60u
 /* Converged: every q_i - q_1 within SWARM_SHAPE_TOL m of the square 1-2-4-3 of
