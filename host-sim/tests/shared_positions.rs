@@ -5,7 +5,9 @@
 //! settings refused with file, field and reason.
 
 mod support;
-use ph_formation_core::Vec2;
+use ph_formation_core::wire::auth::SwarmKey;
+use ph_formation_core::wire::position::{position_len, PositionPacket, MAX_POSITION_LEN};
+use ph_formation_core::{Integrity, Vec2};
 use ph_formation_sim::engine::radio::RadioFrame;
 use ph_formation_sim::engine::sensors::{
     BearingKind, BearingSensor, Sensors, SharedPositions, World, POSITION_VERSION,
@@ -14,6 +16,9 @@ use ph_formation_sim::engine::{run, Engine, NullRecorder, SampledSim, PARALLEL_M
 use ph_formation_sim::load;
 use ph_formation_sim::model::{BearingRate, Model, PositionsModel, SensorModel};
 use ph_formation_sim::scenario::strip_model;
+
+/// A swarm key for the `auth` runs.
+const KEY: &str = "controller.auth_key=000102030405060708090a0b0c0d0e0f";
 
 const KIND: BearingKind = BearingKind {
     exact_rate: false,
@@ -50,11 +55,7 @@ fn bearing(p: &SharedPositions, q: &[Vec2<f64>], i: usize, j: usize) -> Option<V
 /// formation-only's model and its agent 0's first radio neighbour.
 fn pair(noise: f64, max_age: f64) -> (Model, PositionsModel, usize) {
     let m = shared("formation-only", &[]);
-    let p = PositionsModel {
-        noise,
-        max_age,
-        packet_bytes: 10,
-    };
+    let p = PositionsModel { noise, max_age };
     let j = m.graph.radio.of(0)[0];
     (m, p, j)
 }
@@ -75,7 +76,11 @@ fn a_heard_position_gives_the_bearing_until_it_is_older_than_max_age() {
     let frame = RadioFrame::new(&[0x84; 20]);
     inboxes[0].push(frame);
     inboxes[0].push(p.packet(j));
-    assert_eq!(p.packet(j).as_bytes().len(), 10);
+    // The core's packet under the scenario's integrity (crc16): 11 bytes and the CRC.
+    assert_eq!(
+        p.packet(j).as_bytes().len(),
+        position_len(&Integrity::Crc16)
+    );
     assert_eq!(p.packet(j).as_bytes()[0], POSITION_VERSION);
     p.hear(0.01, 1, &q, &mut inboxes);
     assert_eq!(inboxes[0], vec![frame]);
@@ -198,21 +203,83 @@ fn the_position_packets_are_load_on_the_shared_channel() {
     let plain = load("formation-only", &owned(&base)).expect("load");
     let air = plain.radio.channel.as_ref().expect("channel").clone();
     let (air0, tx0, drop0) = channel_over(&plain, warm, ticks);
-    for bytes in [10usize, 60] {
-        let set = format!("sensors.positions.packet_bytes={bytes}");
-        let m = shared("formation-only", &[base[0], base[1], &set]);
+    for integrity in ["crc16", "link", "auth"] {
+        let set = format!("controller.integrity={integrity}");
+        let key = if integrity == "auth" { KEY } else { base[0] };
+        let sets = [base[0], base[1], &set, key];
+        let m = shared("formation-only", &sets);
+        let plain = load("formation-only", &owned(&sets)).expect("load");
+        let (air0, tx0, drop0) = channel_over(&plain, warm, ticks);
         let (air1, tx1, drop1) = channel_over(&m, warm, ticks);
         assert_eq!((drop0, drop1), (0, 0));
-        // One packet per agent per tick, each its air time on the channel.
+        // One packet per agent per tick, each the air time of the core's packet.
+        let bytes = position_len(&m.integrity.core(&m.auth_key));
         let packets = (m.n() * ticks) as u64;
-        assert_eq!(tx1 - tx0, packets, "{bytes} bytes");
+        assert_eq!(tx1 - tx0, packets, "{integrity}");
         let share = packets as f64 * air.air_time(bytes);
         assert!(
             ((air1 - air0) - share).abs() < 1e-9 * share,
-            "{bytes} bytes: {} s more, expected {share} s",
+            "{integrity} ({bytes} bytes): {} s more, expected {share} s",
             air1 - air0
         );
     }
+}
+
+/// Under `auth` a position is accepted only with the swarm's tag and a counter above the
+/// last one accepted from its sender: a spoofed packet (another key), a replay and a
+/// corrupted copy are refused and give no bearing; the genuine packet gives one.
+#[test]
+fn spoofed_and_replayed_positions_are_refused_under_auth() {
+    let m = shared("formation-only", &["controller.integrity=auth", KEY]);
+    let settings = PositionsModel {
+        noise: 0.0,
+        max_age: 1.0,
+    };
+    let j = m.graph.radio.of(0)[0];
+    let mut p = SharedPositions::new(&m, &settings);
+    let mut q = vec![Vec2::zeros(); m.n()];
+    q[j] = Vec2::new(3.0, 4.0);
+    let mut inboxes = vec![Vec::new(); m.n()];
+    p.hear(0.0, 0, &q, &mut inboxes);
+    let genuine = p.packet(j);
+    assert_eq!(genuine.as_bytes().len(), MAX_POSITION_LEN);
+    // A spoofer without the key: j's id at another position, tagged under its own key.
+    let forged = {
+        let packet = PositionPacket {
+            sender: m.agents[j].id,
+            position: [-3.0, 0.0],
+        };
+        let other = Integrity::Auth(SwarmKey::new([0x5a; 16]));
+        let mut b = [0u8; MAX_POSITION_LEN];
+        let n = packet.encode(&other, 1_000, &mut b).expect("encode");
+        RadioFrame::new(&b[..n])
+    };
+    let mut corrupted = genuine.as_bytes().to_vec();
+    corrupted[4] ^= 0x01;
+    inboxes[0].push(forged);
+    inboxes[0].push(RadioFrame::new(&corrupted));
+    p.hear(0.01, 1, &q, &mut inboxes);
+    assert_eq!(
+        bearing(&p, &q, 0, j),
+        None,
+        "spoofed or corrupted: no bearing"
+    );
+    assert_eq!(p.packets_refused(), 2);
+    // The genuine packet (negative control: the check accepts what it should).
+    inboxes[0].push(genuine);
+    p.hear(0.02, 2, &q, &mut inboxes);
+    assert_eq!(bearing(&p, &q, 0, j), Some(Vec2::new(0.6, 0.8)));
+    // j moves and sends again; then an attacker replays the first packet: refused, the
+    // bearing stays the new one.
+    q[j] = Vec2::new(-5.0, 0.0);
+    p.hear(0.03, 3, &q, &mut inboxes);
+    inboxes[0].push(p.packet(j));
+    p.hear(0.04, 4, &q, &mut inboxes);
+    assert_eq!(bearing(&p, &q, 0, j), Some(Vec2::new(-1.0, 0.0)));
+    inboxes[0].push(genuine);
+    p.hear(0.05, 5, &q, &mut inboxes);
+    assert_eq!(p.packets_refused(), 3, "the replay is refused");
+    assert_eq!(bearing(&p, &q, 0, j), Some(Vec2::new(-1.0, 0.0)));
 }
 
 use support::bits;
@@ -225,7 +292,6 @@ fn a_shared_positions_run_gives_the_same_bits_on_1_and_4_threads() {
     m.sensors.positions = Some(PositionsModel {
         noise: 0.003,
         max_age: 0.03,
-        packet_bytes: 10,
     });
     let one = bits(&m, 20, 1);
     assert!(one == bits(&m, 20, 4), "the states differ");
@@ -244,18 +310,17 @@ fn every_positions_field_can_be_set() {
         &[
             "sensors.positions.noise_m=0.003",
             "sensors.positions.max_age_s=0.25",
-            "sensors.positions.packet_bytes=16",
         ],
     );
     let p = m.sensors.positions.clone().expect("shared positions");
-    assert_eq!((p.noise, p.max_age, p.packet_bytes), (0.003, 0.25, 16));
+    assert_eq!((p.noise, p.max_age), (0.003, 0.25));
     assert!(!ph_formation_sim::engine::direct_radio(&m));
     // The source alone: the defaults.
     let p = shared("formation-only", &[])
         .sensors
         .positions
         .expect("shared");
-    assert_eq!((p.noise, p.max_age, p.packet_bytes), (0.0, 0.1, 10));
+    assert_eq!((p.noise, p.max_age), (0.0, 0.1));
     let plain = load("formation-only", &[]).expect("load");
     assert!(plain.sensors.positions.is_none());
     assert!(ph_formation_sim::engine::direct_radio(&plain));
@@ -272,19 +337,9 @@ fn bad_positions_settings_are_refused_with_file_field_and_reason() {
         (&["max_age_s=-1"], "sensors.positions.max_age_s", "> 0"),
         (&["max_age_s=nan"], "sensors.positions.max_age_s", "> 0"),
         (
-            &["packet_bytes=0"],
+            &["packet_bytes=10"],
             "sensors.positions.packet_bytes",
-            "10 to 60",
-        ),
-        (
-            &["packet_bytes=9"],
-            "sensors.positions.packet_bytes",
-            "10 to 60",
-        ),
-        (
-            &["packet_bytes=61"],
-            "sensors.positions.packet_bytes",
-            "10 to 60",
+            "the core's position packet",
         ),
     ];
     for (sets, field, reason) in cases {
@@ -315,10 +370,6 @@ fn bad_positions_settings_are_refused_with_file_field_and_reason() {
     let e = load(file, &owned(&["sensors.bearing_source=gps"])).expect_err("unknown source");
     assert!(e.to_string().contains("bearing_source"), "{e}");
     // Edges accepted.
-    let ok = [
-        source.to_owned(),
-        "sensors.positions.packet_bytes=60".to_owned(),
-        "sensors.positions.noise_m=0".to_owned(),
-    ];
+    let ok = [source.to_owned(), "sensors.positions.noise_m=0".to_owned()];
     assert!(load(file, &ok).is_ok());
 }

@@ -120,15 +120,14 @@ impl CameraModel {
 
 /// Bearings from positions shared over the radio (`[sensors.positions]`, docs/sensors.md):
 /// each agent's position estimate is the true position plus white Gaussian noise, and it
-/// broadcasts that estimate in a packet of its own at every tick. SI units.
+/// broadcasts that estimate in a packet of its own at every tick (the core's position
+/// packet, protected by the scenario's integrity mode). SI units.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PositionsModel {
     /// Standard deviation of the position noise per axis (m).
     pub noise: f64,
     /// A neighbour's position heard longer ago than this gives no bearing (s).
     pub max_age: f64,
-    /// Size of one position packet on the radio (bytes, 10 to 60).
-    pub packet_bytes: usize,
 }
 
 /// How a [`SensorModel`] departs from ideal sensors ([`SensorModel::departures`]).

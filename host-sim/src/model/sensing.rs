@@ -98,7 +98,6 @@ mod tests {
         let p = PositionsModel {
             noise: 0.01,
             max_age: 0.1,
-            packet_bytes: 16,
         };
         let s = positions_bearing_noise(&p, 2.0);
         assert!((s - 0.01 * 2f64.sqrt() / 2.0).abs() < 1e-15);

@@ -137,8 +137,9 @@ pub struct PositionsSpec {
     pub noise_m: f64,
     /// A neighbour's position heard longer ago than this (s) gives no bearing.
     pub max_age_s: f64,
-    /// Size of one position packet on the radio (bytes).
-    pub packet_bytes: usize,
+    /// Removed: the packet is the core's position packet, its length set by the
+    /// integrity mode. Accepted only to say so (validation refuses it).
+    pub packet_bytes: Option<usize>,
 }
 
 impl Default for PositionsSpec {
@@ -146,7 +147,7 @@ impl Default for PositionsSpec {
         Self {
             noise_m: 0.0,
             max_age_s: 0.1,
-            packet_bytes: 10,
+            packet_bytes: None,
         }
     }
 }

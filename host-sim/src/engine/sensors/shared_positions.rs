@@ -20,12 +20,16 @@
 //! leader's partner offset is `q̂_p − q̂_i` the same way (plus the offset noise).
 //!
 //! After its tick each agent broadcasts its estimate through the radio
-//! ([`SharedPositions::packet`]): a frame of `packet_bytes` bytes with the layout of
-//! docs/core.md "Position packets" (version 1, sender id, `x`, `y` as little-endian `f32`,
-//! zeros after), a packet of its own on the radio model and the shared channel (loss,
-//! latency, air time, collisions). It is told from a formation frame by its length and
-//! first byte (a formation frame's mode byte is `0x80` or more, and it is at least 12
-//! bytes long; the app sends it on a P2P port of its own).
+//! ([`SharedPositions::packet`]): the core's position packet
+//! ([`ph_formation_core::wire::position`], the one the C API and the Crazyflie app use:
+//! 13 bytes with `crc16`, 11 with `link`, 27 with `auth`), protected by the scenario's
+//! integrity mode, a packet of its own on the radio model and the shared channel (loss,
+//! latency, air time, collisions). It is told from a formation frame by its first byte
+//! (the position packet's version, 2; a formation frame's mode byte is `0x80` or more;
+//! the app sends it on a P2P port of its own). A receiver keeps only packets that decode
+//! (CRC or tag, finite position) and, under `auth`, whose counter is above the last it
+//! accepted from that sender: spoofed and replayed positions are refused
+//! ([`SharedPositions::packets_refused`]).
 //!
 //! Everything is drawn from per-agent streams or from the radio's stream in agent order,
 //! and the table is written only between ticks: a run gives the same bits on any number
@@ -35,11 +39,12 @@ use super::source::{BearingKind, BearingSensor, World};
 use super::{Draws, Sensors, Sight};
 use crate::engine::radio::RadioFrame;
 use crate::model::{Model, PositionsModel};
-use ph_formation_core::{BearingMeasurement, Vec2};
+use ph_formation_core::wire::auth::Counter;
+use ph_formation_core::wire::position::{accept_counter, PositionPacket, MAX_POSITION_LEN};
+use ph_formation_core::{BearingMeasurement, Integrity, Vec2};
 
-/// The first byte of a position packet: its layout version (formation.h's
-/// `FORMATION_POSITION_VERSION`).
-pub const POSITION_VERSION: u8 = 1;
+/// The first byte of a position packet: the core's layout version.
+pub use ph_formation_core::wire::position::POSITION_VERSION;
 /// Tag mixed into the run's seed for the position noise's streams (independent of the
 /// sensors' and the radio's).
 const POSITION_STREAM: u64 = 0x5053_4e00; // "PSN"
@@ -53,6 +58,8 @@ struct Peer {
     id: u8,
     index: usize,
     heard: Option<(Vec2<f64>, f64)>,
+    /// `auth`: the last counter accepted from it.
+    counter: Option<Counter>,
 }
 
 /// Every agent's position estimate and the positions it heard.
@@ -71,6 +78,12 @@ pub struct SharedPositions {
     now: f64,
     /// Position packets taken out of the inboxes (each a copy the radio delivered).
     heard: u64,
+    /// Of those, the ones refused (bad CRC or tag, replayed, not finite, unknown sender).
+    refused: u64,
+    /// The packets' integrity (the formation frames').
+    integrity: Integrity,
+    /// Each agent's next `auth` counter (from 1).
+    counters: Vec<Counter>,
 }
 
 impl SharedPositions {
@@ -85,6 +98,7 @@ impl SharedPositions {
                         id: ids[j],
                         index: j,
                         heard: None,
+                        counter: None,
                     })
                     .collect()
             })
@@ -97,6 +111,9 @@ impl SharedPositions {
             peers,
             now: f64::NEG_INFINITY,
             heard: 0,
+            refused: 0,
+            integrity: model.integrity.core(&model.auth_key),
+            counters: vec![1; model.n()],
         }
     }
 
@@ -105,18 +122,25 @@ impl SharedPositions {
     /// agent's own estimate is drawn.
     pub fn hear(&mut self, now: f64, tick: u64, q: &[Vec2<f64>], inboxes: &mut [Vec<RadioFrame>]) {
         self.now = now;
-        let len = self.model.packet_bytes;
+        let integrity = &self.integrity;
         for (inbox, peers) in inboxes.iter_mut().zip(&mut self.peers) {
             inbox.retain(|f| {
                 let b = f.as_bytes();
-                if b.len() != len || b.first() != Some(&POSITION_VERSION) {
+                if b.first() != Some(&POSITION_VERSION) {
                     return true;
                 }
                 self.heard += 1;
-                if let Some(p) = decode(b) {
-                    if let Some(peer) = peers.iter_mut().find(|x| x.id == b[1]) {
-                        peer.heard = Some((p, now));
-                    }
+                let accepted = PositionPacket::decode(b, integrity)
+                    .ok()
+                    .and_then(|(p, c)| {
+                        let peer = peers.iter_mut().find(|x| x.id == p.sender)?;
+                        accept_counter(&mut peer.counter, c).then(|| {
+                            let [x, y] = p.position.map(f64::from);
+                            peer.heard = Some((Vec2::new(x, y), now));
+                        })
+                    });
+                if accepted.is_none() {
+                    self.refused += 1;
                 }
                 false
             });
@@ -129,16 +153,30 @@ impl SharedPositions {
         }
     }
 
-    /// Agent `i`'s position packet of this tick (its estimate, tagged with its id).
-    pub fn packet(&self, i: usize) -> RadioFrame {
-        let mut bytes = [0u8; ph_formation_core::MAX_FRAME_LEN];
+    /// Agent `i`'s position packet of this tick: its estimate, tagged with its id, as
+    /// the core encodes it (under `auth` with its next counter).
+    pub fn packet(&mut self, i: usize) -> RadioFrame {
         let p = self.own.get(i).copied().unwrap_or_else(Vec2::zeros);
-        bytes[0] = POSITION_VERSION;
-        bytes[1] = self.ids.get(i).copied().unwrap_or(0);
-        bytes[2..6].copy_from_slice(&(p.x as f32).to_le_bytes());
-        bytes[6..10].copy_from_slice(&(p.y as f32).to_le_bytes());
-        let len = self.model.packet_bytes.clamp(10, bytes.len());
+        let packet = PositionPacket {
+            sender: self.ids.get(i).copied().unwrap_or(0),
+            position: [p.x as f32, p.y as f32],
+        };
+        let counter = self.counters.get_mut(i).map_or(0, |c| {
+            *c += 1;
+            *c - 1
+        });
+        let mut bytes = [0u8; MAX_POSITION_LEN];
+        // The buffer holds the longest packet: encode cannot fail.
+        let len = packet
+            .encode(&self.integrity, counter, &mut bytes)
+            .unwrap_or(0);
         RadioFrame::checked(&bytes[..len], None)
+    }
+
+    /// Position packets refused so far (bad CRC or tag, replayed, not finite, or from
+    /// an agent that is not a radio neighbour).
+    pub fn packets_refused(&self) -> u64 {
+        self.refused
     }
 
     /// Position packets taken out of the inboxes so far (link copies delivered).
@@ -153,17 +191,6 @@ impl SharedPositions {
         let (p, at) = peer.heard?;
         (self.now - at <= self.model.max_age + AGE_EPS).then_some(p)
     }
-}
-
-/// The position a packet carries, `None` if a coordinate is not finite (formation.c's
-/// `formation_position_received`).
-fn decode(b: &[u8]) -> Option<Vec2<f64>> {
-    let f = |k: usize| -> Option<f64> {
-        let w: [u8; 4] = b.get(k..k + 4)?.try_into().ok()?;
-        let x = f64::from(f32::from_le_bytes(w));
-        x.is_finite().then_some(x)
-    };
-    Some(Vec2::new(f(2)?, f(6)?))
 }
 
 /// `p` rounded to `f32` per axis (what the packet and the app's `float`s hold).

@@ -7,11 +7,8 @@ use crate::model::{BearingRate, Mode, PositionsModel};
 use crate::scenario::error::ErrorKind::InvalidValue;
 use crate::scenario::settings::BearingSource;
 use crate::scenario::ScenarioFile;
-use ph_formation_core::MAX_FRAME_LEN;
-
-/// The position packet's own bytes: layout version, sender id, `x` and `y` as `f32`
-/// (docs/core.md "Position packets").
-pub(super) const POSITION_PAYLOAD: usize = 10;
+use ph_formation_core::wire::position::{position_len, MAX_POSITION_LEN};
+use ph_formation_core::Integrity;
 
 /// Checks the bearing source; the shared positions in SI units, or `None` with the
 /// agents' own bearing sensor.
@@ -31,15 +28,17 @@ pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile) -> Option<PositionsMo
     let f = |x: &str| format!("sensors.positions.{x}");
     c.non_negative(InvalidValue, &f("noise_m"), p.noise_m);
     c.positive(InvalidValue, &f("max_age_s"), p.max_age_s);
-    if !(POSITION_PAYLOAD..=MAX_FRAME_LEN).contains(&p.packet_bytes) {
+    if let Some(bytes) = p.packet_bytes {
         c.err(
             InvalidValue,
             &f("packet_bytes"),
             format!(
-                "must be {POSITION_PAYLOAD} to {MAX_FRAME_LEN} bytes (the packet holds \
-                 {POSITION_PAYLOAD}: version, id, x, y; the radio carries at most \
-                 {MAX_FRAME_LEN}), got {}",
-                p.packet_bytes
+                "no longer set (got {bytes}): the packet is the core's position packet \
+                 (docs/core.md \"Position packets\"), {} bytes with integrity = \"crc16\", \
+                 {} with \"link\", {} with \"auth\"; remove the key",
+                position_len(&Integrity::Crc16),
+                position_len(&Integrity::Link),
+                MAX_POSITION_LEN
             ),
         );
     }
@@ -70,6 +69,5 @@ pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile) -> Option<PositionsMo
     Some(PositionsModel {
         noise: p.noise_m,
         max_age: p.max_age_s,
-        packet_bytes: p.packet_bytes,
     })
 }
