@@ -202,7 +202,6 @@ fn the_position_packets_are_load_on_the_shared_channel() {
     let (warm, ticks) = (20, 150);
     let plain = load("formation-only", &owned(&base)).expect("load");
     let air = plain.radio.channel.as_ref().expect("channel").clone();
-    let (air0, tx0, drop0) = channel_over(&plain, warm, ticks);
     for integrity in ["crc16", "link", "auth"] {
         let set = format!("controller.integrity={integrity}");
         let key = if integrity == "auth" { KEY } else { base[0] };
