@@ -76,6 +76,63 @@ fn lost_radio_holds_then_lands_after_the_timeout() {
     }
 }
 
+/// A battery from 4.0 V to 3.0 V over 20 s reads 3.2 V at 16 s (`BatteryModel`'s
+/// closed form); below it for 1 s, every agent lands at 17 s: not in a 16.8 s run,
+/// in a 17.3 s one, each with the reason `Battery`. Without the policy (negative
+/// control) the battery lands nobody.
+#[test]
+fn a_low_battery_lands_when_the_voltage_says() {
+    let battery = [
+        "battery.full_v=4.0",
+        "battery.empty_v=3.0",
+        "battery.flight_time_s=20",
+        "policy.battery_land_v=3.2",
+        "policy.battery_land_s=1.0",
+    ];
+    let with = |duration: &str| {
+        let mut o = battery.to_vec();
+        o.push(duration);
+        run(&o)
+    };
+    let before = with("duration=16.8");
+    assert!(
+        before.policy.iter().all(|c| c.landings == 0),
+        "{:?}",
+        before.policy
+    );
+    let after = with("duration=17.3");
+    assert_eq!(after.policy.len(), 4);
+    assert!(
+        after
+            .policy
+            .iter()
+            .all(|c| c.landings == 1 && c.last_landing == PolicyReason::Battery),
+        "{:?}",
+        after.policy
+    );
+    // The outcome names the landings and their cause.
+    assert!(
+        after
+            .reason
+            .contains("the safety policies landed 4 of 4 agents (low battery: agents 1, 2, 3, 4)"),
+        "{}",
+        after.reason
+    );
+    assert!(!before.reason.contains("landed"), "{}", before.reason);
+    let off = run(&[
+        battery[0],
+        battery[1],
+        battery[2],
+        "policy.hold_timeout_s=2",
+        "duration=17.3",
+    ]);
+    assert!(
+        off.policy.iter().all(|c| c.landings == 0),
+        "{:?}",
+        off.policy
+    );
+}
+
 #[test]
 fn separation_guard_acts_only_inside_the_minimum() {
     // 3 m: every neighbour is inside it, so every approach is cut.
@@ -92,6 +149,10 @@ fn bad_policy_values_are_refused_with_the_field() {
         ("policy.hold_timeout_s=-1.0", "policy.hold_timeout_s"),
         ("policy.min_separation=-0.1", "policy.min_separation"),
         ("policy.fence_min=[0.0, 0.0]", "policy.fence_min"),
+        ("policy.battery_land_v=3.2", "policy.battery_land_v"),
+        ("policy.battery_land_s=-1", "policy.battery_land_s"),
+        ("battery.full_v=3.0", "battery.full_v"),
+        ("battery.flight_time_s=0", "battery.flight_time_s"),
     ] {
         let e = room(&[set]).expect_err(set);
         assert!(
@@ -102,6 +163,14 @@ fn bad_policy_values_are_refused_with_the_field() {
     let e = room(&["policy.fence_min=[2.0, 0.0]", "policy.fence_max=[1.0, 3.0]"])
         .expect_err("inverted fence");
     assert!(e.contains("policy.fence_max"), "{e}");
+    // A battery's voltages must fall in flight.
+    let e = room(&[
+        "battery.full_v=3.0",
+        "battery.empty_v=3.5",
+        "battery.flight_time_s=60",
+    ])
+    .expect_err("inverted battery");
+    assert!(e.contains("battery.full_v"), "{e}");
     let e = room(&["policy.hold_timeout=1"]).expect_err("unknown key");
     assert!(e.contains("hold_timeout"), "{e}");
 }

@@ -216,6 +216,7 @@ pub fn drive(
     };
     let steady_control = engine.control_stats().window;
     let channel = engine.channel_stats();
+    let policy = engine.policy_counts();
     let (q, v, est) = engine.view();
     let verdict = sim
         .monitor
@@ -240,6 +241,9 @@ pub fn drive(
         if let Some(note) = view_note(model, &at) {
             reason = format!("{reason}; {note}");
         }
+    }
+    if let Some(note) = super::policy::landings_note(&policy, model) {
+        reason = format!("{reason}; {note}");
     }
     let tri = model.triangles.iter().map(|t| t.vertices);
     let s = &sim.diag.snap;
@@ -277,7 +281,7 @@ pub fn drive(
         control: engine.control_stats(),
         channel,
         attacks: engine.attack_counts(),
-        policy: engine.policy_counts(),
+        policy,
         warnings,
         steps: sim.steps,
         wall_seconds: started.elapsed().as_secs_f64(),

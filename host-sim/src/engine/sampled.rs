@@ -201,7 +201,9 @@ impl<'m> SampledSim<'m> {
             stats: ControlStats::with_window(crate::analysis::steady::Window::of(model).from),
             direct,
             local: false,
-            policy: model.policy.map(|c| super::policy::PolicyRun::new(c, n)),
+            policy: model
+                .policy
+                .map(|c| super::policy::PolicyRun::new(c, n, model.battery)),
         })
     }
 

@@ -6,6 +6,7 @@
 //! `AgentModel::id` is the controller-core id used on the wire.
 
 pub mod attack;
+mod battery;
 pub mod channel;
 mod core_config;
 mod criteria;
@@ -23,6 +24,7 @@ pub mod wire_ids;
 pub mod world;
 
 pub use attack::{AttackKind, AttackModel};
+pub use battery::BatteryModel;
 pub use channel::{Access, ChannelModel, IntegrityMode};
 pub use core_config::{CoreAgent, MT, NB};
 pub use criteria::Criteria;
@@ -101,6 +103,8 @@ pub struct Model {
     pub world: WorldModel,
     /// The vehicles' safety policies (`[policy]`; `None`: none run).
     pub policy: Option<ph_formation_core::policy::PolicyConfig<f64>>,
+    /// The vehicles' battery (`[battery]`; `None`: none modelled, no low-battery policy).
+    pub battery: Option<BatteryModel>,
 }
 
 impl Model {

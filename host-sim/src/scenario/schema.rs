@@ -277,6 +277,9 @@ pub struct ScenarioFile {
     /// `[policy]`: the vehicles' safety policies (optional).
     #[serde(default)]
     pub policy: Option<super::policy::PolicySpec>,
+    /// `[battery]`: the vehicles' battery (optional).
+    #[serde(default)]
+    pub battery: Option<super::policy::BatterySpec>,
 }
 
 /// `[target]`: the target shape, one `[x, y]` per agent in `[[agents]]` order; compared

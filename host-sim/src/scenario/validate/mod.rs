@@ -66,6 +66,7 @@ fn check(
     let auth_key = comm::auth_key(&mut c, s);
     let world = world::check(&mut c, s, period);
     let policy = policy::check(&mut c, s);
+    let battery = policy::battery(&mut c, s);
     let (mut agents, index) = agents::check(&mut c, s);
     let camera = camera::check(&mut c, s, &agents);
     let positions = positions::check(&mut c, s);
@@ -150,6 +151,7 @@ fn check(
         target,
         world,
         policy,
+        battery,
     };
     model.sensors.bearing_filter = bearing_filter(se, &model.sensing_noise());
     // Last line of defence, shared with generated models (`model::check_model`): wire

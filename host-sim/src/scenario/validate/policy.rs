@@ -1,10 +1,33 @@
 //! `[policy]`: each value in range, resolved into the core's `PolicyConfig`.
 
 use super::checker::Checker;
-use crate::model::Mode;
+use crate::model::{BatteryModel, Mode};
 use crate::scenario::error::ErrorKind::InvalidValue;
 use crate::scenario::ScenarioFile;
 use ph_formation_core::policy::PolicyConfig;
+
+/// `[battery]`, if the scenario has one: full above empty above 0, a positive flight
+/// time.
+pub(super) fn battery(c: &mut Checker<'_>, s: &ScenarioFile) -> Option<BatteryModel> {
+    let b = s.battery.as_ref()?;
+    c.positive(InvalidValue, "battery.empty_v", b.empty_v);
+    c.positive(InvalidValue, "battery.flight_time_s", b.flight_time_s);
+    if !(b.full_v.is_finite() && b.full_v > b.empty_v) {
+        c.err(
+            InvalidValue,
+            "battery.full_v",
+            format!(
+                "must be a finite voltage above empty_v = {} V, got {}",
+                b.empty_v, b.full_v
+            ),
+        );
+    }
+    Some(BatteryModel {
+        full: b.full_v,
+        empty: b.empty_v,
+        flight_time: b.flight_time_s,
+    })
+}
 
 /// The policies of `s`, if it has a `[policy]` table.
 pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile) -> Option<PolicyConfig<f64>> {
@@ -50,16 +73,35 @@ pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile) -> Option<PolicyConfi
             (false, [0.0; 2], [0.0; 2])
         }
     };
+    c.non_negative(InvalidValue, "policy.battery_land_v", p.battery_land_v);
+    c.non_negative(InvalidValue, "policy.battery_land_s", p.battery_land_s);
+    let battery_ms = (p.battery_land_s * 1000.0).round();
+    if battery_ms > f64::from(u32::MAX) {
+        c.err(
+            InvalidValue,
+            "policy.battery_land_s",
+            format!("must be at most 4294967 s, got {}", p.battery_land_s),
+        );
+    }
+    if p.battery_land_v > 0.0 && s.battery.is_none() {
+        c.err(
+            InvalidValue,
+            "policy.battery_land_v",
+            "the low-battery landing reads the battery's voltage: add a [battery] table \
+             (or world = \"crazyflie\", which has one), or set battery_land_v = 0",
+        );
+    }
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // checked above
     let hold_timeout_ms = hold_ms.clamp(0.0, f64::from(u32::MAX)) as u32;
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // checked above
+    let battery_ms = battery_ms.clamp(0.0, f64::from(u32::MAX)) as u32;
     Some(PolicyConfig {
         hold_timeout_ms,
         fence,
         fence_min: lo,
         fence_max: hi,
-        // The simulator has no battery.
-        battery_land: 0.0,
-        battery_ms: 0,
+        battery_land: p.battery_land_v,
+        battery_ms,
         min_separation: p.min_separation,
     })
 }
