@@ -1,0 +1,231 @@
+//! Figures and claims of README.md and docs/*.md that the code produces, read back from
+//! the docs and compared with a run or a constant (issue 40 item 5):
+//! * README.md: the paper run ("every angle error below 1e-3 rad from t ≈ X s, … |z − z*|
+//!   ≈ A m and |v − v*| ≈ B m/s", the number of plots), the exit codes it lists, and the
+//!   agent's RAM (`PH_AGENT_SIZE` of the header's Cortex-M branch);
+//! * docs/outputs.md: the exit code of every outcome;
+//! * docs/sensors.md: the camera table (every row run, seed 1, 100 s);
+//! * crazyflie-app/README.md: what the controller does with the bearings it is given
+//!   (the exported blobs' bearing filter: the tracker).
+//!
+//! docs/outputs.md's reference figures are read back by `scenarios.rs`, the noise-free
+//! tracker's by `sensors.rs`, docs/radio.md's broadcast rates by `channel.rs`.
+
+#[path = "support/docs.rs"]
+mod docs;
+
+use ph_formation_sim::{load, Outcome, Simulation};
+use std::path::Path;
+
+fn readme() -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md");
+    std::fs::read_to_string(path).expect("README.md")
+}
+
+/// The number written after `before` (up to `after`), e.g. `t ≈ ` … ` s`.
+fn figure(text: &str, before: &str, after: &str) -> f64 {
+    let flat = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    let start = flat
+        .find(before)
+        .unwrap_or_else(|| panic!("README: no `{before}`"))
+        + before.len();
+    let rest = &flat[start..];
+    rest[..rest.find(after).expect("end")]
+        .trim()
+        .parse()
+        .expect("a number")
+}
+
+/// `x` rounds to `shown` at `shown`'s precision (one significant digit for `2e-5`).
+fn rounds_to(x: f64, shown: f64, digits: i32) -> bool {
+    let scale = 10f64.powi(shown.abs().log10().floor() as i32 - digits + 1);
+    ((x / scale).round() * scale - shown).abs() < 1e-9 * shown.abs()
+}
+
+#[test]
+fn the_readme_figures_of_the_paper_run_are_true() {
+    let text = readme();
+    let words = [
+        "one", "two", "three", "four", "five", "six", "seven", "eight", "nine",
+    ];
+    let flat = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    let plots = words
+        .iter()
+        .position(|w| flat.contains(&format!("`summary.json`, {w} plots (PNG and SVG)")))
+        .map(|k| k + 1)
+        .expect("README: `summary.json`, N plots (PNG and SVG)");
+    let settle = figure(&text, "every angle error below 1e-3 rad from t ≈", " s");
+    let z = figure(&text, "|z − z*| ≈", " m");
+    let v = figure(&text, "|v − v*| ≈", " m/s");
+
+    let model = ph_formation_sim::load("paper", &[]).expect("paper");
+    let dir = tempfile::tempdir().expect("tempdir");
+    let run = ph_formation_sim::Simulation::new(&model)
+        .keep_series(false)
+        .write_to(dir.path(), ph_formation_sim::WriteOptions::default())
+        .run()
+        .expect("run");
+    let r = &run.result;
+    let pngs = run
+        .files
+        .iter()
+        .filter(|f| f.extension().is_some_and(|e| e == "png"))
+        .count();
+    assert_eq!(pngs, plots, "README says {plots} plots");
+    assert!(dir.path().join("replay.html").is_file());
+    let got = r.settle_time.expect("settles");
+    assert!(
+        rounds_to(got, settle, 4),
+        "settle time {got} s, README {settle} s"
+    );
+    let summary = run.summary_json(&model);
+    let dz = summary["final_displacement_error"].as_f64().expect("dz");
+    let dv = summary["final_velocity_error"].as_f64().expect("dv");
+    assert!(rounds_to(dz, z, 1), "|z − z*| {dz}, README {z}");
+    assert!(rounds_to(dv, v, 1), "|v − v*| {dv}, README {v}");
+}
+
+/// `docs::shows` prints a value at the doc's precision (its negative control: a value
+/// that rounds otherwise is refused).
+#[test]
+fn a_figure_shows_at_the_docs_precision() {
+    assert!(docs::shows(40.85, "40.85") && !docs::shows(40.86, "40.85"));
+    assert!(docs::shows(5.462e-7, "5.5e-7") && !docs::shows(5.3e-7, "5.5e-7"));
+    assert!(docs::shows(0.0, "0") && !docs::shows(0.3, "0"));
+}
+
+/// The outcome named by `words` (`"not converged"`, `` "`not_converged`" ``).
+fn outcome_named(words: &str) -> Option<Outcome> {
+    let name = words.trim().trim_matches('`').replace(' ', "_");
+    Outcome::ALL.iter().copied().find(|o| o.as_str() == name)
+}
+
+#[test]
+fn the_exit_codes_of_the_readme_and_outputs_md_are_the_outcomes() {
+    // README.md: "the exit code names the outcome (0 converged, 10 not converged, …; 2x".
+    let readme = docs::read("README.md");
+    let list = docs::between(&readme, "the exit code names the outcome (", "; 2x");
+    let mut named = Vec::new();
+    for item in list.split(", ") {
+        let (code, words) = item.split_once(' ').expect("CODE outcome");
+        let o = outcome_named(words).unwrap_or_else(|| panic!("README: {words:?}"));
+        assert_eq!(
+            code.parse::<u8>().ok(),
+            Some(o.exit_code()),
+            "README: {item}"
+        );
+        named.push(o);
+    }
+    // docs/outputs.md's table: `| 10 | `not_converged` |`.
+    let outputs = docs::read("docs/outputs.md");
+    let rows = docs::table_after(&outputs, "## Exit codes");
+    for o in Outcome::ALL {
+        assert!(
+            named.contains(o),
+            "README names no exit code for {}",
+            o.as_str()
+        );
+        let row = rows
+            .iter()
+            .find(|r| {
+                r[1].split_whitespace()
+                    .next()
+                    .and_then(|w| outcome_named(w.trim_end_matches(':')))
+                    == Some(*o)
+            })
+            .unwrap_or_else(|| panic!("docs/outputs.md: no exit code row for {}", o.as_str()));
+        assert_eq!(row[0].parse::<u8>().ok(), Some(o.exit_code()), "{row:?}");
+    }
+}
+
+#[test]
+fn the_readme_states_the_headers_agent_size() {
+    let readme = docs::read("README.md");
+    let stated = docs::number(&readme, "`PH_AGENT_SIZE` =", "bytes on Cortex-M");
+    let header = docs::read("controller-ffi/include/ph_formation.h");
+    let branch = &header[header.find("#if defined(PH_PTR32)").expect("32-bit branch")..];
+    let size = docs::number(branch, "#define PH_AGENT_SIZE", "#endif");
+    assert_eq!(stated, size, "README.md against ph_formation.h");
+}
+
+/// crazyflie-app/README.md: the app leaves `rate` and `range` unset and "the controller's
+/// bearing tracker (SPEC §11, σ_b = 2°: the exported blobs', …)" estimates the rates: every
+/// exported blob carries the tracker with that σ_b.
+#[test]
+fn the_crazyflie_apps_blobs_track_bearings() {
+    let readme = docs::read("crazyflie-app/README.md");
+    let sigma = docs::number(
+        &readme,
+        "the controller's bearing tracker (SPEC §11, σ_b =",
+        "°",
+    );
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../crazyflie-app/src/blobs");
+    let mut blobs = 0;
+    for entry in std::fs::read_dir(&dir).expect("blobs") {
+        let path = entry.expect("entry").path();
+        if path.extension().is_some_and(|e| e == "blob") {
+            let bytes = std::fs::read(&path).expect("blob");
+            let config = ph_formation_ffi::blob::decode_blob(&bytes).expect("a valid blob");
+            match config.bearing_filter {
+                ph_formation_core::BearingFilter::Tracker(t) => {
+                    let deg = f64::from(t.bearing_noise).to_degrees();
+                    assert!((deg - sigma).abs() < 1e-5, "{}: σ_b {deg}°", path.display());
+                }
+                other => panic!("{}: {other:?}", path.display()),
+            }
+            blobs += 1;
+        }
+    }
+    assert_eq!(blobs, 4);
+}
+
+/// docs/sensors.md's camera table: every row is one run of `formation-only` (seed 1,
+/// 100 s) with the row's `KEY = VALUE` settings (a key without a dot is a
+/// `sensors.camera` key); its outcome, settle time (where the row shows one) and safe
+/// agent-ticks are the run's. The all-defaults camera gives the camera-less run's bits.
+#[test]
+fn the_camera_table_of_sensors_md_is_measured() {
+    let doc = docs::read("docs/sensors.md");
+    let total = docs::number(&doc, "in the safe output after the start, of", "(4 agents");
+    let plain = Simulation::new(&load("formation-only", &[]).expect("formation-only"))
+        .run()
+        .expect("run")
+        .result;
+    // 4 agents, a tick every 10 ms over 100 s and one at t = 0.
+    assert_eq!(total, 4.0 * (100.0 * 100.0 + 1.0));
+    assert_eq!(plain.control.ticks as f64, total);
+    let rows = docs::table_after(&doc, "| camera | outcome | settle (s) | safe |");
+    assert!(rows.len() >= 10, "{rows:?}");
+    for row in rows {
+        let overrides: Vec<String> = row[0]
+            .split('`')
+            .skip(1)
+            .step_by(2)
+            .filter_map(|kv| kv.split_once(" = "))
+            .map(|(k, v)| {
+                let key = if k.contains('.') {
+                    k.to_owned()
+                } else {
+                    format!("sensors.camera.{k}")
+                };
+                format!("{key}={v}")
+            })
+            .collect();
+        assert!(!overrides.is_empty(), "{row:?}");
+        let m = load("formation-only", &overrides).unwrap_or_else(|e| panic!("{row:?}: {e}"));
+        let r = Simulation::new(&m).run().expect("run").result;
+        let outcome = row[1].split_whitespace().next().unwrap_or_default();
+        assert_eq!(outcome, r.outcome.as_str(), "{row:?}: {}", r.reason);
+        if let Some(settle) = docs::parse(&row[2]) {
+            let got = r.settle_time.unwrap_or(f64::NAN);
+            assert!(docs::shows(got, &row[2]), "{row:?}: settle {got} s");
+            assert!(settle > 0.0);
+        }
+        let safe = docs::parse(&row[3]).expect("safe agent-ticks");
+        assert_eq!(r.control.safe_after_start as f64, safe, "{row:?}");
+        if row[1].contains("bits of the camera-less run") {
+            assert_eq!(r.final_positions, plain.final_positions, "{row:?}");
+            assert_eq!(r.final_velocities, plain.final_velocities, "{row:?}");
+        }
+    }
+}
