@@ -54,7 +54,9 @@ fn forged_frames_with_crc16_pull_the_formation_out_of_shape() {
         r.outcome.as_str(),
         r.frames.by_reason
     );
-    assert_ne!(r.outcome, Outcome::Converged, "{}", r.reason);
+    // The forged efforts hold the formation in another shape: it moves and settles, but
+    // not into the target (not a collision, not a collapse).
+    assert_eq!(r.outcome, Outcome::NotConverged, "{}", r.reason);
     assert!(d > 1.0, "the forged run ends {d} m from the clean shape");
     // One forgery per broadcast of agent 3 from t = 10 s (100 Hz): 9,000.
     assert_eq!(r.attacks.len(), 1);
