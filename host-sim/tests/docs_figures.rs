@@ -229,3 +229,85 @@ fn the_camera_table_of_sensors_md_is_measured() {
         }
     }
 }
+
+/// One row of docs/sensors.md's tolerance tables: formation, noise (°), loss (%),
+/// converged of 100, largest final angle error (°).
+type ToleranceRow = (String, f64, f64, f64, f64);
+
+/// The rows of every table of docs/sensors.md's "What the formations tolerate".
+fn tolerance_rows(doc: &str) -> Vec<ToleranceRow> {
+    let start = doc
+        .find("## What the formations tolerate")
+        .expect("section");
+    let end = doc
+        .find("### The honest verdict's camera check")
+        .expect("end");
+    let mut rows = Vec::new();
+    let mut formation = String::new();
+    for line in doc[start..end].lines() {
+        if let Some(h) = line.strip_prefix("### ") {
+            formation = h.to_owned();
+        }
+        let c = docs::cells(line);
+        if line.starts_with("| ") && c.len() == 6 && c[0].ends_with('°') {
+            let num = |s: &str| docs::parse(s.split(['°', '%', '/']).next().unwrap_or(s));
+            let (Some(noise), Some(loss), Some(runs), Some(conv)) =
+                (num(&c[0]), num(&c[1]), num(&c[2]), num(&c[3]))
+            else {
+                panic!("{line}")
+            };
+            assert_eq!(runs, 100.0, "{line}");
+            let largest = docs::parse(c[5].split('/').nth(1).expect("median / max"));
+            rows.push((formation.clone(), noise, loss, conv, largest.expect("max")));
+        }
+    }
+    rows
+}
+
+/// README.md and docs/sensors.md's "Result" say what the sweep tables of
+/// docs/sensors.md show (the tables are the sweeps' output, each under its command).
+#[test]
+fn the_tolerance_claims_are_the_sweep_tables() {
+    let doc = docs::read("docs/sensors.md");
+    let rows = tolerance_rows(&doc);
+    assert!(rows.len() >= 50, "{} rows", rows.len());
+    let noisy = |paper: bool| -> Vec<&ToleranceRow> {
+        rows.iter()
+            .filter(|r| r.1 >= 0.5 && (r.0 == "`paper`") == paper)
+            .collect()
+    };
+    let range = |rs: &[&ToleranceRow]| {
+        let lo = rs.iter().map(|r| r.3).fold(f64::INFINITY, f64::min);
+        let hi = rs.iter().map(|r| r.3).fold(0.0, f64::max);
+        format!("{lo}–{hi}")
+    };
+    let (others, paper) = (range(&noisy(false)), range(&noisy(true)));
+    let readme = docs::read("README.md");
+    let said = docs::between(&readme, "lattices converged in", " of 100 runs and `paper`");
+    assert_eq!(said, others, "README.md");
+    let said = docs::between(&readme, "of 100 runs and `paper` in", " (its long");
+    assert_eq!(said, paper, "README.md");
+    let result = docs::between(&doc, "**Result**", "issue 30's table");
+    let said = docs::between(&result, "lattices converged in", " of 100 runs");
+    assert_eq!(said, others, "docs/sensors.md Result");
+    let at = |noise: f64| {
+        rows.iter()
+            .find(|r| r.0 == "`paper`" && r.1 == noise && r.2 == 10.0)
+            .expect("paper row")
+            .3
+    };
+    let two = docs::number(&result, "`paper` converged in", " of 100 at 2°");
+    let five = docs::number(&result, "with 10 % loss and in", " at 5°");
+    assert_eq!((two, five), (at(2.0), at(5.0)), "docs/sensors.md Result");
+    let worst = rows.iter().map(|r| r.4).fold(0.0, f64::max);
+    let worst_2 = rows
+        .iter()
+        .filter(|r| r.1 <= 2.0)
+        .map(|r| r.4)
+        .fold(0.0, f64::max);
+    assert_eq!(
+        docs::number(&result, "largest final angle error was", "°"),
+        worst
+    );
+    assert_eq!(docs::number(&result, "at most", "° at 2°"), worst_2);
+}
