@@ -149,7 +149,10 @@ fn paper_converges_into_the_square_not_its_mirror() {
 fn paper_printed_fails_and_names_the_cause() {
     let r = run(&model("paper-printed", &[]));
     assert_eq!(r.outcome, Outcome::EstimateCollapse, "{}", r.reason);
-    assert_eq!(r.outcome.exit_code(), 12);
+    // README.md: "run paper-printed   # the printed gains: reported as a failure, exit 12".
+    let readme = docs::read("README.md");
+    let code = docs::number(&readme, "reported as a failure, exit", " cargo");
+    assert_eq!(f64::from(r.outcome.exit_code()), code, "README.md");
     assert_eq!(r.min_estimate, Some(0.1));
     assert!(
         r.final_time < 5.0,
