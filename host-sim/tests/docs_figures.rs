@@ -73,6 +73,16 @@ fn the_readme_figures_of_the_paper_run_are_true() {
         .count();
     assert_eq!(pngs, plots, "README says {plots} plots");
     assert!(dir.path().join("replay.html").is_file());
+    // docs/outputs.md: "`host-sim run paper`: 0.46 MB" (10⁶ bytes).
+    let outputs = docs::read("docs/outputs.md");
+    let mb = docs::between(&outputs, "`host-sim run paper`:", " MB;");
+    let bytes = std::fs::metadata(dir.path().join("replay.html"))
+        .expect("replay")
+        .len();
+    assert!(
+        docs::shows(bytes as f64 / 1e6, &mb),
+        "replay.html: {bytes} bytes, docs/outputs.md {mb} MB"
+    );
     let got = r.settle_time.expect("settles");
     assert!(
         rounds_to(got, settle, 4),
@@ -310,4 +320,19 @@ fn the_tolerance_claims_are_the_sweep_tables() {
         worst
     );
     assert_eq!(docs::number(&result, "at most", "° at 2°"), worst_2);
+}
+
+/// README.md: "one frame of at most 60 bytes per tick (wire version 4" are the core's
+/// constants.
+#[test]
+fn the_readme_states_the_wire_constants() {
+    let readme = docs::read("README.md");
+    let len = docs::number(
+        &readme,
+        "one frame of at most",
+        " bytes per tick (wire version",
+    );
+    let version = docs::number(&readme, "bytes per tick (wire version", ", postcard");
+    assert_eq!(len, ph_formation_core::wire::MAX_FRAME_LEN as f64);
+    assert_eq!(version, f64::from(ph_formation_core::wire::WIRE_VERSION));
 }
