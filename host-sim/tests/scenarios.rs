@@ -169,6 +169,14 @@ fn paper_printed_fails_and_names_the_cause() {
     let readme = docs::read("README.md");
     let said = docs::between(&readme, "make the estimates collapse", "as [SPEC §9]");
     assert_events_at("README.md", &said, &times);
+    // docs/outputs.md quotes this run's `outcome_reason` word for word.
+    let outputs = docs::read("docs/outputs.md");
+    let quoted = docs::between(&outputs, "e.g. for `paper-printed`: \"", "\". ");
+    assert_eq!(
+        quoted,
+        docs::flat(&r.reason),
+        "docs/outputs.md's example reason"
+    );
     let table = docs::read("docs/scenarios.md");
     let said = docs::row(&table, "`paper-printed`")[2].clone();
     assert_events_at("docs/scenarios.md", &said, &times);
