@@ -4,6 +4,8 @@
 //! packets' share of the shared channel, the same bits on 1 and 4 threads), and bad
 //! settings refused with file, field and reason.
 
+#[path = "support/docs.rs"]
+mod docs;
 mod support;
 use ph_formation_core::Vec2;
 use ph_formation_sim::engine::radio::RadioFrame;
@@ -207,13 +209,110 @@ fn the_position_packets_are_load_on_the_shared_channel() {
         // One packet per agent per tick, each its air time on the channel.
         let packets = (m.n() * ticks) as u64;
         assert_eq!(tx1 - tx0, packets, "{bytes} bytes");
-        let share = packets as f64 * air.air_time(bytes);
+        // Closed form: a packet is its bytes plus the channel's overhead at its bit rate.
+        let share = packets as f64 * (bytes as f64 + air.overhead_bytes) * 8.0 / air.bit_rate;
         assert!(
             ((air1 - air0) - share).abs() < 1e-9 * share,
             "{bytes} bytes: {} s more, expected {share} s",
             air1 - air0
         );
     }
+}
+
+/// docs/crazyflie.md, "The packets' share of the channel", on `crazyflie-app/formation.toml`
+/// over 60 s: the packets' air time is their closed form (`24,004` = 4 agents × 6,001
+/// ticks, each `(packet_bytes + overhead) · 8 / bit rate` = 84.5 µs), the utilisation
+/// with and without them and ALOHA's collided link copies are the doc's (link copies:
+/// 6,001 ticks × 10 links of the square's graph, twice with the packets).
+#[test]
+fn the_crazyflie_channel_figures_of_crazyflie_md_are_measured() {
+    let square = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../crazyflie-app/formation.toml"
+    );
+    let doc = docs::read("docs/crazyflie.md");
+    let para = docs::between(
+        &doc,
+        "The packets' share of the channel:",
+        "the bearings survive it",
+    );
+    let runs = |access: &str, positions: bool| {
+        let mut sets = vec![
+            "radio.channel.preset=crazyflie".to_owned(),
+            format!("radio.channel.access={access}"),
+        ];
+        if positions {
+            sets.push("sensors.bearing_source=shared_positions".to_owned());
+        }
+        let m = load(square, &sets).expect("load");
+        let r = run(&m, &mut NullRecorder, &mut |_| {}).expect("run");
+        (m, r)
+    };
+    let (m, plain) = runs("aloha", false);
+    let (_, with) = runs("aloha", true);
+    let ch = m.radio.channel.as_ref().expect("channel");
+    let bytes = m.sensors.positions.as_ref().map_or(10, |p| p.packet_bytes);
+    let ticks = (m.duration / m.control_period()).round() as u64 + 1;
+    let packets = m.n() as u64 * ticks;
+    let each = (bytes as f64 + ch.overhead_bytes) * 8.0 / ch.bit_rate;
+    assert_eq!(
+        docs::number(&para, "air time per 60 s:", " packets of"),
+        packets as f64
+    );
+    assert!(docs::shows(
+        each * 1e6,
+        &docs::between(&para, "packets of", " µs")
+    ));
+    let (a, b) = (
+        plain.channel.expect("channel"),
+        with.channel.expect("channel"),
+    );
+    // The packets' air time, and the run's extra air time within the formation frames
+    // of one tick of the four agents (60 bytes each): before any position is heard the
+    // frames carry fewer items than with the ideal sensor (measured: 60 bytes fewer).
+    let packets_air = packets as f64 * each;
+    let extra = b.air_time - a.air_time;
+    let slack = m.n() as f64 * 60.0 * 8.0 / ch.bit_rate;
+    assert!(
+        (extra - packets_air).abs() <= slack,
+        "{extra} s vs {packets_air} s"
+    );
+    assert!(docs::shows(
+        packets_air,
+        &docs::between(&para, "9.0 % (", " s of air time")
+    ));
+    // Utilisation: air time over the run's time (docs/outputs.md).
+    let util = |air: f64, t: f64| format!("{:.1}", 100.0 * air / t);
+    let said = docs::between(&para, "utilisation from", " s of air time");
+    assert!(
+        said.starts_with(&format!(
+            "{} % to {} %",
+            util(a.air_time, plain.final_time),
+            util(b.air_time, with.final_time)
+        )),
+        "{said}"
+    );
+    // ALOHA's collisions: "from 8.3 % (4,986 of 60,010) to 13.6 % (16,322 of 120,020".
+    let links: u64 = 10;
+    assert_eq!(
+        (plain.frames.sent, with.frames.sent),
+        (ticks * links, 2 * ticks * links)
+    );
+    let copies = docs::between(&para, "lost to collisions from", ", packets included");
+    let stated: Vec<f64> = copies
+        .split(|c: char| !(c.is_ascii_digit() || c == ',' || c == '.'))
+        .filter_map(docs::parse)
+        .collect();
+    let pct = |c: u64, n: u64| (100.0 * c as f64 / n as f64 * 10.0).round() / 10.0;
+    let want = [
+        pct(a.collided, plain.frames.sent),
+        a.collided as f64,
+        plain.frames.sent as f64,
+        pct(b.collided, with.frames.sent),
+        b.collided as f64,
+        with.frames.sent as f64,
+    ];
+    assert_eq!(stated, want, "docs/crazyflie.md: {copies}");
 }
 
 use support::bits;
