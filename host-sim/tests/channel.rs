@@ -387,3 +387,98 @@ fn a_channel_run_is_reproducible_bit_for_bit() {
     assert!(files[0] == files[1], "same seed, different output");
     assert!(files[0].0 != files[2].0, "the seed changes nothing");
 }
+
+/// One row of docs/radio.md's shared-channel tables against its run: `scenario` with the
+/// row's access and broadcast rate (and, below 25 Hz, the neighbour timeout of 2.5
+/// broadcast periods the commands use). Outcome exact, figures at the precision shown
+/// (deterministic runs); the payload in closed form from the air time (`air =
+/// transmissions · (payload + overhead) · 8 / bit rate`).
+fn check_channel_row(scenario: &str, row: &[String]) {
+    let c: Vec<String> = row.iter().map(|c| c.replace("**", "")).collect();
+    let hz: f64 = c[1].parse().expect("comm rate");
+    let mut sets = vec![
+        "radio.channel.preset=crazyflie".to_owned(),
+        format!("radio.channel.access={}", c[0]),
+        "controller.integrity=link".to_owned(),
+        format!("controller.comm_rate_hz={hz}"),
+    ];
+    if hz <= 20.0 {
+        sets.push(format!("controller.neighbour_timeout={}", 2.5 / hz));
+    }
+    let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+    let m = model(scenario, &sets);
+    let r = run(&m);
+    let what = format!("docs/radio.md {scenario} {} {hz} Hz", c[0]);
+    let outcome = c[2].trim_end_matches(" in 60 s").replace(' ', "_");
+    assert_eq!(outcome, r.outcome.as_str(), "{what}: {}", r.reason);
+    let unit = |s: &str, u: &str| s.trim_end_matches(u).trim().to_owned();
+    if c[3] != "—" {
+        let settle = r.settle_time.expect("settled");
+        assert!(
+            docs::shows(settle, &unit(&c[3], " s")),
+            "{what}: settle {settle}"
+        );
+    }
+    assert!(
+        docs::shows(r.final_max_angle_error, &c[4]),
+        "{what}: {}",
+        r.final_max_angle_error
+    );
+    let ch = r.channel.as_ref().expect("channel");
+    let cm = m.radio.channel.as_ref().expect("channel");
+    let payload = ch.air_time * cm.bit_rate / 8.0 / ch.transmissions as f64 - cm.overhead_bytes;
+    assert!(
+        docs::shows(payload, &unit(&c[5], " B")),
+        "{what}: payload {payload}"
+    );
+    let util = 100.0 * ch.air_time / r.final_time;
+    assert!(
+        docs::shows(util, &unit(&c[6], " %")),
+        "{what}: utilisation {util}"
+    );
+    let lost = c[7].split(" (").next().expect("count");
+    assert_eq!(docs::parse(lost), Some(ch.collided as f64), "{what}");
+    if let Some(pct) = c[7].split(" (").nth(1) {
+        let pct = pct.split(" %").next().expect("%");
+        let share = 100.0 * ch.collided_transmissions as f64 / ch.transmissions as f64;
+        assert!(docs::shows(share, pct), "{what}: {share} % of tx");
+    }
+    let (mean, worst) = unit(&c[8], " ms")
+        .split_once(" / ")
+        .map(|(a, b)| (a.to_owned(), b.to_owned()))
+        .expect("mean / worst");
+    assert!(
+        docs::shows(ch.mean_age * 1e3, &mean),
+        "{what}: mean age {}",
+        ch.mean_age
+    );
+    assert!(
+        docs::shows(ch.max_age * 1e3, &worst),
+        "{what}: worst age {}",
+        ch.max_age
+    );
+}
+
+/// docs/radio.md's shared-channel tables: every row of the paper's (12 runs of 100 s)
+/// and of the 20-agent strip's (14 runs of 60 s), on every core.
+#[test]
+fn the_shared_channel_tables_of_radio_md_are_measured() {
+    use rayon::prelude::*;
+    let doc = docs::read("docs/radio.md");
+    let header = "| access | comm (Hz) | outcome |";
+    let paper = &doc[doc
+        .find("### The paper formation (4 agents)")
+        .expect("paper")..];
+    let rows = docs::table_after(paper, header);
+    assert_eq!(rows.len(), 12);
+    let strip = &doc[doc.find("### 20 agents").expect("strip")..];
+    let strip_rows = docs::table_after(strip, header);
+    assert_eq!(strip_rows.len(), 14);
+    let strip20 = strip20();
+    let jobs: Vec<(&str, &Vec<String>)> = rows
+        .iter()
+        .map(|r| ("paper", r))
+        .chain(strip_rows.iter().map(|r| (strip20.as_str(), r)))
+        .collect();
+    jobs.par_iter().for_each(|(s, r)| check_channel_row(s, r));
+}
