@@ -4,6 +4,7 @@
 //!   ≈ A m and |v − v*| ≈ B m/s", the number of plots), the exit codes it lists, and the
 //!   agent's RAM (`PH_AGENT_SIZE` of the header's Cortex-M branch);
 //! * docs/outputs.md: the exit code of every outcome;
+//! * docs/spec.md §9: the built-in `paper` and `paper-printed` scenario files;
 //! * docs/sensors.md: the camera table (every row run, seed 1, 100 s);
 //! * crazyflie-app/README.md: what the controller does with the bearings it is given
 //!   (the exported blobs' bearing filter: the tracker).
@@ -335,4 +336,107 @@ fn the_readme_states_the_wire_constants() {
     let version = docs::number(&readme, "bytes per tick (wire version", ", postcard");
     assert_eq!(len, ph_formation_core::wire::MAX_FRAME_LEN as f64);
     assert_eq!(version, f64::from(ph_formation_core::wire::WIRE_VERSION));
+}
+
+/// `scenarios/NAME.toml` (the built-ins' text) as a TOML value.
+fn scenario(name: &str) -> toml::Value {
+    let text = docs::read(&format!("host-sim/scenarios/{name}.toml"));
+    toml::from_str(&text).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+/// A number or an array of numbers of a TOML value at `path` (`"leader.displacement"`).
+fn numbers(v: &toml::Value, path: &str) -> Vec<f64> {
+    let mut at = v;
+    for key in path.split('.') {
+        at = at.get(key).unwrap_or_else(|| panic!("no {path}"));
+    }
+    let one = |x: &toml::Value| x.as_float().or(x.as_integer().map(|i| i as f64));
+    match at.as_array() {
+        Some(a) => a.iter().map(|x| one(x).expect("number")).collect(),
+        None => vec![one(at).expect("number")],
+    }
+}
+
+/// The numbers of a spec expression such as `(0.9, 2.2)`, `1.8 I` or `(10, −10)`.
+fn spec_numbers(s: &str) -> Vec<f64> {
+    s.replace('−', "-")
+        .split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
+        .filter_map(|w| w.parse().ok())
+        .collect()
+}
+
+/// SPEC §9 (the reference scenario) is the built-in `paper` and `paper-printed`:
+/// initial positions, desired angles, leader, v*, the paper's and our constants, and
+/// both sets of gains.
+#[test]
+fn spec_section_9_is_the_built_in_paper() {
+    let spec = docs::read("docs/spec.md");
+    let s9 = docs::between(&spec, "## 9. Reference scenario", "## 10. Errata");
+    let paper = scenario("paper");
+    let agents = paper["agents"].as_array().expect("agents");
+    for (i, agent) in agents.iter().enumerate() {
+        let stated = spec_numbers(&docs::between(&s9, &format!("q{} = (", i + 1), ")"));
+        assert_eq!(stated, numbers(agent, "position"), "q{}", i + 1);
+    }
+    let says = |before: &str, after: &str| spec_numbers(&docs::between(&s9, before, after));
+    assert_eq!(
+        says("z* = q1 − q2 = (", ")"),
+        numbers(&paper, "leader.displacement")
+    );
+    assert_eq!(says("`v* = (", ")`"), numbers(&paper, "velocity_reference"));
+    assert_eq!(says("`m =", "`"), numbers(&paper, "agent_defaults.mass"));
+    assert_eq!(says("`k_z =", "`"), numbers(&paper, "leader.stiffness"));
+    assert_eq!(says("`D_z =", " I`"), numbers(&paper, "leader.damping"));
+    assert_eq!(
+        says("`D^v =", " I`"),
+        numbers(&paper, "agent_defaults.velocity_damping")
+    );
+    assert_eq!(
+        says("`D^r =", " I`"),
+        numbers(&paper, "agent_defaults.friction")
+    );
+    assert_eq!(
+        says("`r̂(0) =", "`"),
+        numbers(&paper, "controller.initial_estimate")
+    );
+    assert_eq!(
+        says("`r_min =", "`"),
+        numbers(&paper, "controller.min_estimate")
+    );
+    // The angle table: apex and desired (π/2, π/4) per triangle, in the file's order.
+    let mut table = Vec::new();
+    for line in spec
+        .lines()
+        .filter(|l| l.starts_with("| θ") || l.starts_with("| φ"))
+    {
+        let c = docs::cells(line);
+        let apex: f64 = c[2].trim_start_matches("agent ").parse().expect("apex");
+        let desired = match c[3].as_str() {
+            "π/2" => 90.0,
+            "π/4" => 45.0,
+            other => panic!("desired {other}"),
+        };
+        table.push((apex, desired));
+    }
+    let file: Vec<(f64, f64)> = paper["triangles"]
+        .as_array()
+        .expect("triangles")
+        .iter()
+        .flat_map(|t| t["angles"].as_array().expect("angles").clone())
+        .map(|a| (numbers(&a, "apex")[0], numbers(&a, "desired_deg")[0]))
+        .collect();
+    assert_eq!(table, file);
+    for (name, before) in [
+        ("paper", "(the default): `c ="),
+        ("paper-printed", "printed in the paper, `c ="),
+    ] {
+        let stated = spec_numbers(&docs::between(&s9, before, "`. It"));
+        let v = scenario(name);
+        let gains = [
+            numbers(&v, "gains.stiffness")[0],
+            numbers(&v, "gains.damping")[0],
+            numbers(&v, "gains.estimator_gain")[0],
+        ];
+        assert_eq!(stated, gains, "{name}");
+    }
 }
