@@ -440,3 +440,55 @@ fn spec_section_9_is_the_built_in_paper() {
         assert_eq!(stated, gains, "{name}");
     }
 }
+
+/// The 95 % Wilson score interval of `k` successes in `n` runs, in percent.
+fn wilson(k: f64, n: f64) -> (f64, f64) {
+    let z = 1.959_963_985;
+    let p = k / n;
+    let d = 1.0 + z * z / n;
+    let centre = (p + z * z / (2.0 * n)) / d;
+    let half = z * (p * (1.0 - p) / n + z * z / (4.0 * n * n)).sqrt() / d;
+    (100.0 * (centre - half), 100.0 * (centre + half))
+}
+
+/// Every "P [L, H]" (docs/sweeps.md) and "P % (L–H %)" (docs/sensors.md) of a sweep
+/// table is a share of the row's runs with its 95 % Wilson interval, computed here in
+/// closed form (independently of `host-sim`'s statistics) and rounded to whole percent.
+#[test]
+fn the_sweep_tables_intervals_are_wilson_intervals() {
+    let mut checked = 0;
+    for path in ["docs/sweeps.md", "docs/sensors.md"] {
+        let doc = docs::read(path);
+        let mut runs_col = None;
+        for line in doc.lines().filter(|l| l.starts_with('|')) {
+            let c = docs::cells(line);
+            if let Some(i) = c.iter().position(|h| h == "runs") {
+                runs_col = Some(i);
+                continue;
+            }
+            let Some(n) = runs_col.and_then(|i| c.get(i)).and_then(|s| docs::parse(s)) else {
+                continue;
+            };
+            for cell in &c {
+                let parts: Vec<f64> = cell
+                    .split(|ch: char| !(ch.is_ascii_digit() || ch == '.'))
+                    .filter_map(|w| w.parse().ok())
+                    .collect();
+                let shaped = (cell.contains(" [") && cell.ends_with(']'))
+                    || (cell.contains(" % (") && cell.ends_with(" %)"));
+                if !shaped || parts.len() != 3 {
+                    continue;
+                }
+                // The share is rounded to whole percent: the count is the nearest one.
+                let (lo, hi) = wilson((parts[0] / 100.0 * n).round(), n);
+                assert_eq!(
+                    (parts[1], parts[2]),
+                    (lo.round(), hi.round()),
+                    "{path}: {cell} of {n} runs in {line}"
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 100, "{checked} intervals");
+}
