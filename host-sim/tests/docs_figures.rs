@@ -1,16 +1,21 @@
 //! Figures and claims of README.md and docs/*.md that the code produces, read back from
-//! the docs and compared with a run or a constant (issue 40 item 5):
+//! the docs and compared with a run, a constant or a closed form (issue 40 item 5):
 //! * README.md: the paper run ("every angle error below 1e-3 rad from t ≈ X s, … |z − z*|
-//!   ≈ A m and |v − v*| ≈ B m/s", the number of plots), the exit codes it lists, and the
-//!   agent's RAM (`PH_AGENT_SIZE` of the header's Cortex-M branch);
-//! * docs/outputs.md: the exit code of every outcome;
+//!   ≈ A m and |v − v*| ≈ B m/s", the number of plots), the exit codes it lists, the
+//!   agent's RAM (`PH_AGENT_SIZE` of the header's Cortex-M branch), the wire constants,
+//!   the sensor sweeps' ranges (against docs/sensors.md's tables);
+//! * docs/outputs.md: the exit code of every outcome, the paper run's replay size;
 //! * docs/spec.md §9: the built-in `paper` and `paper-printed` scenario files;
-//! * docs/sensors.md: the camera table (every row run, seed 1, 100 s);
+//! * docs/sensors.md: the camera table (every row run, seed 1, 100 s), the "Result";
+//! * docs/sweeps.md, sensors.md, world.md: every 95 % interval (Wilson, closed form);
 //! * crazyflie-app/README.md: what the controller does with the bearings it is given
 //!   (the exported blobs' bearing filter: the tracker).
 //!
-//! docs/outputs.md's reference figures are read back by `scenarios.rs`, the noise-free
-//! tracker's by `sensors.rs`, docs/radio.md's broadcast rates by `channel.rs`.
+//! Elsewhere: docs/outputs.md's reference figures, the README's and scenarios.md's
+//! `paper-printed` in `scenarios.rs`; sensors.md's noise-free tracker in `sensors.rs`;
+//! radio.md's tables in `channel.rs`; attacks.md's in `attacks.rs`; crazyflie.md's
+//! channel figures in `shared_positions.rs`; world.md's cascade in `world.rs` and its
+//! step responses in `vehicle_step.rs`; design.md's N = 10 rows in `design_cli.rs`.
 
 #[path = "support/docs.rs"]
 mod docs;
@@ -451,13 +456,13 @@ fn wilson(k: f64, n: f64) -> (f64, f64) {
     (100.0 * (centre - half), 100.0 * (centre + half))
 }
 
-/// Every "P [L, H]" (docs/sweeps.md) and "P % (L–H %)" (docs/sensors.md) of a sweep
+/// Every "P [L, H]" (docs/sweeps.md, world.md) and "P % (L–H %)" (docs/sensors.md) of a sweep
 /// table is a share of the row's runs with its 95 % Wilson interval, computed here in
 /// closed form (independently of `host-sim`'s statistics) and rounded to whole percent.
 #[test]
 fn the_sweep_tables_intervals_are_wilson_intervals() {
     let mut checked = 0;
-    for path in ["docs/sweeps.md", "docs/sensors.md"] {
+    for path in ["docs/sweeps.md", "docs/sensors.md", "docs/world.md"] {
         let doc = docs::read(path);
         let mut runs_col = None;
         for line in doc.lines().filter(|l| l.starts_with('|')) {
