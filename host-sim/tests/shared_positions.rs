@@ -263,6 +263,29 @@ fn the_crazyflie_channel_figures_of_crazyflie_md_are_measured() {
         each * 1e6,
         &docs::between(&para, "packets of", " µs")
     ));
+    // The app's packet (docs/crazyflie.md: "13 bytes with `crc16`, 27 with `auth`") is the
+    // core's; on the same channel it would take "96.5 µs on the air".
+    use ph_formation_core::wire::{position, Integrity};
+    let crc16 = position::position_len(&Integrity::Crc16);
+    let sizes = docs::between(
+        &doc,
+        "in the core's position packet on P2P port 1 every tick (",
+        " with `auth`",
+    );
+    assert_eq!(
+        sizes,
+        format!("{crc16} bytes with `crc16`, {}", position::MAX_POSITION_LEN)
+    );
+    let app_air = (crc16 as f64 + ch.overhead_bytes) * 8.0 / ch.bit_rate;
+    let said = docs::between(
+        &doc,
+        "the app's packet with `crc16` is 13 bytes,",
+        " µs on the air",
+    );
+    assert!(
+        docs::shows(app_air * 1e6, &said),
+        "{said} µs, closed form {app_air} s"
+    );
     let (a, b) = (
         plain.channel.expect("channel"),
         with.channel.expect("channel"),
