@@ -255,8 +255,8 @@ fn paper_converges_with_20_percent_loss_and_20_ms_latency() {
     assert_reference_row("`paper`, 20 % loss", &r);
     // Each link copy is lost independently with p = 0.2: the count of losses is
     // binomial(n, p); 4 standard deviations (a false alarm once in ~16,000 seeds) from
-    // n p, which a loss rate off by 0.01 already leaves (n ≈ 120,000: σ ≈ 140, 0.01 n =
-    // 1,200).
+    // n p, which a loss rate off by 0.01 already leaves (n = 100,010 link copies: σ ≈ 126,
+    // 0.01 n = 1,000; with p = 0.19 the check fails by 1,093).
     let (n, p) = (r.frames.sent as f64, 0.2);
     let sigma = (n * p * (1.0 - p)).sqrt();
     let lost = r.frames.lost as f64;
