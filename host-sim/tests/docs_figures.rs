@@ -497,3 +497,28 @@ fn the_sweep_tables_intervals_are_wilson_intervals() {
     }
     assert!(checked > 100, "{checked} intervals");
 }
+
+/// README.md's "equations cited as `S1`…`SN` and sections as `SPEC §1`…`§M`" are the
+/// last equation and section of docs/spec.md.
+#[test]
+fn the_readme_cites_the_whole_spec() {
+    let spec = docs::read("docs/spec.md");
+    let last_section = spec
+        .lines()
+        .filter_map(|l| l.strip_prefix("## "))
+        .filter_map(|h| h.split('.').next()?.parse::<u32>().ok())
+        .max()
+        .expect("numbered sections");
+    let last_equation = spec
+        .split(|c: char| !c.is_ascii_alphanumeric())
+        .filter_map(|w| w.strip_prefix('S')?.parse::<u32>().ok())
+        .max()
+        .expect("equations");
+    let readme = docs::read("README.md");
+    let eq = docs::number(&readme, "equations cited as `S1`…`S", "` and sections");
+    let sec = docs::number(&readme, "sections as `SPEC §1`…`§", "` throughout");
+    assert_eq!(
+        (eq, sec),
+        (f64::from(last_equation), f64::from(last_section))
+    );
+}
