@@ -275,6 +275,11 @@ fn the_crazyflie_world_flies_the_apps_square() {
         docs::shows(slow, &said),
         "docs/world.md: {said} s, run {slow} s"
     );
+    let said = docs::between(&doc, "to settle in 14 s (", " s with S21 alone)");
+    assert!(
+        docs::shows(slow, &said),
+        "docs/crazyflie.md: {said} s, run {slow} s"
+    );
     let said = docs::between(&world, "settles in 97 s; with S21b in", " s (");
     assert!(
         docs::shows(got, &said),
