@@ -522,3 +522,21 @@ fn the_readme_cites_the_whole_spec() {
         (f64::from(last_equation), f64::from(last_section))
     );
 }
+
+/// README.md's `list` line and docs/scenarios.md's table name the built-in scenarios,
+/// in order, and each built-in is the file `host-sim/scenarios/NAME.toml`.
+#[test]
+fn the_built_ins_are_the_ones_the_docs_name() {
+    let names: Vec<&str> = ph_formation_sim::BUILTINS.iter().map(|b| b.name).collect();
+    let readme = docs::read("README.md");
+    let said = docs::between(&readme, "-- list #", " cargo");
+    assert_eq!(said, names.join(", "), "README.md");
+    let table = docs::read("docs/scenarios.md");
+    for b in ph_formation_sim::BUILTINS {
+        docs::row(&table, &format!("`{}`", b.name));
+        assert_eq!(
+            b.text,
+            docs::read(&format!("host-sim/scenarios/{}.toml", b.name))
+        );
+    }
+}
