@@ -9,6 +9,9 @@
 //!   shows it.
 //! * Bad `[[attacks]]` entries get errors naming the file, the field and the reason.
 
+#[path = "support/docs.rs"]
+mod docs;
+
 use ph_formation_sim::{load_toml, Model, Outcome, RunResult, Simulation};
 
 const PAPER: &str = include_str!("../scenarios/paper.toml");
@@ -42,10 +45,55 @@ gamma = 5.0
 start = 10.0
 "#;
 
+/// The row of docs/attacks.md's forgery table starting with `first` states `r`: the
+/// outcome (and its exit code), the settle time ("never": none), the final angle error
+/// at the precision shown (deterministic runs), the frames injected and rejected.
+fn assert_forge_row(first: &str, r: &RunResult) {
+    let doc = docs::read("docs/attacks.md");
+    let c = docs::row(&doc, first);
+    let what = format!("docs/attacks.md, {first}");
+    let outcome = c[1].replace("**", "");
+    let name = outcome
+        .split(" (")
+        .next()
+        .expect("outcome")
+        .replace(' ', "_");
+    assert_eq!(name, r.outcome.as_str(), "{what}: {}", r.reason);
+    if let Some(code) = outcome.split("(exit ").nth(1) {
+        let code = code.trim_end_matches(')');
+        assert_eq!(code.parse().ok(), Some(r.outcome.exit_code()), "{what}");
+    }
+    match c[2].as_str() {
+        "never" => assert_eq!(r.settle_time, None, "{what}"),
+        s => {
+            let settle = r.settle_time.expect("settled");
+            assert!(
+                docs::shows(settle, s.trim_end_matches(" s")),
+                "{what}: {settle}"
+            );
+        }
+    }
+    let angle = c[3].trim_end_matches(" rad");
+    assert!(
+        docs::shows(r.final_max_angle_error, angle),
+        "{what}: {}",
+        r.final_max_angle_error
+    );
+    let injected = r.attacks.first().map_or(0, |a| a.injected);
+    assert_eq!(docs::parse(&c[4]).unwrap_or(0.0), injected as f64, "{what}");
+    let rejected = c[5].split(" *").next().expect("rejected");
+    assert_eq!(
+        docs::parse(rejected),
+        Some(r.frames.rejected as f64),
+        "{what}"
+    );
+}
+
 #[test]
 fn forged_frames_with_crc16_pull_the_formation_out_of_shape() {
     let clean = run(&model(""));
     assert_eq!(clean.outcome, Outcome::Converged, "{}", clean.reason);
+    assert_forge_row("none (clean run", &clean);
     let m = model(FORGE);
     let r = run(&m);
     let d = shape_difference(&r, &clean);
@@ -54,7 +102,10 @@ fn forged_frames_with_crc16_pull_the_formation_out_of_shape() {
         r.outcome.as_str(),
         r.frames.by_reason
     );
-    assert_ne!(r.outcome, Outcome::Converged, "{}", r.reason);
+    // The forged efforts hold the formation in another shape: it moves and settles, but
+    // not into the target (not a collision, not a collapse).
+    assert_eq!(r.outcome, Outcome::NotConverged, "{}", r.reason);
+    assert_forge_row("`crc16`", &r);
     assert!(d > 1.0, "the forged run ends {d} m from the clean shape");
     // One forgery per broadcast of agent 3 from t = 10 s (100 Hz): 9,000.
     assert_eq!(r.attacks.len(), 1);
@@ -130,6 +181,37 @@ fn a_flood_on_the_shared_channel_costs_frames_to_collisions() {
     let own = summary["channel"]["utilisation"].as_f64().expect("own");
     assert!((total - own - c1.external_air_time / r.final_time).abs() < 1e-12);
     assert_eq!(summary["channel"]["external_transmissions"], 40_000);
+    // docs/attacks.md's flood table, row by row: the swarm's transmissions lost to
+    // collisions ("A of B"), the outcome and the settle time at the precision shown.
+    let doc = docs::read("docs/attacks.md");
+    let rows = docs::table_after(&doc, "| access | flood rate |");
+    assert_eq!(rows.len(), 4);
+    for row in rows {
+        let access = row[0].split('`').nth(1).expect("`access`");
+        let channel = format!("[radio.channel]\npreset = \"crazyflie\"\naccess = \"{access}\"\n");
+        let r = match docs::parse(row[1].trim_end_matches(" /s")) {
+            None => run(&model(&channel)),
+            Some(rate) => run(&model(&format!(
+                "{channel}\n[[attacks]]\nkind = \"flood\"\nrate_hz = {rate}\nbytes = 60\nstart = 10.0\nend = 20.0\n"
+            ))),
+        };
+        let c = r.channel.as_ref().expect("channel");
+        let lost = match row[2].split_once(" of ") {
+            Some((a, b)) => (docs::parse(a), docs::parse(b)),
+            None => (docs::parse(&row[2]), Some(c.transmissions as f64)),
+        };
+        let got = (
+            Some(c.collided_transmissions as f64),
+            Some(c.transmissions as f64),
+        );
+        assert_eq!(lost, got, "docs/attacks.md {row:?}");
+        assert_eq!(row[3], r.outcome.as_str(), "{row:?}: {}", r.reason);
+        let settle = r.settle_time.expect("settled");
+        assert!(
+            docs::shows(settle, row[4].trim_end_matches(" s")),
+            "{row:?}: {settle}"
+        );
+    }
 }
 
 #[test]
@@ -209,6 +291,7 @@ fn with_auth_the_same_forgery_changes_nothing_but_the_counters() {
     assert_eq!(r.frames.by_reason.bad_tag, 3 * 9000);
     assert_eq!(r.frames.by_reason.stale, 0);
     assert_eq!(r.frames.rejected, 3 * 9000);
+    assert_forge_row("`auth`", &r);
     // Replays too are refused (by the counter), and change nothing.
     let rp = run(&paper_auth(
         "[[attacks]]\nkind = \"replay\"\ndelay = 0.5\nstart = 5.0\n",

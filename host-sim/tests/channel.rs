@@ -1,5 +1,9 @@
 //! Issue 9 §2 and §3: broadcasting every k-th control tick, and the shared radio channel
-//! (`docs/radio.md`). The figures asserted here are the ones measured there.
+//! (`docs/radio.md`). The figures asserted here are read from there, or derived in
+//! closed form (broadcast counts, air time = bytes · 8 / bit rate).
+
+#[path = "support/docs.rs"]
+mod docs;
 
 use ph_formation_sim::engine::{self as sim, NullRecorder, RunResult};
 use ph_formation_sim::model::{Access, Model};
@@ -27,31 +31,93 @@ fn refused(name: &str, overrides: &[&str]) -> String {
     }
 }
 
+/// docs/radio.md's table "The paper formation, 100 Hz control, ideal links", every row
+/// run with the command listed under it: the outcome (and the failure's time), the
+/// settle time and final angle error at the precision shown (deterministic runs), and
+/// the broadcasts, which must also be the closed form of one broadcast per agent every
+/// k ticks (agent i on the ticks ≡ i mod k). The prose's claims on the table are checked
+/// on its figures: settling grows with the broadcast period, by the percentages stated.
 #[test]
-fn paper_converges_broadcasting_at_50_and_25_hz() {
-    // docs/radio.md: settle 40.85 s at 100 Hz, 41.61 s at 50 Hz, 43.22 s at 25 Hz.
-    for (hz, settle) in [("50", 41.61), ("25", 43.22)] {
-        let m = model("paper", &[&format!("controller.comm_rate_hz={hz}")]);
-        assert_eq!(m.comm_every, if hz == "50" { 2 } else { 4 });
+fn the_broadcast_rate_table_of_radio_md_is_measured() {
+    let doc = docs::read("docs/radio.md");
+    let section = &doc[doc
+        .find("### The paper formation, 100 Hz control, ideal links")
+        .expect("section")..];
+    let rows = docs::table_after(section, "| comm rate (Hz) |");
+    let commands: Vec<&str> = section
+        .lines()
+        .skip_while(|l| !l.starts_with("```sh"))
+        .skip(1)
+        .take_while(|l| !l.starts_with("```"))
+        .collect();
+    assert_eq!(rows.len(), commands.len(), "one command per row");
+    let mut settles = Vec::new();
+    for (row, command) in rows.iter().zip(&commands) {
+        let sets: Vec<&str> = command.split("--set").skip(1).map(str::trim).collect();
+        let hz = &row[0];
+        assert!(sets.contains(&format!("controller.comm_rate_hz={hz}").as_str()));
+        let m = model("paper", &sets);
         let r = run(&m);
-        assert_eq!(r.outcome, Outcome::Converged, "{hz} Hz: {}", r.reason);
-        let t = r.settle_time.expect("settled");
-        assert!((t - settle).abs() < 0.05, "{hz} Hz: settle {t} s");
-        assert!(r.final_max_angle_error < 1e-5);
-        // One broadcast per agent every k ticks, agent i on the ticks ≡ i mod k.
-        let (ticks, k) = (r.control.ticks / 4, m.comm_every as u64);
+        let k = m.comm_every as u64;
+        assert_eq!(m.comm_period(), k as f64 * 0.01, "{hz} Hz");
+        let outcome = row[1].split(':').next().unwrap_or_default();
+        assert_eq!(outcome, r.outcome.as_str(), "{hz} Hz: {}", r.reason);
+        if let Some(t) = row[1].split("t = ").nth(1) {
+            let stated = t.trim_end_matches(" s");
+            assert!(docs::shows(r.events[0].t, stated), "{hz} Hz: {}", r.reason);
+        }
+        if row[2] != "—" {
+            let settle = r.settle_time.expect("settled");
+            let shown = row[2].trim_end_matches(" s");
+            assert!(docs::shows(settle, shown), "{hz} Hz: settle {settle} s");
+            settles.push((k, docs::parse(shown).expect("settle")));
+            // Only at start-up: an agent whose neighbours' first broadcast is due at a
+            // later phase waits for it (docs/radio.md); never afterwards.
+            if let Some((t, _, f)) = r.control.last_fault {
+                assert!(t <= m.comm_period() + 1e-9, "{hz} Hz: {f:?} at {t} s");
+            }
+        }
+        assert!(
+            docs::shows(r.final_max_angle_error, &row[3]),
+            "{hz} Hz: {}",
+            r.final_max_angle_error
+        );
+        let ticks = r.control.ticks / 4;
         let expected: u64 = (0..4u64).map(|i| (ticks - i % k).div_ceil(k)).sum();
-        assert_eq!(r.frames.broadcasts, expected);
-        // Only at start-up: an agent whose neighbours' first broadcast is due at a later
-        // phase waits for it (docs/radio.md); never afterwards.
-        if let Some((t, _, f)) = r.control.last_fault {
-            assert!(t <= m.comm_period() + 1e-9, "{hz} Hz: {f:?} at {t} s");
+        assert_eq!(r.frames.broadcasts, expected, "{hz} Hz");
+        assert_eq!(docs::parse(&row[4]), Some(expected as f64), "{hz} Hz");
+    }
+    // "Settle time grows smoothly": with the period, and by the stated percentages.
+    assert!(
+        settles
+            .windows(2)
+            .all(|w| w[0].0 < w[1].0 && w[0].1 < w[1].1),
+        "{settles:?}"
+    );
+    let base = settles[0].1;
+    let flat = docs::flat(section);
+    for (k, settle) in &settles[1..] {
+        let hz = 100 / k;
+        if let Some(at) = flat.find(&format!("at {hz} Hz")) {
+            let before = &flat[..at];
+            let pct = before[before.rfind('+').expect("+N %") + 1..]
+                .trim_end_matches([' ', ','])
+                .trim_end_matches('%')
+                .trim();
+            let growth = format!(
+                "{:.*}",
+                pct.split('.').nth(1).map_or(0, str::len),
+                100.0 * (settle / base - 1.0)
+            );
+            assert_eq!(growth, pct, "+{pct} % at {hz} Hz");
         }
     }
 }
 
 #[test]
 fn paper_tolerates_5_hz_but_not_4_hz() {
+    // Either side of the boundary with the same (generous) neighbour timeout: the
+    // outcome, not a settle time, is what this pins.
     let ok = run(&model(
         "paper",
         &[
@@ -60,8 +126,6 @@ fn paper_tolerates_5_hz_but_not_4_hz() {
         ],
     ));
     assert_eq!(ok.outcome, Outcome::Converged, "{}", ok.reason);
-    let t = ok.settle_time.expect("settled");
-    assert!((t - 51.52).abs() < 0.05, "settle {t}");
     let bad = run(&model(
         "paper",
         &[
@@ -322,4 +386,99 @@ fn a_channel_run_is_reproducible_bit_for_bit() {
     }
     assert!(files[0] == files[1], "same seed, different output");
     assert!(files[0].0 != files[2].0, "the seed changes nothing");
+}
+
+/// One row of docs/radio.md's shared-channel tables against its run: `scenario` with the
+/// row's access and broadcast rate (and, below 25 Hz, the neighbour timeout of 2.5
+/// broadcast periods the commands use). Outcome exact, figures at the precision shown
+/// (deterministic runs); the payload in closed form from the air time (`air =
+/// transmissions · (payload + overhead) · 8 / bit rate`).
+fn check_channel_row(scenario: &str, row: &[String]) {
+    let c: Vec<String> = row.iter().map(|c| c.replace("**", "")).collect();
+    let hz: f64 = c[1].parse().expect("comm rate");
+    let mut sets = vec![
+        "radio.channel.preset=crazyflie".to_owned(),
+        format!("radio.channel.access={}", c[0]),
+        "controller.integrity=link".to_owned(),
+        format!("controller.comm_rate_hz={hz}"),
+    ];
+    if hz <= 20.0 {
+        sets.push(format!("controller.neighbour_timeout={}", 2.5 / hz));
+    }
+    let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+    let m = model(scenario, &sets);
+    let r = run(&m);
+    let what = format!("docs/radio.md {scenario} {} {hz} Hz", c[0]);
+    let outcome = c[2].trim_end_matches(" in 60 s").replace(' ', "_");
+    assert_eq!(outcome, r.outcome.as_str(), "{what}: {}", r.reason);
+    let unit = |s: &str, u: &str| s.trim_end_matches(u).trim().to_owned();
+    if c[3] != "—" {
+        let settle = r.settle_time.expect("settled");
+        assert!(
+            docs::shows(settle, &unit(&c[3], " s")),
+            "{what}: settle {settle}"
+        );
+    }
+    assert!(
+        docs::shows(r.final_max_angle_error, &c[4]),
+        "{what}: {}",
+        r.final_max_angle_error
+    );
+    let ch = r.channel.as_ref().expect("channel");
+    let cm = m.radio.channel.as_ref().expect("channel");
+    let payload = ch.air_time * cm.bit_rate / 8.0 / ch.transmissions as f64 - cm.overhead_bytes;
+    assert!(
+        docs::shows(payload, &unit(&c[5], " B")),
+        "{what}: payload {payload}"
+    );
+    let util = 100.0 * ch.air_time / r.final_time;
+    assert!(
+        docs::shows(util, &unit(&c[6], " %")),
+        "{what}: utilisation {util}"
+    );
+    let lost = c[7].split(" (").next().expect("count");
+    assert_eq!(docs::parse(lost), Some(ch.collided as f64), "{what}");
+    if let Some(pct) = c[7].split(" (").nth(1) {
+        let pct = pct.split(" %").next().expect("%");
+        let share = 100.0 * ch.collided_transmissions as f64 / ch.transmissions as f64;
+        assert!(docs::shows(share, pct), "{what}: {share} % of tx");
+    }
+    let (mean, worst) = unit(&c[8], " ms")
+        .split_once(" / ")
+        .map(|(a, b)| (a.to_owned(), b.to_owned()))
+        .expect("mean / worst");
+    assert!(
+        docs::shows(ch.mean_age * 1e3, &mean),
+        "{what}: mean age {}",
+        ch.mean_age
+    );
+    assert!(
+        docs::shows(ch.max_age * 1e3, &worst),
+        "{what}: worst age {}",
+        ch.max_age
+    );
+}
+
+/// docs/radio.md's shared-channel tables: every row of the paper's (12 runs of 100 s)
+/// and of the 20-agent strip's (14 runs of 60 s), on every core.
+#[test]
+fn the_shared_channel_tables_of_radio_md_are_measured() {
+    use rayon::prelude::*;
+    let doc = docs::read("docs/radio.md");
+    let header = "| access | comm (Hz) | outcome |";
+    let paper = &doc[doc
+        .find("### The paper formation (4 agents)")
+        .expect("paper")..];
+    let rows = docs::table_after(paper, header);
+    assert_eq!(rows.len(), 12);
+    let strip = &doc[doc.find("### 20 agents").expect("strip")..];
+    let strip_rows = docs::table_after(strip, header);
+    assert_eq!(strip_rows.len(), 14);
+    let strip20 = strip20();
+    let jobs: Vec<(&str, &Vec<String>)> = rows
+        .iter()
+        .map(|r| ("paper", r))
+        .chain(strip_rows.iter().map(|r| (strip20.as_str(), r)))
+        .collect();
+    jobs.par_iter().for_each(|(s, r)| check_channel_row(s, r));
 }

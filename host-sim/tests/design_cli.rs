@@ -251,3 +251,88 @@ fn a_hundred_thousand_agents_load_with_wire_ids_unique_within_two_hops() {
     }
     assert_eq!(m.target.positions.len(), n);
 }
+
+/// docs/design.md's "Figures per generator", the rows of N = 10 (the others need runs of
+/// 50 and 200 agents; their command is above the table): the design's margin, smallest
+/// controlled angle, triangles per agent and longest edge (from `design`'s report), the
+/// run's outcome, settle time and shape error (`summary.json`), each at the precision
+/// shown (deterministic designs and runs).
+#[test]
+fn the_design_figures_of_n_10_are_measured() {
+    use rayon::prelude::*;
+    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/design.md"))
+        .expect("docs/design.md");
+    let rows: Vec<Vec<String>> = doc
+        .lines()
+        .filter(|l| l.starts_with("| ") && l.split('|').nth(2).is_some_and(|n| n.trim() == "10"))
+        .map(|l| l.split('|').map(|c| c.trim().to_owned()).collect())
+        .collect();
+    assert_eq!(rows.len(), 6, "one row per generator");
+    // `value` printed with as many decimals as `shown` (in its notation) is `shown`'s
+    // number (the table writes `1.7e-08`, Rust `1.7e-8`).
+    let shows = |value: f64, shown: &str| {
+        let (mantissa, exp) = shown
+            .split_once('e')
+            .map_or((shown, None), |(m, e)| (m, Some(e)));
+        let d = mantissa.split_once('.').map_or(0, |(_, d)| d.len());
+        let printed = match exp {
+            Some(_) => format!("{value:.d$e}"),
+            None => format!("{value:.d$}"),
+        };
+        printed.parse::<f64>().ok() == shown.parse::<f64>().ok()
+    };
+    rows.par_iter().for_each(|c| {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let file = dir.path().join("t.toml");
+        let file_s = file.to_string_lossy().into_owned();
+        let design = bin()
+            .args([
+                "design",
+                "--shape",
+                &c[1],
+                "-n",
+                "10",
+                "--duration",
+                "200",
+                "-o",
+                &file_s,
+            ])
+            .output()
+            .expect("design");
+        assert!(design.status.success(), "{c:?}");
+        let report = text(&design.stderr);
+        let figure = |before: &str, after: &str| -> String {
+            let rest = &report[report
+                .find(before)
+                .unwrap_or_else(|| panic!("{before}: {report}"))
+                + before.len()..];
+            rest[..rest.find(after).expect("end")].trim().to_owned()
+        };
+        assert_eq!(format!("{}°", figure("angle margin", "°")), c[3], "{c:?}");
+        assert_eq!(
+            format!("{}°", figure("smallest controlled angle", "°")),
+            c[4],
+            "{c:?}"
+        );
+        assert_eq!(figure("largest triangles per agent", " ("), c[5], "{c:?}");
+        assert_eq!(format!("{} m", figure("longest edge", " m")), c[6], "{c:?}");
+        let out = dir.path().join("out");
+        let run = bin()
+            .args(["run", &file_s, "--no-plots", "-q", "--out"])
+            .arg(&out)
+            .output()
+            .expect("run");
+        let summary: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(out.join("summary.json")).expect("summary"),
+        )
+        .expect("json");
+        assert_eq!(summary["outcome"], c[7].as_str(), "{c:?}");
+        assert_eq!(run.status.code(), Some(0), "{c:?}");
+        let settle = summary["settle_time_s"].as_f64().expect("settled");
+        assert!(shows(settle, &c[8]), "{c:?}: settle {settle}");
+        let shape = summary["shape"]["max_error_rel"]
+            .as_f64()
+            .expect("shape error");
+        assert!(shows(shape, &c[9]), "{c:?}: shape error {shape:e}");
+    });
+}

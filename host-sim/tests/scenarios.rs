@@ -1,5 +1,10 @@
 //! The built-in scenarios end as SPEC §9 says, continuous mode keeps V from increasing,
-//! the paper scenario survives a lossy, delayed radio, and runs are reproducible.
+//! the paper scenario survives a lossy, delayed radio, and runs are reproducible. Each
+//! run's figures are read back from docs/outputs.md's "Reference figures" (and the
+//! README's and docs/scenarios.md's for `paper-printed`).
+
+#[path = "support/docs.rs"]
+mod docs;
 
 use ph_formation_sim::engine::{self as sim, NullRecorder, RunResult};
 use ph_formation_sim::model::{Mode, Model};
@@ -33,6 +38,58 @@ fn mirror_error(p: &[[f64; 2]]) -> f64 {
     let e4 = [q2[0] + (e3[0] - q1[0]), q2[1] + (e3[1] - q1[1])];
     let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
     dist(q3, e3).max(dist(q4, e4))
+}
+
+/// The row of docs/outputs.md's "Reference figures" whose run cell starts with `label`
+/// states `r`'s figures: the outcome, the settle time, the final errors and V's largest
+/// rise (with its time if given), each at the precision shown; for a failure, the times
+/// in its outcome cell are the events' times, in order. Deterministic runs: the doc's
+/// rounding is the only tolerance (`docs::shows`).
+fn assert_reference_row(label: &str, r: &RunResult) {
+    let doc = docs::read("docs/outputs.md");
+    let section = &doc[doc.find("## Reference figures").expect("section")..];
+    let c = docs::row(section, label);
+    let first = |i: usize| c[i].split_whitespace().next().map(str::to_owned);
+    assert_eq!(
+        first(1).as_deref(),
+        Some(r.outcome.as_str()),
+        "{label}: {}",
+        r.reason
+    );
+    let figures = [
+        (2, r.settle_time.unwrap_or(f64::NAN), "settle time"),
+        (3, r.final_max_angle_error, "final max angle error"),
+        (4, r.final_displacement_error, "final |z − z*|"),
+        (5, r.final_velocity_error, "final max |v − v*|"),
+        (6, r.v_max_increase_rel, "V max increase / V(0)"),
+    ];
+    for (i, value, what) in figures {
+        if let Some(shown) = first(i) {
+            assert!(
+                docs::shows(value, &shown),
+                "docs/outputs.md, {label}: {what} {shown}, the run gives {value:e}"
+            );
+        }
+    }
+    if let Some(at) = docs::seconds(&c[6]).first() {
+        assert!(docs::shows(r.v_max_increase_t, &format!("{at:.2}")));
+    }
+    if r.outcome != Outcome::Converged {
+        let times: Vec<f64> = r.events.iter().map(|e| e.t).collect();
+        assert_events_at(&format!("docs/outputs.md, {label}"), &c[1], &times);
+    }
+}
+
+/// The times (`… 0.54 s …`) of `text` are `times` at two decimals.
+fn assert_events_at(source: &str, text: &str, times: &[f64]) {
+    let stated = docs::seconds(text);
+    assert_eq!(stated.len(), times.len(), "{source}: {text:?} vs {times:?}");
+    for (s, t) in stated.iter().zip(times) {
+        assert!(
+            docs::shows(*t, &format!("{s:.2}")),
+            "{source}: {s} s, the run gives {t} s"
+        );
+    }
 }
 
 fn assert_converged_square(name: &str, r: &RunResult, side: Option<f64>) {
@@ -73,13 +130,29 @@ fn paper_converges_into_the_square_not_its_mirror() {
     assert_eq!(r.frames.dropped, 0);
     assert_eq!(r.frames.rejected, 0);
     assert!(r.frames.sent > 0 && r.frames.accepted == r.frames.delivered);
+    assert_reference_row("`paper` (sampled", &r);
+    // "r̂ ≈ A–B m against r = C m and D m" (docs/outputs.md), at the precision shown.
+    let doc = docs::read("docs/outputs.md");
+    let span = docs::between(&doc, "at the end of `paper`, r̂ ≈", " m against");
+    let (lo, hi) = span.split_once('–').expect("A–B");
+    let est = |f: fn(f64, f64) -> f64, init| r.final_estimates.iter().map(|e| e.0).fold(init, f);
+    assert!(docs::shows(est(f64::min, f64::INFINITY), lo), "{span}");
+    assert!(docs::shows(est(f64::max, 0.0), hi), "{span}");
+    let truth = docs::between(&doc, "m against r =", " m, so");
+    let mut distances: Vec<f64> = r.final_estimates.iter().map(|e| e.1).collect();
+    distances.sort_by(f64::total_cmp);
+    let (a, b) = truth.split_once(" m and ").expect("C m and D");
+    assert!(docs::shows(distances[0], a) && docs::shows(distances[distances.len() - 1], b));
 }
 
 #[test]
 fn paper_printed_fails_and_names_the_cause() {
     let r = run(&model("paper-printed", &[]));
     assert_eq!(r.outcome, Outcome::EstimateCollapse, "{}", r.reason);
-    assert_eq!(r.outcome.exit_code(), 12);
+    // README.md: "run paper-printed   # the printed gains: reported as a failure, exit 12".
+    let readme = docs::read("README.md");
+    let code = docs::number(&readme, "reported as a failure, exit", " cargo");
+    assert_eq!(f64::from(r.outcome.exit_code()), code, "README.md");
     assert_eq!(r.min_estimate, Some(0.1));
     assert!(
         r.final_time < 5.0,
@@ -91,6 +164,22 @@ fn paper_printed_fails_and_names_the_cause() {
     let kinds: Vec<Outcome> = r.events.iter().map(|e| e.kind).collect();
     assert_eq!(kinds, [Outcome::EstimateCollapse, Outcome::Collision]);
     assert!(r.min_distance.0 < 0.05);
+    assert_reference_row("`paper-printed`", &r);
+    let times: Vec<f64> = r.events.iter().map(|e| e.t).collect();
+    let readme = docs::read("README.md");
+    let said = docs::between(&readme, "make the estimates collapse", "as [SPEC §9]");
+    assert_events_at("README.md", &said, &times);
+    // docs/outputs.md quotes this run's `outcome_reason` word for word.
+    let outputs = docs::read("docs/outputs.md");
+    let quoted = docs::between(&outputs, "e.g. for `paper-printed`: \"", "\". ");
+    assert_eq!(
+        quoted,
+        docs::flat(&r.reason),
+        "docs/outputs.md's example reason"
+    );
+    let table = docs::read("docs/scenarios.md");
+    let said = docs::row(&table, "`paper-printed`")[2].clone();
+    assert_events_at("docs/scenarios.md", &said, &times);
 }
 
 #[test]
@@ -106,6 +195,7 @@ fn formation_only_converges() {
     let r = run(&model("formation-only", &[]));
     assert_converged_square("formation-only", &r, None);
     assert_eq!(r.final_displacement_error, 0.0);
+    assert_reference_row("`formation-only` |", &r);
 }
 
 /// Continuous mode: V (S13) must not increase beyond RK4 error. Measured: ≈ 6e-12 of
@@ -129,7 +219,18 @@ fn continuous_mode_v_does_not_increase() {
         assert_eq!(r.control.safe, 0);
         assert_eq!(r.frames.sent, 0);
         assert_converged_square(name, &r, None);
+        let label = if name == "paper" {
+            "`paper`, `mode = continuous`"
+        } else {
+            "`formation-only`, continuous"
+        };
+        assert_reference_row(label, &r);
     }
+    // The README's bound: "V never rises by more than ~1e-11 of V(0)".
+    let readme = docs::read("README.md");
+    let bound = docs::number(&readme, "V never rises by more than ~", " of V(0)");
+    let r = run(&model("paper", &["mode=continuous"]));
+    assert!(r.v_max_increase_rel <= bound, "{}", r.v_max_increase_rel);
 }
 
 #[test]
@@ -151,8 +252,20 @@ fn continuous_mode_per_agent_estimator_is_not_passive_but_runs() {
 fn paper_converges_with_20_percent_loss_and_20_ms_latency() {
     let r = run(&model("paper", &["radio.loss=0.2", "radio.latency=0.02"]));
     assert_converged_square("paper lossy", &r, Some(200f64.sqrt()));
-    let lost = r.frames.dropped as f64 / r.frames.sent as f64;
-    assert!((0.18..0.22).contains(&lost), "loss fraction {lost}");
+    assert_reference_row("`paper`, 20 % loss", &r);
+    // Each link copy is lost independently with p = 0.2: the count of losses is
+    // binomial(n, p); 4 standard deviations (a false alarm once in ~16,000 seeds) from
+    // n p, which a loss rate off by 0.01 already leaves (n = 100,010 link copies: σ ≈ 126,
+    // 0.01 n = 1,000; with p = 0.19 the check fails by 1,093).
+    let (n, p) = (r.frames.sent as f64, 0.2);
+    let sigma = (n * p * (1.0 - p)).sqrt();
+    let lost = r.frames.lost as f64;
+    assert!(
+        (lost - n * p).abs() <= 4.0 * sigma,
+        "{lost} of {n} copies lost, expected {} ± {}",
+        n * p,
+        4.0 * sigma
+    );
 }
 
 #[test]

@@ -126,3 +126,50 @@ fn bad_flags_are_refused() {
     assert_eq!(code, 0, "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// docs/world.md's step-response table: every row re-run with the command above it
+/// (`--set world=crazyflie --speed V --direction-deg D`), its printed figures the
+/// table's, at the precision shown (the step is deterministic).
+#[test]
+fn the_step_table_of_world_md_is_measured() {
+    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/world.md"))
+        .expect("docs/world.md");
+    let table = &doc[doc
+        .find("| speed | direction | 63 % rise |")
+        .expect("table")..];
+    let rows: Vec<Vec<String>> = table
+        .lines()
+        .skip(2)
+        .take_while(|l| l.starts_with('|'))
+        .map(|l| {
+            l.trim_matches('|')
+                .split('|')
+                .map(|c| c.trim().to_owned())
+                .collect()
+        })
+        .collect();
+    assert_eq!(rows.len(), 6);
+    for c in rows {
+        let speed = c[0].trim_end_matches(" m/s");
+        let direction = c[1].split('°').next().expect("direction");
+        let dir = scratch(&format!("table-{speed}-{direction}"));
+        let (code, out, err) = step(&[
+            "--set",
+            "world=crazyflie",
+            "--speed",
+            speed,
+            "--direction-deg",
+            direction,
+            "--out",
+            &dir,
+        ]);
+        let _ = std::fs::remove_dir_all(&dir);
+        assert_eq!(code, 0, "{err}");
+        let printed = format!("{out}{err}");
+        let want = format!(
+            "63 % rise time {}, overshoot {}, peak acceleration {}, peak tilt {}",
+            c[2], c[3], c[4], c[5]
+        );
+        assert!(printed.contains(&want), "docs/world.md {c:?}:\n{printed}");
+    }
+}

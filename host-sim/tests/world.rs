@@ -3,6 +3,9 @@
 //! `crazyflie` preset on room-sized formations, the speed-limit warning, and every new
 //! field refused with file, field and reason.
 
+#[path = "support/docs.rs"]
+mod docs;
+
 use ph_formation_sim::engine::world::{Clocks, Headings, Wind};
 use ph_formation_sim::engine::{self as sim, NullRecorder, RunResult};
 use ph_formation_sim::model::{ClockModel, HeadingModel, Model, WindModel};
@@ -191,12 +194,16 @@ fn gusts_have_their_variance_and_correlation() {
 }
 
 /// `world = "crazyflie"` (the cascade, shared positions, absolute yaw) flies the app's
-/// square: after 100 s every angle is within 0.01 rad (measured 0.003; the outcome
-/// under the preset's noise is `NotConverged` by the noise band, the verdict being
-/// replaced). `crazyflie-camera` loads with its camera and drifting yaw. Summary figures
-/// name the preset and its assumptions.
+/// square. Its sensing is random (position noise, clock jitter), so one seed proves
+/// little: of 5 seeds at least 4 must converge under the honest verdict and every one
+/// must end with its angles within 0.01 rad. Why 4: all 5 converged when measured
+/// (final errors 0.9–1.2 mrad); one seed may still meet a burst the calibration run did
+/// not (docs/sensors.md, `paper`), and a broken cascade, lead or sensor fails them all.
+/// `crazyflie-camera` loads with its camera and drifting yaw. Summary figures name the
+/// preset and its assumptions.
 #[test]
 fn the_crazyflie_world_flies_the_apps_square() {
+    use rayon::prelude::*;
     let square = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../crazyflie-app/formation.toml"
@@ -205,21 +212,104 @@ fn the_crazyflie_world_flies_the_apps_square() {
     assert_eq!(m.world.preset, "crazyflie");
     assert!(m.world.clock.is_some() && m.world.heading.is_none());
     assert!(!m.world.assumptions.is_empty());
-    let r = run(&m);
-    assert!(
-        r.final_max_angle_error < 0.01,
-        "{}: {}",
-        r.final_max_angle_error,
-        r.reason
-    );
+    let runs: Vec<RunResult> = (1..=5u64)
+        .into_par_iter()
+        .map(|seed| {
+            run(&model(
+                square,
+                &["world=crazyflie", "duration=100", &format!("seed={seed}")],
+            ))
+        })
+        .collect();
+    let converged = runs
+        .iter()
+        .filter(|r| r.outcome == Outcome::Converged)
+        .count();
+    let reasons: Vec<&str> = runs.iter().map(|r| r.reason.as_str()).collect();
+    assert!(converged >= 4, "{converged} of 5 converged: {reasons:#?}");
+    for r in &runs {
+        assert!(
+            r.final_max_angle_error < 0.01,
+            "{}: {}",
+            r.final_max_angle_error,
+            r.reason
+        );
+    }
     // Noise-free, the cascade alone: the square converges with the second-order lead
-    // (S21b; settles in 13.8 s) and does not within 60 s without it (97 s).
-    let alone = |extra: &str| {
-        let m = model(square, &["plant.model=crazyflie_pid", "duration=60", extra]);
-        run(&m).outcome
+    // (S21b; docs/crazyflie.md: "to settle in 14 s") and settles only after 60 s without
+    // it. Nothing here is random: another seed gives the same bits, so one seed is
+    // every seed.
+    let alone = |extra: &[&str]| {
+        let mut o = vec!["plant.model=crazyflie_pid", "duration=60"];
+        o.extend_from_slice(extra);
+        run(&model(square, &o))
     };
-    assert_eq!(alone("plant.lead_s=0.2337"), Outcome::Converged);
-    assert_eq!(alone("plant.second_lead_s2=0"), Outcome::NotConverged);
+    let led = alone(&["plant.lead_s=0.2337"]);
+    assert_eq!(led.outcome, Outcome::Converged, "{}", led.reason);
+    let other_seed = alone(&["plant.lead_s=0.2337", "seed=2"]);
+    assert_eq!(led.final_positions, other_seed.final_positions);
+    let doc = docs::read("docs/crazyflie.md");
+    let settle = docs::between(&doc, "`ph_actuator_set_second_lead`) to settle in", " s (");
+    let got = led.settle_time.expect("settled");
+    assert!(
+        docs::shows(got, &settle),
+        "docs/crazyflie.md: {settle} s, run {got} s"
+    );
+    // docs/world.md: "With S21 alone the app's square (plant only, noise-free) settles in
+    // 97 s; with S21b in 13.8 s (…); the 20-agent strip settles in 10.75 s with S21b and
+    // collapses without."
+    let world = docs::read("docs/world.md");
+    let unled = alone(&["plant.second_lead_s2=0", "duration=150"]);
+    assert_eq!(unled.outcome, Outcome::Converged, "{}", unled.reason);
+    let slow = unled.settle_time.expect("settled");
+    assert!(
+        slow > 60.0,
+        "without S21b the square settles after 60 s: {slow}"
+    );
+    let said = docs::between(
+        &world,
+        "With S21 alone the app's square (plant only, noise-free) settles in",
+        " s;",
+    );
+    assert!(
+        docs::shows(slow, &said),
+        "docs/world.md: {said} s, run {slow} s"
+    );
+    let said = docs::between(&doc, "to settle in 14 s (", " s with S21 alone)");
+    assert!(
+        docs::shows(slow, &said),
+        "docs/crazyflie.md: {said} s, run {slow} s"
+    );
+    let said = docs::between(&world, "settles in 97 s; with S21b in", " s (");
+    assert!(
+        docs::shows(got, &said),
+        "docs/world.md: {said} s, run {got} s"
+    );
+    let strip = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/strip20.toml");
+    let strip_led = run(&model(strip, &["plant.model=crazyflie_pid", "duration=60"]));
+    assert_eq!(
+        strip_led.outcome,
+        Outcome::Converged,
+        "{}",
+        strip_led.reason
+    );
+    let said = docs::between(&world, "the 20-agent strip settles in", " s with S21b");
+    let t = strip_led.settle_time.expect("settled");
+    assert!(docs::shows(t, &said), "docs/world.md: {said} s, run {t} s");
+    let strip_unled = run(&model(
+        strip,
+        &[
+            "plant.model=crazyflie_pid",
+            "plant.second_lead_s2=0",
+            "duration=60",
+        ],
+    ));
+    assert_eq!(
+        strip_unled.outcome,
+        Outcome::EstimateCollapse,
+        "{}",
+        strip_unled.reason
+    );
     let m = model("formation-only", &["world=crazyflie-camera", "duration=1"]);
     assert!(m.world.heading.is_some() && m.world.preset == "crazyflie-camera");
 }
@@ -229,7 +319,8 @@ fn the_crazyflie_world_flies_the_apps_square() {
 #[test]
 fn a_reference_above_the_speed_limit_is_named() {
     let r = run(&model("paper", &["world=crazyflie", "duration=20"]));
-    assert_ne!(r.outcome, Outcome::Converged);
+    // Limited to 1 m/s the square falls behind v*: its errors stay, nothing fails.
+    assert_eq!(r.outcome, Outcome::NotConverged, "{}", r.reason);
     let says = |s: &str| s.contains("v* = (3, 3)") && s.contains("plant.max_speed = 1");
     assert!(r.warnings.iter().any(|w| says(w)), "{:?}", r.warnings);
     assert!(says(&r.reason), "{}", r.reason);
@@ -304,7 +395,8 @@ fn the_camera_world_names_a_neighbour_out_of_view() {
         "formation-only",
         &["world=crazyflie-camera", "duration=30"],
     ));
-    assert_ne!(r.outcome, Outcome::Converged);
+    // Agents without a bearing sit in their safe output: not in control.
+    assert_eq!(r.outcome, Outcome::NotInControl, "{}", r.reason);
     assert!(
         r.reason
             .contains("out of view of its camera (field of view 87°"),
