@@ -70,7 +70,7 @@
  * `ph_position_*`). Compare the header's value with `ph_abi_version()` of the library
  * you link.
  */
-#define PH_ABI_VERSION 5
+#define PH_ABI_VERSION 6
 
 /**
  * Two positions closer than this (m) are coincident: no bearing between them, and
@@ -257,6 +257,11 @@ enum ph_status
    * Blob: the payload does not decode as a configuration (or has trailing bytes).
    */
   PH_ERR_BLOB_DECODE = 44,
+  /**
+   * Blob: it carries no safety policies (`ph_blob_policy`; the scenario had no
+   * `[policy]`).
+   */
+  PH_ERR_BLOB_NO_POLICY = 45,
   /**
    * Frame: shorter than a header and its check.
    */
@@ -1461,6 +1466,24 @@ ph_status ph_separation_guard(ph_policy *policy,
                               const float *neighbours,
                               size_t count,
                               float *setpoint);
+
+/**
+ * The safety policies a configuration blob carries (`blob[0..len]`, written by
+ * `host-sim export` from the scenario's `[policy]`): fills `*config`, `start[0..2]`
+ * (the agent's initial position in the scenario, m) and `*start_tolerance` (m, the
+ * pre-flight check's radius). The blob gets the checks of `ph_agent_init_blob`
+ * (`PH_ERR_BLOB_*`); `PH_ERR_BLOB_NO_POLICY` (nothing written) when it carries none.
+ *
+ * # Safety
+ * `blob` is NULL or points to `len` readable bytes; `config` is NULL or writable;
+ * `start` is NULL or points to 2 writable floats; `start_tolerance` is NULL or
+ * writable.
+ */
+ph_status ph_blob_policy(const uint8_t *blob,
+                         size_t len,
+                         ph_policy_config *config,
+                         float *start,
+                         float *start_tolerance);
 
 /**
  * Writes this agent's position packet (its id, `position[0..2]` in m, world frame)

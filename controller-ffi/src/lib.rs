@@ -58,7 +58,9 @@ pub mod tick;
 pub mod vehicle;
 
 pub use actuate::ph_actuator;
-pub use blob::{decode_blob, encode_blob, BlobError};
+pub use blob::{
+    decode_blob, decode_blob_policy, encode_blob, encode_blob_with, BlobError, BlobPolicy,
+};
 pub use config::{ph_config, to_core};
 pub use status::ph_status;
 pub use storage::{PH_AGENT_ALIGN, PH_AGENT_SIZE};
@@ -88,7 +90,7 @@ pub const PH_MAX_OWNED_ESTIMATES: usize = 4 * PH_MAX_TRIANGLES;
 /// the safety policies `ph_policy_*` and `ph_separation_guard`, the position packet
 /// `ph_position_*`). Compare the header's value with `ph_abi_version()` of the library
 /// you link.
-pub const PH_ABI_VERSION: u32 = 5;
+pub const PH_ABI_VERSION: u32 = 6;
 
 /// Two positions closer than this (m) are coincident: no bearing between them, and
 /// `ph_separation_guard` stops the setpoint (`ph_formation_core::policy::COINCIDENT`).

@@ -306,3 +306,54 @@ pub unsafe extern "C" fn ph_separation_guard(
     })();
     status(r)
 }
+
+/// The safety policies a configuration blob carries (`blob[0..len]`, written by
+/// `host-sim export` from the scenario's `[policy]`): fills `*config`, `start[0..2]`
+/// (the agent's initial position in the scenario, m) and `*start_tolerance` (m, the
+/// pre-flight check's radius). The blob gets the checks of `ph_agent_init_blob`
+/// (`PH_ERR_BLOB_*`); `PH_ERR_BLOB_NO_POLICY` (nothing written) when it carries none.
+///
+/// # Safety
+/// `blob` is NULL or points to `len` readable bytes; `config` is NULL or writable;
+/// `start` is NULL or points to 2 writable floats; `start_tolerance` is NULL or
+/// writable.
+#[no_mangle]
+pub unsafe extern "C" fn ph_blob_policy(
+    blob: *const u8,
+    len: usize,
+    config: *mut ph_policy_config,
+    start: *mut f32,
+    start_tolerance: *mut f32,
+) -> ph_status {
+    let r = (|| {
+        // SAFETY: per this function's contract.
+        let bytes = unsafe { crate::api::slice(blob, len) }?;
+        if bytes.is_empty() {
+            return Err(ph_status::PH_ERR_NULL);
+        }
+        check(config.cast_const())?;
+        check(start.cast_const())?;
+        check(start_tolerance.cast_const())?;
+        let p = crate::blob::decode_blob_policy(bytes)?.ok_or(ph_status::PH_ERR_BLOB_NO_POLICY)?;
+        let (fence, (fence_min, fence_max)) = match p.fence {
+            Some(corners) => (1, corners),
+            None => (0, ([0.0; 2], [0.0; 2])),
+        };
+        let c = ph_policy_config {
+            hold_timeout_ms: p.hold_timeout_ms,
+            fence,
+            fence_min,
+            fence_max,
+            battery_land: p.battery_land,
+            battery_ms: p.battery_ms,
+            min_separation: p.min_separation,
+        };
+        // SAFETY: per this function's contract (checked non-null and aligned above).
+        unsafe { write(config, c) }?;
+        // SAFETY: as above (2 writable floats).
+        unsafe { write(start.cast::<[f32; 2]>(), p.start) }?;
+        // SAFETY: as above.
+        unsafe { write(start_tolerance, p.start_tolerance) }
+    })();
+    status(r)
+}

@@ -74,6 +74,9 @@ pub enum ph_status {
     PH_ERR_BLOB_CHECKSUM = 43,
     /// Blob: the payload does not decode as a configuration (or has trailing bytes).
     PH_ERR_BLOB_DECODE = 44,
+    /// Blob: it carries no safety policies (`ph_blob_policy`; the scenario had no
+    /// `[policy]`).
+    PH_ERR_BLOB_NO_POLICY = 45,
     /// Frame: shorter than a header and its check.
     PH_ERR_FRAME_TOO_SHORT = 60,
     /// Frame: longer than `PH_MAX_FRAME_LEN`.
@@ -163,7 +166,7 @@ impl From<BlobError> for ph_status {
 
 /// Every status, for the code → status lookup of `ph_status_str`. `tests/header.rs`
 /// checks that it lists as many codes as the header's `ph_status` has.
-pub const ALL: [ph_status; 40] = {
+pub const ALL: [ph_status; 41] = {
     use ph_status::*;
     [
         PH_OK,
@@ -192,6 +195,7 @@ pub const ALL: [ph_status; 40] = {
         PH_ERR_BLOB_LENGTH,
         PH_ERR_BLOB_CHECKSUM,
         PH_ERR_BLOB_DECODE,
+        PH_ERR_BLOB_NO_POLICY,
         PH_ERR_FRAME_TOO_SHORT,
         PH_ERR_FRAME_TOO_LONG,
         PH_ERR_FRAME_BAD_CRC,
@@ -240,6 +244,7 @@ impl ph_status {
             Self::PH_ERR_BLOB_LENGTH => c"PH_ERR_BLOB_LENGTH",
             Self::PH_ERR_BLOB_CHECKSUM => c"PH_ERR_BLOB_CHECKSUM",
             Self::PH_ERR_BLOB_DECODE => c"PH_ERR_BLOB_DECODE",
+            Self::PH_ERR_BLOB_NO_POLICY => c"PH_ERR_BLOB_NO_POLICY",
             Self::PH_ERR_FRAME_TOO_SHORT => c"PH_ERR_FRAME_TOO_SHORT",
             Self::PH_ERR_FRAME_TOO_LONG => c"PH_ERR_FRAME_TOO_LONG",
             Self::PH_ERR_FRAME_BAD_CRC => c"PH_ERR_FRAME_BAD_CRC",

@@ -8,8 +8,12 @@ use ph_formation_core::{
 };
 use ph_formation_ffi::api::ph_agent_init_blob;
 use ph_formation_ffi::blob::{BLOB_VERSION, PH_MAX_BLOB_LEN};
+use ph_formation_ffi::policy::{ph_blob_policy, ph_policy_config};
 use ph_formation_ffi::storage::ph_agent;
-use ph_formation_ffi::{decode_blob, encode_blob, ph_status, BlobError, FfiConfig, PH_AGENT_SIZE};
+use ph_formation_ffi::{
+    decode_blob, decode_blob_policy, encode_blob, encode_blob_with, ph_status, BlobError,
+    BlobPolicy, FfiConfig, PH_AGENT_SIZE,
+};
 
 /// Agent 1 of the paper's formation (firmware-example/src/paper.rs).
 fn paper_agent_1() -> FfiConfig {
@@ -216,7 +220,8 @@ fn every_defect_has_its_status() {
     // check): agent 1 in a triangle without agent 1.
     let mut bad = paper_agent_1();
     bad.triangles[0].vertices = [2, 3, 4];
-    let payload = postcard::to_allocvec(&bad).expect("postcard");
+    let mut payload = postcard::to_allocvec(&bad).expect("postcard");
+    payload.push(0); // no policy section (version 6)
     let mut b = good[..8].to_vec();
     b[6..8].copy_from_slice(&u16::try_from(payload.len()).expect("small").to_le_bytes());
     b.extend_from_slice(&payload);
@@ -248,9 +253,90 @@ fn pinned_bytes_of_agent_1() {
         .iter()
         .map(|b| format!("{b:02x}"))
         .collect();
-    let pinned = "50484346050095000101010203010000000000007a440000204100007a4403f304353f00007a440000204100007a44000000803fcdcccc3d0000003f0000003f6666e63f6666e63f010000000000004040000040400100020000803fcdcc4c3fcdcc4c3f010000000000002041000020c10050c347cdcccc3d0000803f6f12833a9e067f3f000000000135fa0e3d6f12033acdcc4c3d0000a04000010084e300eb";
+    let pinned = "50484346060096000101010203010000000000007a440000204100007a4403f304353f00007a440000204100007a44000000803fcdcccc3d0000003f0000003f6666e63f6666e63f010000000000004040000040400100020000803fcdcc4c3fcdcc4c3f010000000000002041000020c10050c347cdcccc3d0000803f6f12833a9e067f3f000000000135fa0e3d6f12033acdcc4c3d0000a0400001000049aa8f4e";
     assert_eq!(
         hex, pinned,
         "the blob layout changed: bump BLOB_VERSION and update the pinned bytes to\n{hex}"
     );
+}
+
+/// `ph_blob_policy` of a blob.
+fn blob_policy(blob: &[u8]) -> (ph_status, ph_policy_config, [f32; 2], f32) {
+    let mut c = ph_policy_config::default();
+    let (mut start, mut tol) = ([f32::NAN; 2], f32::NAN);
+    // SAFETY: `blob` is readable; the outputs are writable.
+    let s = unsafe {
+        ph_blob_policy(
+            blob.as_ptr(),
+            blob.len(),
+            &mut c,
+            start.as_mut_ptr(),
+            &mut tol,
+        )
+    };
+    (s, c, start, tol)
+}
+
+/// Version 6 carries the vehicle's safety policies and pre-flight reference: what
+/// `encode_blob_with` wrote, `ph_blob_policy` reads back exactly; the agent still
+/// initialises from the same blob; a blob without them gives `PH_ERR_BLOB_NO_POLICY`
+/// (nothing written), a corrupted one its blob status, NULL outputs `PH_ERR_NULL`.
+#[test]
+fn the_policy_section_round_trips() {
+    let policy = BlobPolicy {
+        hold_timeout_ms: 2000,
+        fence: Some(([-0.5, -0.5], [3.0, 3.0])),
+        battery_land: 3.2,
+        battery_ms: 2000,
+        min_separation: 0.3,
+        start: [0.45, 1.1],
+        start_tolerance: 0.3,
+    };
+    let mut buf = [0u8; PH_MAX_BLOB_LEN];
+    let n = encode_blob_with(&paper_agent_1(), Some(&policy), &mut buf).expect("encode");
+    let blob = buf[..n].to_vec();
+    let blob = blob.as_slice();
+    assert_eq!(decode_blob_policy(blob), Ok(Some(policy)));
+    assert_eq!(init_blob(blob), ph_status::PH_OK);
+    let (s, c, start, tol) = blob_policy(blob);
+    assert_eq!(s, ph_status::PH_OK);
+    let want = ph_policy_config {
+        hold_timeout_ms: 2000,
+        fence: 1,
+        fence_min: [-0.5, -0.5],
+        fence_max: [3.0, 3.0],
+        battery_land: 3.2,
+        battery_ms: 2000,
+        min_separation: 0.3,
+    };
+    assert_eq!((c, start, tol), (want, [0.45, 1.1], 0.3));
+    // No fence: `fence = 0`.
+    let open = BlobPolicy {
+        fence: None,
+        ..policy
+    };
+    let n = encode_blob_with(&paper_agent_1(), Some(&open), &mut buf).expect("encode");
+    assert_eq!(blob_policy(&buf[..n]).1.fence, 0);
+    // Without a policy section (negative control): refused, nothing written.
+    let plain = encode(&paper_agent_1());
+    let (s, c, start, _) = blob_policy(&plain);
+    assert_eq!(s, ph_status::PH_ERR_BLOB_NO_POLICY);
+    assert_eq!(c, ph_policy_config::default());
+    assert!(start[0].is_nan());
+    // A corrupted blob: its blob status.
+    let mut bad = buf[..n].to_vec();
+    bad[10] ^= 1;
+    assert_eq!(blob_policy(&bad).0, ph_status::PH_ERR_BLOB_CHECKSUM);
+    // NULL outputs.
+    // SAFETY: `blob` is readable; NULL outputs are allowed.
+    let s = unsafe {
+        ph_blob_policy(
+            blob.as_ptr(),
+            blob.len(),
+            std::ptr::null_mut(),
+            std::ptr::null_mut(),
+            std::ptr::null_mut(),
+        )
+    };
+    assert_eq!(s, ph_status::PH_ERR_NULL);
 }

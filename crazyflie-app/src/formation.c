@@ -243,6 +243,7 @@ bool formation_positioning_locked(void)
     return vx < FORMATION_POSITION_VAR && vy < FORMATION_POSITION_VAR; /* false for NaN */
 }
 
+#ifdef FORMATION_USE_STRUCT
 /* crazyflie-app/formation.toml's [[agents]] positions, by id (checked by
  * controller-ffi/tests/crazyflie_app.rs). */
 static const float starts[][2] = {{0.0f, 0.0f}, {0.45f, 1.1f}, {1.1f, 1.4f}, {0.9f, 0.55f},
@@ -267,6 +268,21 @@ bool formation_policy(uint8_t id, flight_policy *p)
     p->start[1] = starts[id][1];
     return true;
 }
+#else
+/* The policies `host-sim export` wrote into agent `id`'s blob from formation.toml's
+ * [policy] (ph_blob_policy): one configuration, the scenario's, for the simulator and
+ * the app. A blob without them (a scenario without [policy]) gives no policy: the app
+ * refuses to start (app.c) rather than fly unguarded. */
+bool formation_policy(uint8_t id, flight_policy *p)
+{
+    const uint8_t *blob = NULL;
+    size_t len = 0;
+    __builtin_memset(p, 0, sizeof *p);
+    if (formation_blob(id, &blob, &len) != PH_OK)
+        return false;
+    return ph_blob_policy(blob, len, &p->core, p->start, &p->start_tolerance) == PH_OK;
+}
+#endif
 
 void formation_guard(const formation_state *state, uint32_t now_ms, ph_policy *policy,
                      const ph_policy_config *config, const float own[2], float setpoint[2])

@@ -635,6 +635,18 @@ int main(void)
         printf("FLIGHT FAIL policy: no agent 1\n");
         return 1;
     }
+    /* The policies come from the blob (formation.toml's [policy], host-sim export):
+     * the same values as the FORMATION_USE_STRUCT build's defines. */
+    check(pol.core.hold_timeout_ms == FORMATION_HOLD_TIMEOUT_MS && pol.core.fence == 1 &&
+              pol.core.fence_min[0] == FORMATION_FENCE_MIN_X &&
+              pol.core.fence_min[1] == FORMATION_FENCE_MIN_Y &&
+              pol.core.fence_max[0] == FORMATION_FENCE_MAX_X &&
+              pol.core.fence_max[1] == FORMATION_FENCE_MAX_Y &&
+              pol.core.battery_land == FORMATION_VBAT_LAND &&
+              pol.core.battery_ms == FORMATION_VBAT_MS &&
+              pol.core.min_separation == FORMATION_MIN_SEPARATION &&
+              pol.start_tolerance == FORMATION_START_TOLERANCE,
+          "policy_from_the_blob", "the blob's [policy] differs from formation.h's defines");
     idle_and_enable();
     preflight();
     lost();

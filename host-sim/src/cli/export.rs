@@ -15,7 +15,7 @@
 use super::ExportArgs;
 use crate::exit_code;
 use crate::model::Model;
-use ph_formation_ffi::blob::{encode_blob, PH_MAX_BLOB_LEN};
+use ph_formation_ffi::blob::{encode_blob_with, BlobPolicy, PH_MAX_BLOB_LEN};
 use ph_formation_ffi::PH_MAX_TRIANGLES;
 use std::fmt::Write as _;
 use std::io::Write as _;
@@ -160,15 +160,35 @@ fn export_agent(model: &Model, i: usize) -> Result<Exported, ExportError> {
             source,
         })?;
     let mut buf = [0u8; PH_MAX_BLOB_LEN];
-    let n = encode_blob(&config, &mut buf).map_err(|error| ExportError::Blob {
-        agent: name.clone(),
-        error,
+    let policy = blob_policy(model, i);
+    let n = encode_blob_with(&config, policy.as_ref(), &mut buf).map_err(|error| {
+        ExportError::Blob {
+            agent: name.clone(),
+            error,
+        }
     })?;
     Ok(Exported {
         name,
         id: config.id,
         triangles: config.triangles.len(),
         blob: buf[..n].to_vec(),
+    })
+}
+
+/// The scenario's `[policy]` for agent `i`'s blob, with its initial position as the
+/// pre-flight reference (`None` without `[policy]`).
+fn blob_policy(model: &Model, i: usize) -> Option<BlobPolicy> {
+    let p = model.policy.as_ref()?;
+    let start = model.agents.get(i).map_or([0.0; 2], |a| a.position);
+    let f = |x: [f64; 2]| x.map(|v| v as f32);
+    Some(BlobPolicy {
+        hold_timeout_ms: p.hold_timeout_ms,
+        fence: p.fence.then(|| (f(p.fence_min), f(p.fence_max))),
+        battery_land: p.battery_land as f32,
+        battery_ms: p.battery_ms,
+        min_separation: p.min_separation as f32,
+        start: f(start),
+        start_tolerance: model.start_tolerance as f32,
     })
 }
 

@@ -103,6 +103,10 @@ pub struct Model {
     pub world: WorldModel,
     /// The vehicles' safety policies (`[policy]`; `None`: none run).
     pub policy: Option<ph_formation_core::policy::PolicyConfig<f64>>,
+    /// The pre-flight check's radius around each agent's initial position (m,
+    /// `policy.start_tolerance_m`): exported to the app, not simulated (a run starts in
+    /// the air).
+    pub start_tolerance: f64,
     /// The vehicles' battery (`[battery]`; `None`: none modelled, no low-battery policy).
     pub battery: Option<BatteryModel>,
 }

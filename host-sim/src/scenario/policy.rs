@@ -28,6 +28,14 @@ pub struct PolicySpec {
     /// For this long (s).
     #[serde(default = "default_battery_land")]
     pub battery_land_s: f64,
+    /// The app's pre-flight check: the drone within this of its initial position (m;
+    /// exported in the blob, not simulated).
+    #[serde(default = "default_start_tolerance")]
+    pub start_tolerance_m: f64,
+}
+
+fn default_start_tolerance() -> f64 {
+    0.3
 }
 
 fn default_battery_land() -> f64 {

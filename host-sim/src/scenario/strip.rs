@@ -82,6 +82,7 @@ pub fn strip_model(n: usize, duration: f64) -> Result<Model, ScenarioErrors> {
         attacks: Vec::new(),
         world: crate::model::WorldModel::ideal(),
         policy: None,
+        start_tolerance: 0.3,
         battery: None,
         // The equilateral strip the 60° angles encode.
         target: Target {

@@ -150,6 +150,7 @@ fn check(
         attacks,
         target,
         world,
+        start_tolerance: s.policy.as_ref().map_or(0.3, |p| p.start_tolerance_m),
         policy,
         battery,
     };

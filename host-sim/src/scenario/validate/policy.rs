@@ -74,6 +74,11 @@ pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile) -> Option<PolicyConfi
         }
     };
     c.non_negative(InvalidValue, "policy.battery_land_v", p.battery_land_v);
+    c.positive(
+        InvalidValue,
+        "policy.start_tolerance_m",
+        p.start_tolerance_m,
+    );
     c.non_negative(InvalidValue, "policy.battery_land_s", p.battery_land_s);
     let battery_ms = (p.battery_land_s * 1000.0).round();
     if battery_ms > f64::from(u32::MAX) {
