@@ -48,9 +48,11 @@ pub mod stats;
 pub mod tracker;
 pub mod wire;
 
+#[cfg(any(feature = "sim", test))]
+pub use agent::Evaluation;
 pub use agent::{
-    Agent, BearingMeasurement, Evaluation, Fault, LawOutput, MeasurementError, Measurements,
-    OwnedEstimate, Status, StepOutput,
+    Agent, BearingMeasurement, Fault, LawOutput, MeasurementError, Measurements, OwnedEstimate,
+    Status, StepOutput,
 };
 pub use config::{
     AgentConfig, AgentId, AngleConfig, BearingFilter, ConfigError, EstimatorMode, Integrity,

@@ -23,8 +23,10 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// current estimates). Nothing else changes if they are refused, except that no
     /// angle is sent until the next accepted measurements.
     ///
-    /// [`Agent::step`] calls it; simulators that drive [`Agent::evaluate`] themselves
-    /// call it first (after [`Agent::set_estimate`], before exchanging frames).
+    /// [`Agent::step`] does the same; simulators that drive [`Agent::evaluate`] themselves
+    /// call it first (after [`Agent::set_estimate`], before exchanging frames). Feature
+    /// `sim` only (not built for the firmware).
+    #[cfg(any(feature = "sim", test))]
     pub fn sense(&mut self, m: &Measurements<'_, T>) -> Result<(), Fault> {
         self.sense_own(m)?;
         let (mode, v) = (self.config.estimator, self.velocity);
@@ -74,8 +76,8 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 v: m.velocity,
                 v_before,
                 limits: TrackLimits {
-                    rho_initial: T::one() / self.config.initial_estimate,
-                    rho_max: T::one() / self.config.min_estimate,
+                    inv_range_initial: T::one() / self.config.initial_estimate,
+                    inv_range_max: T::one() / self.config.min_estimate,
                 },
             }),
             BearingFilter::FiniteDifference => None,
@@ -271,7 +273,7 @@ fn apex_part<T: Real, const MT: usize>(
         share,
         force: k.force,
         sigma: k.sigma,
-        rho: r,
+        range: r,
     })
 }
 

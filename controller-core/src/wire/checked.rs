@@ -44,7 +44,8 @@ impl CrcCheck {
     }
 
     /// The check of a frame this crate has just finished (its trailer is its CRC, by
-    /// construction): no CRC computed.
+    /// construction): no CRC computed. (For `Agent::frames_checked`, feature `sim`.)
+    #[cfg(any(feature = "sim", test))]
     pub(crate) fn written(bytes: &[u8]) -> Option<Self> {
         Self::new(bytes, true)
     }
@@ -64,6 +65,8 @@ impl CrcCheck {
     }
 
     /// The check's result if it was computed from `bytes` (same length and trailer).
+    /// (For `Agent::receive_checked`, feature `sim`.)
+    #[cfg(any(feature = "sim", test))]
     #[inline]
     pub(crate) fn result_for(&self, bytes: &[u8]) -> Option<bool> {
         let len_ok = self.len_ok.get();
