@@ -68,7 +68,7 @@ pub mod results {
     pub use ph_formation_core::policy::PolicyCounts;
 }
 
-/// Why a library call failed: the parts of [`Error`](crate::Error).
+/// Why a library call failed: the parts of [`Error`].
 pub mod errors {
     pub use crate::engine::hil::{HilError, When};
     pub use crate::engine::SetupError;

@@ -7,7 +7,7 @@ use core::num::NonZeroU8;
 /// The result of the CRC-16 check of one `crc16` frame, computed once
 /// ([`CrcCheck::of`]) for bytes that several receivers take in: a simulator delivers each
 /// broadcast to every agent in radio range, and each would compute the same CRC of the
-/// same bytes. [`crate::Agent::receive_checked`] uses it instead of computing the CRC
+/// same bytes. `Agent::receive_checked` (feature `sim`) uses it instead of computing the CRC
 /// again, and only for the bytes it was computed from (same length and trailer;
 /// otherwise it computes the CRC itself). Everything else about the frame is checked by
 /// each receiver as in [`crate::Agent::receive`], with the same result.
