@@ -30,7 +30,7 @@ pub struct Track<T: Real> {
     /// Seconds of the interval since the last bearing that [`Track::predict`] has
     /// already propagated `ŝ`, `ρ̂` and `P` over (SPEC §12, S18): the next
     /// [`Track::update`] predicts over the rest only.
-    pub predicted: T,
+    pub predicted_span: T,
 }
 
 /// What the tracker needs besides its configuration: the agent-wide constants.
@@ -46,7 +46,7 @@ pub struct TrackLimits<T: Real> {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RelativeVelocity<T: Real> {
     /// Over the interval since the previous bearing, as known at its start (S15).
-    pub moved: Vec2<T>,
+    pub over_interval: Vec2<T>,
     /// Now (S17).
     pub now: Vec2<T>,
 }
@@ -75,13 +75,13 @@ impl<T: Real> Track<T> {
     ) -> Vec2<T> {
         let r = c.bearing_noise * c.bearing_noise;
         // SPEC §12: what `predict` propagated over already is not predicted again.
-        let dt = dt - core::mem::take(&mut self.predicted);
-        let (moved, dv) = (&dv.moved, &dv.now);
+        let dt = dt - core::mem::take(&mut self.predicted_span);
+        let (over_interval, dv) = (&dv.over_interval, &dv.now);
         if !(dt > T::zero() && dt.finite()) {
             self.start(s, z, r, lim);
             return rate(s, self.inv_range, dv);
         }
-        let (s_pred, inv_range_pred, [p00, p01, p11]) = self.s15(s, moved, dt, c, lim);
+        let (s_pred, inv_range_pred, [p00, p01, p11]) = self.s15(s, over_interval, dt, c, lim);
         // S16: the bearing as a measurement of the tangent angle, e = (Jŝ)ᵀz ≈ δθ.
         let tp = perp(&s_pred);
         let (e, along) = (tp.dot(z), s_pred.dot(z));
@@ -125,30 +125,30 @@ impl<T: Real> Track<T> {
         c: &TrackerConfig<T>,
         lim: &TrackLimits<T>,
     ) -> Vec2<T> {
-        let dt = since - self.predicted;
+        let dt = since - self.predicted_span;
         if dt > T::zero() && dt.finite() {
-            let (s_pred, inv_range_pred, p) = self.s15(s, &dv.moved, dt, c, lim);
+            let (s_pred, inv_range_pred, p) = self.s15(s, &dv.over_interval, dt, c, lim);
             *s = s_pred;
             self.inv_range = inv_range_pred;
             self.p = p;
-            self.predicted = since;
+            self.predicted_span = since;
         }
         rate(s, self.inv_range, &dv.now)
     }
 
     /// S15: the prediction over `dt` along the bearing kinematics (S2, S3) with `ρ̂` for
-    /// `1/r`, driven by the relative velocity `moved`: `(ŝ⁻, ρ̂⁻, P⁻)`.
+    /// `1/r`, driven by the relative velocity `over_interval`: `(ŝ⁻, ρ̂⁻, P⁻)`.
     #[inline(always)]
     fn s15(
         &self,
         s: &Vec2<T>,
-        moved: &Vec2<T>,
+        over_interval: &Vec2<T>,
         dt: T,
         c: &TrackerConfig<T>,
         lim: &TrackLimits<T>,
     ) -> (Vec2<T>, T, [T; 3]) {
         let t = perp(s);
-        let (a, b) = (t.dot(moved), s.dot(moved));
+        let (a, b) = (t.dot(over_interval), s.dot(over_interval));
         let delta = dt * self.inv_range * a;
         let s_pred = unit(&(*s + t * delta));
         let inv_range_pred = clamp(
@@ -174,7 +174,7 @@ impl<T: Real> Track<T> {
             inv_range,
             p: [r, T::zero(), inv_range * inv_range],
             rejected: 0,
-            predicted: T::zero(),
+            predicted_span: T::zero(),
         };
     }
 }

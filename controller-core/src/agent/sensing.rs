@@ -338,7 +338,7 @@ fn take_bearing<T: Real, const MT: usize>(
         // the last tick with the own velocity then, the rate with the own velocity now.
         (None, Some(t)) => {
             let dv = RelativeVelocity {
-                moved: n.velocity - t.v_before,
+                over_interval: n.velocity - t.v_before,
                 now: n.velocity - t.v,
             };
             let mut s = n.s;
@@ -391,11 +391,11 @@ fn hold_missing<T: Real, const MT: usize>(
                 // The first tick of the gap (the bearing was measured at the last one):
                 // nothing of an earlier gap is left to subtract (a bearing with a
                 // measured rate bypasses the tracker's update, which clears it).
-                n.track.predicted = T::zero();
+                n.track.predicted_span = T::zero();
             }
             // The same relative velocities as `take_bearing` gives the tracker (SPEC §11).
             let dv = RelativeVelocity {
-                moved: n.velocity - t.v_before,
+                over_interval: n.velocity - t.v_before,
                 now: n.velocity - t.v,
             };
             n.rate = n.track.predict(&mut n.s, &dv, since, t.c, &t.limits);
