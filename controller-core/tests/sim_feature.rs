@@ -2,11 +2,14 @@
 //! `set_estimate`, …) are not built into the flight code: cargo's own resolution of the
 //! firmware's and the C API's builds leaves the feature off (docs/core.md, "Feature
 //! `sim`"). `cargo tree` resolves features exactly as `cargo build` does, without
-//! building; `--target all` takes every platform's dependencies, so a dependency that
-//! only the microcontroller build has is seen too.
+//! building; the flight builds are resolved for their target (`thumbv7em-none-eabihf`),
+//! so a dependency that only the microcontroller build has is seen too.
 
 use std::path::Path;
 use std::process::Command;
+
+/// The microcontroller target of the firmware and the C API's staticlib.
+const FLIGHT: &str = "thumbv7em-none-eabihf";
 
 /// The features of `ph-formation-core` in the normal (not dev) dependency graph of
 /// `cargo tree` run with `args`, or the error.
@@ -15,7 +18,7 @@ fn core_features(args: &[&str]) -> Vec<String> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
     let out = Command::new(cargo)
         .current_dir(&root)
-        .args(["tree", "--offline", "--target", "all", "-e", "normal,build"])
+        .args(["tree", "-e", "normal,build"])
         .args(["--prefix", "none", "-f", "{p}|{f}"])
         .args(args)
         .output()
@@ -50,15 +53,17 @@ fn features_of(tree: &str, package: &str) -> Vec<String> {
 #[test]
 fn no_flight_build_enables_the_simulator_entry_points() {
     let builds: [&[&str]; 3] = [
-        &["-p", "firmware-example"],
+        &["--target", FLIGHT, "-p", "firmware-example"],
         &[
+            "--target",
+            FLIGHT,
             "-p",
             "firmware-example",
             "--no-default-features",
             "--features",
             "rtt",
         ],
-        &["-p", "ph-formation-ffi"],
+        &["--target", FLIGHT, "-p", "ph-formation-ffi"],
     ];
     for args in builds {
         let features = core_features(args);
