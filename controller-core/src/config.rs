@@ -59,7 +59,7 @@ pub struct TrackerConfig<T> {
     pub rate_noise: T,
     /// `σ_ρ ≥ 0`: random walk of the inverse distance, density `σ_ρ²` (1/(m² s)) in S15.
     pub inverse_range_noise: T,
-    /// `g > 0`: a bearing whose innovation exceeds `g` standard deviations is an outlier
+    /// `1 ≤ g ≤ 1000`: a bearing whose innovation exceeds `g` standard deviations is an outlier
     /// and is not used (S16); three in a row restart the track.
     pub gate: T,
 }

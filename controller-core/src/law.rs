@@ -140,7 +140,7 @@ pub fn at_floor<T: Real>(r_hat: T, r_min: T) -> bool {
 }
 
 /// S10's floor `max(r_min, r̂)`, a NaN estimate read as `r_min`: the one implementation
-/// of the floor (the sampled step [`estimator_step`], [`crate::Agent::set_estimate`] and
+/// of the floor (the sampled step [`estimator_step`], `Agent::set_estimate` (feature `sim`) and
 /// host-sim's continuous integration use it).
 #[inline]
 pub fn estimate_floor<T: Real>(r_hat: T, r_min: T) -> T {

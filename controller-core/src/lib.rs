@@ -18,6 +18,12 @@
 //! 3. [`Agent::frames`] → one frame of at most 60 bytes to broadcast (more for the apex
 //!    of more angles than a frame holds, [`wire::Integrity::max_angles`]: 4 with every
 //!    integrity mode; none on the ticks [`AgentConfig::comm_every`] skips).
+//!
+//! Cargo features (none by default): `defmt` (`defmt::Format` for the public types, for
+//! firmware logging); `std` (host builds: binary16 conversions with F16C); `sim`, the
+//! simulator's entry points (`Agent::sense`, `evaluate`, `output`, `set_estimate`,
+//! `copy_estimates`, `receive_direct`, `frames_checked`, `receive_checked`), which a
+//! firmware never enables (`docs/core.md`, "Feature `sim`").
 #![no_std]
 #![deny(
     clippy::unwrap_used,
@@ -48,9 +54,11 @@ pub mod stats;
 pub mod tracker;
 pub mod wire;
 
+#[cfg(any(feature = "sim", test))]
+pub use agent::Evaluation;
 pub use agent::{
-    Agent, BearingMeasurement, Evaluation, Fault, LawOutput, MeasurementError, Measurements,
-    OwnedEstimate, Status, StepOutput,
+    Agent, BearingMeasurement, Fault, LawOutput, MeasurementError, Measurements, OwnedEstimate,
+    Status, StepOutput,
 };
 pub use config::{
     AgentConfig, AgentId, AngleConfig, BearingFilter, ConfigError, EstimatorMode, Integrity,

@@ -22,7 +22,7 @@ use crate::{Real, Vec2};
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Track<T: Real> {
     /// `ρ̂ ≥ 0`, the inverse distance (1/m).
-    pub rho: T,
+    pub inv_range: T,
     /// Covariance of `(δθ, δρ)`: `[p00, p01, p11]`.
     pub p: [T; 3],
     /// Measurements in a row that failed the gate (S16).
@@ -30,23 +30,23 @@ pub struct Track<T: Real> {
     /// Seconds of the interval since the last bearing that [`Track::predict`] has
     /// already propagated `ŝ`, `ρ̂` and `P` over (SPEC §12, S18): the next
     /// [`Track::update`] predicts over the rest only.
-    pub predicted: T,
+    pub predicted_span: T,
 }
 
 /// What the tracker needs besides its configuration: the agent-wide constants.
 #[derive(Clone, Copy, Debug)]
 pub struct TrackLimits<T: Real> {
     /// `ρ̂(0) = 1/r̂(0)` (the configured initial estimate, SPEC §6).
-    pub rho_initial: T,
+    pub inv_range_initial: T,
     /// `ρ_max = 1/r_min` (S10's floor).
-    pub rho_max: T,
+    pub inv_range_max: T,
 }
 
 /// The relative velocity `v_w − v_u` the tracker is driven by (S15, S17).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RelativeVelocity<T: Real> {
     /// Over the interval since the previous bearing, as known at its start (S15).
-    pub moved: Vec2<T>,
+    pub over_interval: Vec2<T>,
     /// Now (S17).
     pub now: Vec2<T>,
 }
@@ -75,13 +75,13 @@ impl<T: Real> Track<T> {
     ) -> Vec2<T> {
         let r = c.bearing_noise * c.bearing_noise;
         // SPEC §12: what `predict` propagated over already is not predicted again.
-        let dt = dt - core::mem::take(&mut self.predicted);
-        let (moved, dv) = (&dv.moved, &dv.now);
+        let dt = dt - core::mem::take(&mut self.predicted_span);
+        let (over_interval, dv) = (&dv.over_interval, &dv.now);
         if !(dt > T::zero() && dt.finite()) {
             self.start(s, z, r, lim);
-            return rate(s, self.rho, dv);
+            return rate(s, self.inv_range, dv);
         }
-        let (s_pred, rho_pred, [p00, p01, p11]) = self.s15(s, moved, dt, c, lim);
+        let (s_pred, inv_range_pred, [p00, p01, p11]) = self.s15(s, over_interval, dt, c, lim);
         // S16: the bearing as a measurement of the tangent angle, e = (Jŝ)ᵀz ≈ δθ.
         let tp = perp(&s_pred);
         let (e, along) = (tp.dot(z), s_pred.dot(z));
@@ -98,18 +98,18 @@ impl<T: Real> Track<T> {
                 self.start(s, z, r, lim);
             } else {
                 *s = s_pred;
-                self.rho = rho_pred;
+                self.inv_range = inv_range_pred;
                 self.p = [p00, p01, p11];
             }
-            return rate(s, self.rho, dv);
+            return rate(s, self.inv_range, dv);
         }
         self.rejected = 0;
         let (k0, k1) = (p00 / sv, p01 / sv);
         *s = unit(&(s_pred + tp * (k0 * e)));
-        self.rho = clamp(rho_pred + k1 * e, lim.rho_max);
+        self.inv_range = clamp(inv_range_pred + k1 * e, lim.inv_range_max);
         let one_k0 = T::one() - k0;
         self.p = [one_k0 * p00, one_k0 * p01, p11 - k1 * p01];
-        rate(s, self.rho, dv)
+        rate(s, self.inv_range, dv)
     }
 
     /// No bearing this tick, `since` seconds after the last one (SPEC §12, S18): S15
@@ -125,62 +125,65 @@ impl<T: Real> Track<T> {
         c: &TrackerConfig<T>,
         lim: &TrackLimits<T>,
     ) -> Vec2<T> {
-        let dt = since - self.predicted;
+        let dt = since - self.predicted_span;
         if dt > T::zero() && dt.finite() {
-            let (s_pred, rho_pred, p) = self.s15(s, &dv.moved, dt, c, lim);
+            let (s_pred, inv_range_pred, p) = self.s15(s, &dv.over_interval, dt, c, lim);
             *s = s_pred;
-            self.rho = rho_pred;
+            self.inv_range = inv_range_pred;
             self.p = p;
-            self.predicted = since;
+            self.predicted_span = since;
         }
-        rate(s, self.rho, &dv.now)
+        rate(s, self.inv_range, &dv.now)
     }
 
     /// S15: the prediction over `dt` along the bearing kinematics (S2, S3) with `ρ̂` for
-    /// `1/r`, driven by the relative velocity `moved`: `(ŝ⁻, ρ̂⁻, P⁻)`.
+    /// `1/r`, driven by the relative velocity `over_interval`: `(ŝ⁻, ρ̂⁻, P⁻)`.
     #[inline(always)]
     fn s15(
         &self,
         s: &Vec2<T>,
-        moved: &Vec2<T>,
+        over_interval: &Vec2<T>,
         dt: T,
         c: &TrackerConfig<T>,
         lim: &TrackLimits<T>,
     ) -> (Vec2<T>, T, [T; 3]) {
         let t = perp(s);
-        let (a, b) = (t.dot(moved), s.dot(moved));
-        let delta = dt * self.rho * a;
+        let (a, b) = (t.dot(over_interval), s.dot(over_interval));
+        let delta = dt * self.inv_range * a;
         let s_pred = unit(&(*s + t * delta));
-        let rho_pred = clamp(self.rho - dt * self.rho * self.rho * b, lim.rho_max);
+        let inv_range_pred = clamp(
+            self.inv_range - dt * self.inv_range * self.inv_range * b,
+            lim.inv_range_max,
+        );
         let f01 = dt * a;
-        let f11 = T::one() - T::lit(2.0) * dt * self.rho * b;
+        let f11 = T::one() - T::lit(2.0) * dt * self.inv_range * b;
         let [p00, p01, p11] = self.p;
         let p11f = p11 * f01;
         let p00 = p00 + f01 * (p01 + p01 + p11f) + c.rate_noise * c.rate_noise * dt;
         let p01 = f11 * (p01 + p11f);
         let p11 = f11 * f11 * p11 + c.inverse_range_noise * c.inverse_range_noise * dt;
-        (s_pred, rho_pred, [p00, p01, p11])
+        (s_pred, inv_range_pred, [p00, p01, p11])
     }
 
     /// (Re)starts the track at bearing `z` with `ρ̂(0)`: variance `R` on the angle, `ρ̂(0)²`
     /// (100 %) on the inverse distance.
     fn start(&mut self, s: &mut Vec2<T>, z: &Vec2<T>, r: T, lim: &TrackLimits<T>) {
-        let rho = clamp(lim.rho_initial, lim.rho_max);
+        let inv_range = clamp(lim.inv_range_initial, lim.inv_range_max);
         *s = *z;
         *self = Self {
-            rho,
-            p: [r, T::zero(), rho * rho],
+            inv_range,
+            p: [r, T::zero(), inv_range * inv_range],
             rejected: 0,
-            predicted: T::zero(),
+            predicted_span: T::zero(),
         };
     }
 }
 
 /// S17: `ṡ̂ = ρ̂ P(ŝ) Δv = ρ̂ ((Jŝ)ᵀΔv) Jŝ` (S2 with `ρ̂` for `1/r`).
 #[inline]
-pub fn rate<T: Real>(s: &Vec2<T>, rho: T, dv: &Vec2<T>) -> Vec2<T> {
+pub fn rate<T: Real>(s: &Vec2<T>, inv_range: T, dv: &Vec2<T>) -> Vec2<T> {
     let t = perp(s);
-    t * (rho * t.dot(dv))
+    t * (inv_range * t.dot(dv))
 }
 
 /// `x / |x|` (the tracker's vectors are never near zero: a unit vector plus a
@@ -192,11 +195,11 @@ fn unit<T: Real>(x: &Vec2<T>) -> Vec2<T> {
 
 /// `ρ` clamped to `[0, ρ_max]` (NaN becomes 0).
 #[inline]
-fn clamp<T: Real>(rho: T, rho_max: T) -> T {
-    if rho > rho_max {
-        rho_max
-    } else if rho >= T::zero() {
-        rho
+fn clamp<T: Real>(inv_range: T, inv_range_max: T) -> T {
+    if inv_range > inv_range_max {
+        inv_range_max
+    } else if inv_range >= T::zero() {
+        inv_range
     } else {
         T::zero()
     }

@@ -45,7 +45,7 @@ fn signed(key: SwarmKey, sender: AgentId, c: Counter, items: usize) -> Vec<u8> {
     let mut w = FrameWriter::new(Integrity::Auth(key));
     w.start_counted(mode(), sender, c, [0.25, -0.5]);
     for i in 0..items {
-        // γ 0.5, σ 0.5, ρ 1.0, 1.5 (binary16 codes); far vertices (2, 3) or (3, 2).
+        // γ 0.5, σ 0.5, r 1.0, 1.5 (binary16 codes); far vertices (2, 3) or (3, 2).
         let far = if i % 2 == 0 { [2, 3] } else { [3, 2] };
         assert!(w.push_angle(far, [0x3800, 0x3800, 0x3C00, 0x3E00]));
     }

@@ -64,8 +64,8 @@ fn config(sigma: f64) -> TrackerConfig<f64> {
 }
 
 const LIMITS: TrackLimits<f64> = TrackLimits {
-    rho_initial: 1.0,
-    rho_max: 10.0,
+    inv_range_initial: 1.0,
+    inv_range_max: 10.0,
 };
 
 /// Runs the tracker over `[0, t_end]` with bearing noise `sigma`; calls `each(t, ŝ, ṡ̂,
@@ -87,11 +87,11 @@ fn run(
         let t = k as f64 * DT;
         let (s, _) = scene.truth(t);
         let z = rotate(&s, sigma * normal(&mut rng));
-        let moved = scene.velocity((t - DT).max(0.0));
+        let over_interval = scene.velocity((t - DT).max(0.0));
         // The first bearing has no previous one: an interval of −∞, as the agent passes.
         let dt = if k == 0 { f64::NEG_INFINITY } else { DT };
         let dv = RelativeVelocity {
-            moved,
+            over_interval,
             now: scene.velocity(t),
         };
         let rh = tr.update(&mut sh, &z, &dv, dt, &c, &LIMITS);
@@ -228,7 +228,7 @@ fn an_outlier_is_gated_out_and_a_lost_track_restarts() {
     assert!((sh - wrong).norm() < 1e-12);
     // The restarted track's rate is S17 with ρ̂(0).
     let turning = RelativeVelocity {
-        moved: Vec2::zeros(),
+        over_interval: Vec2::zeros(),
         now: Vec2::new(0.0, 1.0),
     };
     let rate = tr.update(&mut sh, &wrong, &turning, DT, &c, &LIMITS);

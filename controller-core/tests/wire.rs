@@ -58,7 +58,7 @@ const SHARED: u8 = mode_byte(Integrity::Crc16, EstimatorMode::Shared);
 
 /// The frames over the wire give the same forces as a direct exchange, within the
 /// documented rounding (relative 2⁻¹¹ per value, `wire::quant`): a far vertex's S8 force
-/// `γσ/ρ` then carries a relative error of at most about 3·2⁻¹¹ (γ, σ, ρ each rounded),
+/// `γσ/r` then carries a relative error of at most about 3·2⁻¹¹ (γ, σ, r each rounded),
 /// so an agent's force is off by at most that times the far-vertex forces it received.
 #[test]
 fn frames_round_trip_between_agents_within_the_rounding_bound() {
@@ -86,7 +86,7 @@ fn frames_round_trip_between_agents_within_the_rounding_bound() {
                             // |γ σ / r| with the distance the far vertex divides by (the
                             // test's distances and estimates are ≥ 0.3).
                             let r = if mode == EstimatorMode::Shared {
-                                f32::from(it.rho[k])
+                                f32::from(it.range[k])
                             } else {
                                 0.3
                             };
@@ -167,7 +167,7 @@ fn one_frame() -> (Formation, Vec<HostAgent<f64>>, Vec<u8>) {
 }
 
 /// A frame from `sender` with `seq`, velocity `v` and the given angle items (codes of
-/// `[γ, σ, ρ_v, ρ_w]`).
+/// `[γ, σ, r_v, r_w]`).
 fn frame(sender: u8, seq: u16, v: [f32; 2], items: &[([u8; 2], [u16; 4])]) -> Vec<u8> {
     let mut w = FrameWriter::new(Integrity::Crc16);
     w.start(SHARED, sender, seq, v);
@@ -274,10 +274,10 @@ fn wrong_version_mode_length_and_values_are_rejected_and_counted() {
         ([0.0; 2], [0x7E00, 0, ONE, ONE]), // γ = NaN
         ([0.0; 2], [0, 0x3C01, ONE, ONE]), // σ just above 1
         ([0.0; 2], [0, 0xBC01, ONE, ONE]), // σ just below −1
-        ([0.0; 2], [0, 0, 0, ONE]),        // ρ = 0
-        ([0.0; 2], [0, 0, ONE, 0xBC00]),   // ρ = −1
-        ([0.0; 2], [0, 0, ONE, 0xFC00]),   // ρ = −∞
-        ([0.0; 2], [0, 0, 0x2E65, ONE]),   // ρ just below r_min as rounded
+        ([0.0; 2], [0, 0, 0, ONE]),        // r = 0
+        ([0.0; 2], [0, 0, ONE, 0xBC00]),   // r = −1
+        ([0.0; 2], [0, 0, ONE, 0xFC00]),   // r = −∞
+        ([0.0; 2], [0, 0, 0x2E65, ONE]),   // r just below r_min as rounded
     ];
     for (k, (v, e)) in bad.iter().enumerate() {
         assert_eq!(
@@ -298,7 +298,7 @@ fn wrong_version_mode_length_and_values_are_rejected_and_counted() {
         ),
         (2, 4, 4, 3, 11, 0)
     );
-    // Nothing of the rejected frames was applied; σ = ±1 and ρ = r_min (rounded) are in
+    // Nothing of the rejected frames was applied; σ = ±1 and r = r_min (rounded) are in
     // range.
     rx.receive(&good).expect("valid");
     rx.receive(&frame(
@@ -367,7 +367,7 @@ fn reference_decode(b: &[u8]) -> (u8, usize, u8, u16, [f32; 2], Vec<([u8; 2], [f
     )
 }
 
-/// Valid codes of `[γ, σ, ρ_v, ρ_w]`: finite γ, |σ| ≤ 1, ρ ≥ 0.1.
+/// Valid codes of `[γ, σ, r_v, r_w]`: finite γ, |σ| ≤ 1, r ≥ 0.1.
 fn item_codes() -> impl Strategy<Value = [u16; 4]> {
     (
         any::<u16>().prop_filter("finite", |c| c & 0x7C00 != 0x7C00),
@@ -422,7 +422,7 @@ proptest! {
         for ((it, (far, codes)), (rf, re)) in decoded.angles.iter().zip(&items).zip(&its) {
             prop_assert_eq!(it.far, *far);
             prop_assert_eq!(*rf, *far);
-            let got = [it.gamma, it.sigma, it.rho[0], it.rho[1]];
+            let got = [it.gamma, it.sigma, it.range[0], it.range[1]];
             for k in 0..4 {
                 prop_assert_eq!(f64::from(got[k]), re[k]);
                 prop_assert_eq!(got[k].0, codes[k]);
@@ -434,7 +434,7 @@ proptest! {
     /// Any bytes behind a valid CRC: the core's decoder accepts a frame exactly when the
     /// documented layout holds (version 4: bits 7–4 of the mode byte are 8 + the item
     /// count, the receiver's modes in bits 3–0, the announced number of items with two
-    /// distinct far vertices, finite values, |σ| ≤ 1, ρ > 0).
+    /// distinct far vertices, finite values, |σ| ≤ 1, r > 0).
     #[test]
     fn decoder_accepts_exactly_the_documented_frames(
         body in proptest::collection::vec(any::<u8>(), 0..60),

@@ -35,7 +35,7 @@ fn receiver(integrity: Integrity) -> HostAgent<f64> {
 }
 
 /// A valid frame of `integrity` from id 2 with sequence number `seq`, velocity `v` and
-/// one angle item about the far vertices 1 and 3 (codes of `[γ, σ, ρ_v, ρ_w]`).
+/// one angle item about the far vertices 1 and 3 (codes of `[γ, σ, r_v, r_w]`).
 fn frame(integrity: Integrity, seq: u16, v: [f32; 2], codes: [u16; 4]) -> Vec<u8> {
     let mut w = FrameWriter::new(integrity);
     w.start(mode_byte(integrity, EstimatorMode::Shared), 2, seq, v);
@@ -81,7 +81,7 @@ fn delivery() -> impl Strategy<Value = Delivery> {
             [ONE, 0xB800, ONE, ONE],
             [0, 0, ONE, ONE],
             [0x7E00, 0, ONE, ONE], // γ = NaN: invalid value behind a valid CRC
-            [0, 0, 0, ONE],        // ρ = 0
+            [0, 0, 0, ONE],        // r = 0
         ]),
         prop::collection::vec(any::<usize>(), 0..3),
         prop::option::weighted(0.2, 0usize..=MAX_FRAME_LEN + 4),

@@ -34,7 +34,7 @@ struct Sent {
     frame: Frame,
 }
 
-/// Valid binary16 codes of `[γ, σ, ρ_v, ρ_w]`: finite γ, |σ| ≤ 1, ρ > 0 finite.
+/// Valid binary16 codes of `[γ, σ, r_v, r_w]`: finite γ, |σ| ≤ 1, r > 0 finite.
 fn codes() -> impl Strategy<Value = [u16; 4]> {
     (
         any::<u16>().prop_filter("finite", |c| c & 0x7C00 != 0x7C00),
@@ -52,7 +52,7 @@ fn item() -> impl Strategy<Value = AngleItem> {
             far,
             gamma: F16(g),
             sigma: F16(s),
-            rho: [F16(a), F16(b)],
+            range: [F16(a), F16(b)],
         })
 }
 
@@ -94,7 +94,7 @@ fn fast_encode(s: &Sent) -> Vec<u8> {
     let mut w = FrameWriter::new(s.integrity);
     w.start_counted(f.header.mode, f.header.sender, s.counter, f.velocity);
     for a in &f.angles {
-        let codes = [a.gamma.0, a.sigma.0, a.rho[0].0, a.rho[1].0];
+        let codes = [a.gamma.0, a.sigma.0, a.range[0].0, a.range[1].0];
         assert!(w.push_angle(a.far, codes), "a valid frame's item fits");
     }
     w.finish().to_vec()
@@ -318,7 +318,7 @@ fn every_frame_kind_fits_60_bytes() {
                             far: [2, 3 + i as u8],
                             gamma: F16(0x3C00),
                             sigma: F16(0x3800),
-                            rho: [F16(0x3C00); 2],
+                            range: [F16(0x3C00); 2],
                         })
                         .collect(),
                     counter_ext: (auth && k < 4).then_some(CounterExt { epoch: 3, high: 0 }),

@@ -3,11 +3,14 @@
 //! layout is [`crate::wire`]'s.
 
 use super::state::{AngleState, Remote, Side};
-use super::{finite_vec, pick, Agent};
-use crate::config::{AgentId, EstimatorMode};
+use super::{pick, Agent};
+use crate::config::AgentId;
 use crate::wire::auth::{self, Counter};
-use crate::wire::{check_mode, quant, CrcCheck, FrameError, Integrity, RawAngle};
+use crate::wire::{check_mode, quant, FrameError, Integrity, RawAngle};
+// The simulator's entry points (feature `sim`).
 use crate::{law, Real, Vec2};
+#[cfg(any(feature = "sim", test))]
+use {super::finite_vec, crate::config::EstimatorMode, crate::wire::CrcCheck};
 
 /// `auth`: an agent whose broadcasts fill every frame (no room for the counter
 /// extension) adds a sync frame (velocity and counter extension, no items) to the first
@@ -41,8 +44,8 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// `auth`: every frame carries the next counter; a broadcast of full frames only is
     /// followed by a sync frame now and then (every `SYNC_EVERY` frames); after `2³² − 1` frames
     /// in one boot epoch the agent sends nothing more (a counter is never reused).
-    pub fn frames(&mut self, mut send: impl FnMut(&[u8])) -> usize {
-        self.frames_checked(|bytes, _| send(bytes))
+    pub fn frames(&mut self, send: impl FnMut(&[u8])) -> usize {
+        self.encode_frames(send)
     }
 
     /// The most frames [`Agent::frames`] sends in one tick, in any integrity mode: the
@@ -54,11 +57,15 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// [`Agent::frames`], each frame with its [`CrcCheck`] (`crc16` integrity; `None`
     /// otherwise), known without computing the CRC again since this agent has just written
     /// it: for simulators that hand each broadcast to [`Agent::receive_checked`] of every
-    /// receiver.
+    /// receiver. Feature `sim` only (not built for the firmware).
+    #[cfg(any(feature = "sim", test))]
     pub fn frames_checked(&mut self, mut send: impl FnMut(&[u8], Option<CrcCheck>)) -> usize {
         let crc16 = matches!(self.config.integrity, Integrity::Crc16);
-        let mut send =
-            |bytes: &[u8]| send(bytes, crc16.then(|| CrcCheck::written(bytes)).flatten());
+        self.encode_frames(|bytes| send(bytes, crc16.then(|| CrcCheck::written(bytes)).flatten()))
+    }
+
+    /// [`Agent::frames`]: this tick's broadcast, each frame passed to `send`.
+    fn encode_frames(&mut self, mut send: impl FnMut(&[u8])) -> usize {
         if !self.comm_due {
             return 0;
         }
@@ -75,11 +82,11 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         let (writer, angles) = (&mut self.writer, &self.angles);
         writer.start_counted(mode, id, counter, velocity);
         for a in angles.as_slice().as_flattened() {
-            let Some((gamma, sigma, rho)) = sent_angle(a) else {
+            let Some((gamma, sigma, range)) = sent_angle(a) else {
                 continue;
             };
             let q = |x: T| quant::encode(x.as_f32()).0;
-            let code = [q(gamma), unit_code(q(sigma)), q(rho[0]), q(rho[1])];
+            let code = [q(gamma), unit_code(q(sigma)), q(range[0]), q(range[1])];
             if !writer.push_angle(a.far, code) {
                 send(writer.finish());
                 count += 1;
@@ -133,7 +140,9 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// `check` is [`CrcCheck::of`] these same bytes (or `None`). The same result and
     /// counters as `receive`, without computing the CRC again; for simulators that hand
     /// one broadcast to many agents. As a guard, a check whose length or trailer differs
-    /// from `bytes` is ignored (the CRC is then computed).
+    /// from `bytes` is ignored (the CRC is then computed). Feature `sim` only (not built
+    /// for the firmware).
+    #[cfg(any(feature = "sim", test))]
     pub fn receive_checked(
         &mut self,
         bytes: &[u8],
@@ -212,7 +221,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         };
         // The whole frame is valid before anything is applied. With estimators, the
         // distances are estimates: at least r_min (as rounded: rounding is monotone).
-        frame.validate(self.rho_min_code)?;
+        frame.validate(self.range_min_code)?;
         let [vx, vy] = frame.velocity;
         if let Some(n) = self.neighbours.get_mut(slot) {
             n.last_seq = Some(seq);
@@ -244,7 +253,8 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// ([`FrameError::Malformed`]), a finite `γ` and `σ` and distances that are finite,
     /// positive and (with estimators) at least `r_min` ([`FrameError::InvalidValue`]).
     /// (`|σ| ≤ 1` is not checked: the wire rounds `σ` into it, a direct value may exceed
-    /// it by a rounding.)
+    /// it by a rounding.) Feature `sim` only (not built for the firmware).
+    #[cfg(any(feature = "sim", test))]
     pub fn receive_direct(&mut self, from: &Self) -> Result<(), FrameError> {
         let sender = from.id();
         let slot = self.slot(sender).ok_or(FrameError::UnknownSender(sender))?;
@@ -256,10 +266,10 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         self.oldest = None;
         let me = self.config.id;
         for a in from.angles.iter().flatten() {
-            if let (Some((gamma, sigma, rho)), Some((k, other))) =
+            if let (Some((gamma, sigma, range)), Some((k, other))) =
                 (sent_angle(a), far_role(a.far, me))
             {
-                self.apply_angle(slot, other, gamma, sigma, pick(&rho, k));
+                self.apply_angle(slot, other, gamma, sigma, pick(&range, k));
             }
         }
         Ok(())
@@ -267,6 +277,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
 
     /// The value checks of [`Agent::receive_direct`] (those of `FrameView::validate` on
     /// full-precision values).
+    #[cfg(any(feature = "sim", test))]
     fn check_direct(&self, from: &Self) -> Result<(), FrameError> {
         if !finite_vec(&from.velocity) {
             return Err(FrameError::InvalidValue);
@@ -277,11 +288,11 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         };
         let distance = |r: T| r.finite() && r > T::zero() && r >= r_min;
         for a in from.angles.iter().flatten() {
-            if let Some((gamma, sigma, rho)) = sent_angle(a) {
+            if let Some((gamma, sigma, range)) = sent_angle(a) {
                 if a.far[0] == a.far[1] {
                     return Err(FrameError::Malformed);
                 }
-                if !(gamma.finite() && sigma.finite() && distance(rho[0]) && distance(rho[1])) {
+                if !(gamma.finite() && sigma.finite() && distance(range[0]) && distance(range[1])) {
                     return Err(FrameError::InvalidValue);
                 }
             }
@@ -290,9 +301,9 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     }
 
     /// Stores what the apex in neighbour `slot` sent of its angle `(apex; me, other)`:
-    /// `γ`, `σ` and its distance to this agent `ρ`.
+    /// `γ`, `σ` and its distance to this agent `r`.
     #[inline]
-    fn apply_angle(&mut self, slot: usize, other: AgentId, gamma: T, sigma: T, rho: T) {
+    fn apply_angle(&mut self, slot: usize, other: AgentId, gamma: T, sigma: T, range: T) {
         let Some(n) = self.neighbours.get(slot) else {
             return;
         };
@@ -314,7 +325,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                     gamma,
                     // S6: this far vertex's sign, once here rather than every step.
                     sigma: law::far_sigma(sigma, *k),
-                    rho,
+                    range,
                     v_ref,
                 };
                 *age = T::zero();
@@ -350,13 +361,13 @@ fn unit_code(c: u16) -> u16 {
     }
 }
 
-/// What an apex sends of angle `a` (`γ`, `σ`, `ρ`): the values of its last sense, if it
-/// computed them (they are then finite: see `sensing::apex_part`).
+/// What an apex sends of angle `a` (`γ`, `σ`, `[r_v, r_w]`): the values of its last
+/// sense, if it computed them (they are then finite: see `sensing::apex_part`).
 #[inline]
 #[allow(clippy::type_complexity)]
 fn sent_angle<T: Real>(a: &AngleState<T>) -> Option<(T, T, [T; 2])> {
     match &a.side {
-        Side::Apex { part, fault: None } => Some((part.gamma, part.sigma, part.rho)),
+        Side::Apex { part, fault: None } => Some((part.gamma, part.sigma, part.range)),
         _ => None,
     }
 }

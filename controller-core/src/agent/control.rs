@@ -5,9 +5,10 @@
 use super::estimates::owns;
 use super::sensing::sense_angle;
 use super::state::{AngleState, ApexPart, Neighbour, Remote, Side};
+#[cfg(any(feature = "sim", test))]
+use super::Evaluation;
 use super::{
-    finite_vec, pick, vec2, within, Agent, Evaluation, Fault, LawOutput, Measurements, Status,
-    StepOutput,
+    finite_vec, pick, vec2, within, Agent, Fault, LawOutput, Measurements, Status, StepOutput,
 };
 use crate::config::{EstimatorMode, LeaderRole};
 use crate::{geometry, law, Real, Vec2};
@@ -17,7 +18,8 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// measurements and neighbour data, without changing the state (it only overwrites
     /// the internal scratch of the flows). [`Agent::step`] runs the same law; simulators
     /// that integrate the estimators themselves (continuous time) call [`Agent::sense`],
-    /// exchange, then this.
+    /// exchange, then this. Feature `sim` only (not built for the firmware).
+    #[cfg(any(feature = "sim", test))]
     pub fn evaluate(&mut self) -> Result<Evaluation<T, MT>, Fault> {
         let LawOutput { force, degenerate } = self.law_pass()?;
         let r_min = self.config.min_estimate;
@@ -41,14 +43,14 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         })
     }
 
-    /// One control tick: [`Agent::sense`], the law ([`Agent::evaluate`]'s) with the owned
-    /// estimates integrated over `dt` (sampled S10), saturation. On any fault the output
+    /// One control tick: sensing, the law S7–S12 with the owned estimates integrated over
+    /// `dt` (sampled S10), saturation. On any fault the output
     /// is the documented safe command `U = −safe_damping · v` (no formation force) and the
     /// estimates hold still.
     ///
     /// The angles are walked once: each angle's sensing and then its law, the same
-    /// per-angle functions that `sense` and `evaluate` run in two walks, in the same
-    /// order on the same data (the same result bit for bit).
+    /// per-angle functions that `sense` and `evaluate` (feature `sim`) run in two walks,
+    /// in the same order on the same data (the same result bit for bit).
     pub fn step(&mut self, m: &Measurements<'_, T>) -> StepOutput<T> {
         let result = match self.sense_own(m) {
             Ok(()) => {
@@ -66,13 +68,20 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             Some(c) => c,
             None => self.config.comm_every.saturating_sub(1),
         };
-        self.output(result, &m.velocity)
+        self.step_output(result, &m.velocity)
     }
 
     /// The output for a law result: the force saturated to `max_force`, or on a fault the
     /// safe command `U = −safe_damping · v` (zero if `v` is not finite), saturated too.
     /// (What [`Agent::step`] returns; for simulators that call [`Agent::evaluate`].)
+    /// Feature `sim` only (not built for the firmware).
+    #[cfg(any(feature = "sim", test))]
     pub fn output(&self, law: Result<LawOutput<T>, Fault>, velocity: &Vec2<T>) -> StepOutput<T> {
+        self.step_output(law, velocity)
+    }
+
+    /// What [`Agent::step`] returns for its law result (`Agent::output`, feature `sim`).
+    fn step_output(&self, law: Result<LawOutput<T>, Fault>, velocity: &Vec2<T>) -> StepOutput<T> {
         let limits = &self.config.limits;
         let (force, status, degenerate) = match law {
             Ok(LawOutput { force, degenerate }) => (force, Status::Nominal, degenerate),
@@ -133,6 +142,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// and the S9 flow of every owned estimate, left in each angle's `flow`. Returns the
     /// unsaturated force and whether a current angle (of which this agent is the apex) is
     /// degenerate. The first fault in angle order wins (after staleness).
+    #[cfg(any(feature = "sim", test))]
     #[inline]
     fn law_pass(&mut self) -> Result<LawOutput<T>, Fault> {
         self.check_fresh()?;
@@ -266,6 +276,7 @@ impl<T: Real> LawSum<T> {
 
 /// One angle's law: its S8 force into `sum` and the S9 flow (stepped by S10 with
 /// `integrate`) of the estimates it owns, or the angle's fault.
+#[cfg(any(feature = "sim", test))]
 #[inline(always)]
 fn angle_law<T: Real, const MT: usize>(
     cx: &LawContext<T>,
@@ -314,8 +325,8 @@ fn apex_law<T: Real, const MT: usize>(
         let [r0, r1] = a.estimate;
         let f0 = law::estimator_rate(rr[0], p.gamma, p.share[0], gain, r0);
         let f1 = law::estimator_rate(rr[1], p.gamma, p.share[1], gain, r1);
-        settle(cx, a, 0, f0);
-        settle(cx, a, 1, f1);
+        integrate_estimate(cx, a, 0, f0);
+        integrate_estimate(cx, a, 1, f1);
     }
     Ok(())
 }
@@ -340,7 +351,7 @@ fn far_law<T: Real, const MT: usize>(
     }
     // SPEC §6: the apex's shared estimate, the own copy, or the range.
     let r = match cx.mode {
-        EstimatorMode::Shared => remote.rho,
+        EstimatorMode::Shared => remote.range,
         EstimatorMode::PerAgent => pick(&a.estimate, k),
         EstimatorMode::Measured => n.range()?,
     };
@@ -369,15 +380,16 @@ fn far_law<T: Real, const MT: usize>(
         let rr = geometry::range_rate(&-s_ku, &(v - v_apex));
         let share = law::own_share(&g_k, &v, r, true);
         let flow = law::estimator_rate(rr, gamma_k, share, a.estimator_gain, r);
-        settle(cx, a, k, flow);
+        integrate_estimate(cx, a, k, flow);
     }
     Ok(())
 }
 
-/// S9 with S3 for ṙ, then (stepping) S10 on the estimate `e`, or (evaluating) the flow
-/// kept in `flow`.
+/// The S9 `flow` of estimate `e` (computed with S3 for ṙ): stepping, the estimate is
+/// integrated over `Δt` (sampled S10) and its value before kept in `a.flow` (for the roll
+/// back); evaluating, the flow is kept in `a.flow` and the estimate is left alone.
 #[inline(always)]
-fn settle<T: Real>(cx: &LawContext<T>, a: &mut AngleState<T>, e: usize, flow: T) {
+fn integrate_estimate<T: Real>(cx: &LawContext<T>, a: &mut AngleState<T>, e: usize, flow: T) {
     if let (Some(est), Some(f)) = (a.estimate.get_mut(e), a.flow.get_mut(e)) {
         match cx.integrate {
             Some(dt) => {

@@ -4,7 +4,7 @@
 use super::state::{AngleState, Side};
 use super::{pick, Agent, OwnedEstimate};
 use crate::config::EstimatorMode;
-use crate::{law, Real};
+use crate::Real;
 
 impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// Whether this agent owns (integrates) the estimate of `edge` of angle `a` (see
@@ -34,7 +34,9 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// Writes the values of the estimates this agent owns into `out`, in
     /// [`Self::owned_estimates`] order, as far as `out` reaches; returns how many it wrote.
     /// (The same as taking `value` from [`Self::owned_estimates`], as a plain loop: a
-    /// simulator reads every agent's estimates at every instant.)
+    /// simulator reads every agent's estimates at every instant.) Feature `sim` only (not
+    /// built for the firmware).
+    #[cfg(any(feature = "sim", test))]
     pub fn copy_estimates(&self, out: &mut [T]) -> usize {
         let mode = self.config.estimator;
         let mut n = 0;
@@ -56,7 +58,9 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// continuous time; call it before [`Agent::sense`], which computes the apex kernels
     /// with the estimates). `e` names the estimate as [`Agent::owned_estimates`] does
     /// (its `apex` and `far` are not read). Values are clamped to `r_min`; returns `false`
-    /// for an estimate this agent does not own or a non-finite value.
+    /// for an estimate this agent does not own or a non-finite value. Feature `sim` only
+    /// (not built for the firmware).
+    #[cfg(any(feature = "sim", test))]
     pub fn set_estimate(&mut self, e: &OwnedEstimate<T>) -> bool {
         let OwnedEstimate {
             triangle,
@@ -77,7 +81,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             .and_then(|a| a.estimate.get_mut(edge));
         match slot {
             Some(s) if owned && value.finite() => {
-                *s = law::estimate_floor(value, r_min);
+                *s = crate::law::estimate_floor(value, r_min);
                 true
             }
             _ => false,

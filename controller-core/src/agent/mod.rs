@@ -5,10 +5,10 @@
 //! | `types.rs` | the public types of a tick: measurements, output, faults |
 //! | `state.rs` | the internal state: angles and neighbours |
 //! | `setup.rs` | [`Agent::new`]: configuration checks (SPEC §3) and the neighbour table |
-//! | `sensing.rs` | [`Agent::sense`]: own measurements, bearing rates (SPEC §2), the apex kernels (S4–S8) |
-//! | `control.rs` | [`Agent::evaluate`], [`Agent::step`]: far-vertex forces (S8), S9/S10, S11, S12, saturation |
+//! | `sensing.rs` | `Agent::sense` (feature `sim`), sensing within [`Agent::step`]: own measurements, bearing rates (SPEC §2), the apex kernels (S4–S8) |
+//! | `control.rs` | [`Agent::step`], `Agent::evaluate` (feature `sim`): far-vertex forces (S8), S9/S10, S11, S12, saturation |
 //! | `estimates.rs` | owned estimates (S9, S10): reading, setting, integrating |
-//! | `comm.rs` | [`Agent::frames`], [`Agent::receive`], [`Agent::receive_direct`] |
+//! | `comm.rs` | [`Agent::frames`], [`Agent::receive`]; `Agent::receive_direct` (feature `sim`) |
 //!
 //! Who computes what, for an angle `α = (u; v, w)`: the apex `u` computes the angle from
 //! its own bearings and rates when it senses (S4–S7), its own S8 force, and the efforts
@@ -26,9 +26,11 @@ mod state;
 mod test_support;
 mod types;
 
+#[cfg(any(feature = "sim", test))]
+pub use types::Evaluation;
 pub use types::{
-    BearingMeasurement, Evaluation, Fault, LawOutput, MeasurementError, Measurements,
-    OwnedEstimate, Status, StepOutput,
+    BearingMeasurement, Fault, LawOutput, MeasurementError, Measurements, OwnedEstimate, Status,
+    StepOutput,
 };
 
 use crate::config::{AgentConfig, AgentId};
@@ -71,7 +73,7 @@ pub struct Agent<T: Real, const MT: usize, const NB: usize> {
     writer: FrameWriter,
     /// Smallest binary16 code of a received distance: `r_min` as rounded (estimator
     /// modes), or the smallest positive value (measured ranges).
-    rho_min_code: u16,
+    range_min_code: u16,
     /// The mode byte of this agent's frames (and of the frames it accepts).
     mode: u8,
     /// The neighbour slot after the sender of the last frame received: where

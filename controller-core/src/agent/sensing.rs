@@ -23,8 +23,10 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
     /// current estimates). Nothing else changes if they are refused, except that no
     /// angle is sent until the next accepted measurements.
     ///
-    /// [`Agent::step`] calls it; simulators that drive [`Agent::evaluate`] themselves
-    /// call it first (after [`Agent::set_estimate`], before exchanging frames).
+    /// [`Agent::step`] does the same; simulators that drive [`Agent::evaluate`] themselves
+    /// call it first (after [`Agent::set_estimate`], before exchanging frames). Feature
+    /// `sim` only (not built for the firmware).
+    #[cfg(any(feature = "sim", test))]
     pub fn sense(&mut self, m: &Measurements<'_, T>) -> Result<(), Fault> {
         self.sense_own(m)?;
         let (mode, v) = (self.config.estimator, self.velocity);
@@ -74,8 +76,8 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 v: m.velocity,
                 v_before,
                 limits: TrackLimits {
-                    rho_initial: T::one() / self.config.initial_estimate,
-                    rho_max: T::one() / self.config.min_estimate,
+                    inv_range_initial: T::one() / self.config.initial_estimate,
+                    inv_range_max: T::one() / self.config.min_estimate,
                 },
             }),
             BearingFilter::FiniteDifference => None,
@@ -271,7 +273,7 @@ fn apex_part<T: Real, const MT: usize>(
         share,
         force: k.force,
         sigma: k.sigma,
-        rho: r,
+        range: r,
     })
 }
 
@@ -336,7 +338,7 @@ fn take_bearing<T: Real, const MT: usize>(
         // the last tick with the own velocity then, the rate with the own velocity now.
         (None, Some(t)) => {
             let dv = RelativeVelocity {
-                moved: n.velocity - t.v_before,
+                over_interval: n.velocity - t.v_before,
                 now: n.velocity - t.v,
             };
             let mut s = n.s;
@@ -389,11 +391,11 @@ fn hold_missing<T: Real, const MT: usize>(
                 // The first tick of the gap (the bearing was measured at the last one):
                 // nothing of an earlier gap is left to subtract (a bearing with a
                 // measured rate bypasses the tracker's update, which clears it).
-                n.track.predicted = T::zero();
+                n.track.predicted_span = T::zero();
             }
             // The same relative velocities as `take_bearing` gives the tracker (SPEC §11).
             let dv = RelativeVelocity {
-                moved: n.velocity - t.v_before,
+                over_interval: n.velocity - t.v_before,
                 now: n.velocity - t.v,
             };
             n.rate = n.track.predict(&mut n.s, &dv, since, t.c, &t.limits);

@@ -88,7 +88,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         };
         let writer = FrameWriter::new(config.integrity);
         let mode = mode_byte(config.integrity, config.estimator);
-        let rho_min_code = match config.estimator {
+        let range_min_code = match config.estimator {
             EstimatorMode::Measured => 1,
             EstimatorMode::Shared | EstimatorMode::PerAgent => {
                 quant::encode(config.min_estimate.as_f32()).0
@@ -109,7 +109,7 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             comm_countdown,
             comm_due: true,
             writer,
-            rho_min_code,
+            range_min_code,
             mode,
             next_slot: 0,
             stats: FrameStats::default(),

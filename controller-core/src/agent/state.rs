@@ -46,7 +46,7 @@ pub(super) struct ApexPart<T: Real> {
     /// `σ_α = s_uv × s_uw` (for the far vertices).
     pub sigma: T,
     /// The distances used in S8 (estimates or ranges), sent to the far vertices.
-    pub rho: [T; 2],
+    pub range: [T; 2],
 }
 
 /// What a far vertex last received of an angle from its apex.
@@ -56,8 +56,8 @@ pub(super) struct Remote<T: Real> {
     pub gamma: T,
     /// `σ_k = ±σ_α` for this far vertex ([`crate::law::far_sigma`], applied on receipt).
     pub sigma: T,
-    /// The apex's distance to this agent (`ρ_k`).
-    pub rho: T,
+    /// The apex's distance to this agent (`r_k`).
+    pub range: T,
     /// Own velocity when it arrived (the last one sensed before: about when the apex
     /// measured).
     pub v_ref: Vec2<T>,

@@ -162,7 +162,8 @@ impl<T: Real> defmt::Format for StepOutput<T> {
     }
 }
 
-/// What the control law gives before saturation ([`crate::Agent::output`]'s input).
+/// What the control law gives before saturation (the input of `Agent::output`, feature
+/// `sim`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LawOutput<T: Real> {
     /// `U_n` before saturation.
@@ -172,6 +173,8 @@ pub struct LawOutput<T: Real> {
 }
 
 /// The control law evaluated without changing any state (see [`crate::Agent::evaluate`]).
+/// Feature `sim` only (not built for the firmware).
+#[cfg(any(feature = "sim", test))]
 #[derive(Clone, Debug, PartialEq)]
 pub struct Evaluation<T: Real, const MT: usize> {
     /// `U_n` before saturation.

@@ -7,7 +7,7 @@ use core::num::NonZeroU8;
 /// The result of the CRC-16 check of one `crc16` frame, computed once
 /// ([`CrcCheck::of`]) for bytes that several receivers take in: a simulator delivers each
 /// broadcast to every agent in radio range, and each would compute the same CRC of the
-/// same bytes. [`crate::Agent::receive_checked`] uses it instead of computing the CRC
+/// same bytes. `Agent::receive_checked` (feature `sim`) uses it instead of computing the CRC
 /// again, and only for the bytes it was computed from (same length and trailer;
 /// otherwise it computes the CRC itself). Everything else about the frame is checked by
 /// each receiver as in [`crate::Agent::receive`], with the same result.
@@ -44,7 +44,8 @@ impl CrcCheck {
     }
 
     /// The check of a frame this crate has just finished (its trailer is its CRC, by
-    /// construction): no CRC computed.
+    /// construction): no CRC computed. (For `Agent::frames_checked`, feature `sim`.)
+    #[cfg(any(feature = "sim", test))]
     pub(crate) fn written(bytes: &[u8]) -> Option<Self> {
         Self::new(bytes, true)
     }
@@ -64,6 +65,8 @@ impl CrcCheck {
     }
 
     /// The check's result if it was computed from `bytes` (same length and trailer).
+    /// (For `Agent::receive_checked`, feature `sim`.)
+    #[cfg(any(feature = "sim", test))]
     #[inline]
     pub(crate) fn result_for(&self, bytes: &[u8]) -> Option<bool> {
         let len_ok = self.len_ok.get();

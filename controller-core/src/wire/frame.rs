@@ -50,8 +50,8 @@ pub struct AngleItem {
     pub gamma: F16,
     /// `σ_α = s_nv × s_nw`.
     pub sigma: F16,
-    /// `[ρ_v, ρ_w]`: the distances the apex used.
-    pub rho: [F16; 2],
+    /// `[r_v, r_w]`: the distances the apex used.
+    pub range: [F16; 2],
 }
 
 /// `auth`: the high 48 bits of the sender's counter (see [`auth`]), carried by every
@@ -298,7 +298,7 @@ impl Frame {
 
     /// Checks the values as a receiver does that accepts any positive distance: a finite
     /// velocity ([`FrameError::InvalidValue`]), two distinct far vertices per item
-    /// ([`FrameError::Malformed`]), a finite `γ`, `|σ| ≤ 1`, finite distances `ρ > 0`
+    /// ([`FrameError::Malformed`]), a finite `γ`, `|σ| ≤ 1`, finite distances `r > 0`
     /// ([`FrameError::InvalidValue`]). Written with floats, apart from the fast path's
     /// checks on the codes ([`super::FrameView::validate`]).
     pub fn check_values(&self) -> Result<(), FrameError> {
@@ -313,7 +313,7 @@ impl Frame {
             let finite = |x: F16| x.value().filter(|v| v.is_finite());
             valid &= finite(a.gamma).is_some()
                 && finite(a.sigma).is_some_and(|s| s.abs() <= 1.0)
-                && a.rho.iter().all(|&r| finite(r).is_some_and(|r| r > 0.0));
+                && a.range.iter().all(|&r| finite(r).is_some_and(|r| r > 0.0));
         }
         if valid {
             Ok(())

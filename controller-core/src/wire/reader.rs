@@ -9,12 +9,12 @@ use super::{
 use crate::config::EstimatorMode;
 use crate::{crc16, AgentId};
 
-/// One angle item's bytes: far vertices and the binary16 codes of `[γ, σ, ρ_v, ρ_w]`.
+/// One angle item's bytes: far vertices and the binary16 codes of `[γ, σ, r_v, r_w]`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct RawAngle {
     /// The far vertices.
     pub far: [AgentId; 2],
-    /// The codes of `[γ, σ, ρ_v, ρ_w]`.
+    /// The codes of `[γ, σ, r_v, r_w]`.
     pub codes: [u16; 4],
 }
 
@@ -117,12 +117,12 @@ impl<'a> FrameView<'a> {
     }
 
     /// Checks every value: a finite velocity, and per item two distinct far vertices, a
-    /// finite `γ`, `|σ| ≤ 1`, and distances at least `rho_min` (a binary16 code of a
+    /// finite `γ`, `|σ| ≤ 1`, and distances at least `range_min` (a binary16 code of a
     /// positive value: the receiver's `r_min` as rounded, or 1 for any positive value).
     /// Reads nothing but bits (no float conversion: binary16 codes of positive values are
     /// ordered like the values). Always inlined: the receiver's view stays in registers.
     #[inline(always)]
-    pub fn validate(&self, rho_min: u16) -> Result<(), FrameError> {
+    pub fn validate(&self, range_min: u16) -> Result<(), FrameError> {
         let [vx, vy] = self.velocity;
         // `x·0` is ±0 for finite `x` and NaN otherwise: one comparison for both.
         if vx * 0.0 + vy * 0.0 != 0.0 {
@@ -133,13 +133,13 @@ impl<'a> FrameView<'a> {
             if it.far[0] == it.far[1] {
                 return Err(FrameError::Malformed);
             }
-            let [gamma, sigma, rho0, rho1] = it.codes;
+            let [gamma, sigma, range0, range1] = it.codes;
             // Exponent all ones: ∞ or NaN. Positive finite values are 0x0001..=0x7BFF.
-            let distance = |c: u16| (c >= rho_min) & (c < 0x7C00);
+            let distance = |c: u16| (c >= range_min) & (c < 0x7C00);
             ok &= (gamma & 0x7C00 != 0x7C00)
                 & (sigma & 0x7FFF <= F16_ONE)
-                & distance(rho0)
-                & distance(rho1);
+                & distance(range0)
+                & distance(range1);
         }
         if ok {
             Ok(())
@@ -156,7 +156,7 @@ impl<'a> FrameView<'a> {
                 far: it.far,
                 gamma: F16(g),
                 sigma: F16(s),
-                rho: [F16(r0), F16(r1)],
+                range: [F16(r0), F16(r1)],
             }
         })
     }

@@ -76,7 +76,7 @@ impl FrameWriter {
     }
 
     /// Appends one angle item: far vertices and the binary16 codes (see [`super::quant`])
-    /// of `[γ, σ, ρ_v, ρ_w]`; `false`, and nothing written, if the frame is full.
+    /// of `[γ, σ, r_v, r_w]`; `false`, and nothing written, if the frame is full.
     #[inline]
     pub fn push_angle(&mut self, far: [AgentId; 2], codes: [u16; 4]) -> bool {
         let end = self.len + ANGLE_ITEM_LEN;

@@ -167,7 +167,7 @@ impl HilController {
         };
         for item in &frame.angles {
             let [v, w] = item.far;
-            for (far, other, r) in [(v, w, item.rho[0]), (w, v, item.rho[1])] {
+            for (far, other, r) in [(v, w, item.range[0]), (w, v, item.range[1])] {
                 if let Some(k) = self
                     .slots
                     .iter()
