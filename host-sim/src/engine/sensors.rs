@@ -14,12 +14,14 @@
 mod camera;
 mod latency;
 mod occlusion;
+mod registry;
 mod shared_positions;
 mod source;
 
 pub use camera::Camera;
+pub use registry::bearing_sensor;
 pub use shared_positions::{SharedPositions, POSITION_VERSION};
-pub use source::{bearing_sensor, BearingKind, BearingSensor, World};
+pub use source::{BearingKind, BearingSensor, World};
 
 use super::world::{stream, stream_key, Turn};
 use crate::model::SensorModel;

@@ -2,21 +2,21 @@
 //! ticks. One [`Plant`] per run, holding every agent's state; the paper's point mass S1
 //! ([`PointMass`]), a generic velocity-tracking vehicle ([`VelocityTrackingPlant`]) and a
 //! Crazyflie flying its firmware's PID cascade ([`CrazyfliePidPlant`]).
-//! `docs/architecture.md` ("Add a vehicle") says how to add one: a file here and a
-//! variant of [`crate::model::VehicleModel`].
+//! `docs/architecture.md` ("Add a vehicle") says how to add one: a file here that
+//! implements [`Plant`], and one line in `registry.rs` ([`new_plant`]).
 
 mod crazyflie_pid;
 mod point_mass;
+mod registry;
 mod velocity_tracking;
 
 pub use crazyflie_pid::{
     derived_lead, derived_second_lead, firmware, total_tilt, CrazyfliePidPlant,
 };
 pub use point_mass::{acceleration, PointMass};
+pub use registry::new_plant;
 pub use velocity_tracking::{tracking_acceleration, VelocityTrackingPlant};
 
-use super::error::SetupError;
-use crate::model::{Model, VehicleModel};
 use ph_formation_core::Vec2;
 
 /// What the plant holds between ticks: every agent's last force (N, world frame) and
@@ -56,15 +56,6 @@ pub trait Plant: Send + Sync {
     /// `steps` RK4 steps of length `dt` under `held`; `chunk`: on every thread of the
     /// current rayon pool, `chunk` agents per work item (the same bits either way).
     fn step(&mut self, held: &Held<'_>, dt: f64, steps: usize, chunk: Option<usize>);
-}
-
-/// The plant of `model`'s vehicle, at the model's initial state.
-pub fn new_plant(model: &Model) -> Result<Box<dyn Plant>, SetupError> {
-    Ok(match &model.world.vehicle {
-        VehicleModel::PointMass => Box::new(PointMass::new(model)),
-        VehicleModel::VelocityTracking(v) => Box::new(VelocityTrackingPlant::new(model, v)?),
-        VehicleModel::CrazyfliePid(v) => Box::new(CrazyfliePidPlant::new(model, v)?),
-    })
 }
 
 /// The velocity setpoint of agent `i` of a velocity-setpoint vehicle: its virtual mass
