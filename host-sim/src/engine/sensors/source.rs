@@ -20,7 +20,8 @@
 //! knows the seam, not the sensor.
 //!
 //! A new bearing sensor is one file beside this one that implements the trait, and one
-//! line in [`bearing_sensor`] that picks it from the [`SensorModel`] (docs/architecture.md,
+//! line in [`bearing_sensor`](super::bearing_sensor) (`sensors.rs`, the registry, beside its
+//! `mod` line) that picks it from the [`SensorModel`] (docs/architecture.md,
 //! "Add a sensor").
 
 use super::Draws;
