@@ -5,15 +5,15 @@
 //!
 //! | stage | file | what it owns |
 //! |---|---|---|
-//! | radio delivery | `sampled/delivery.rs` | inboxes, outboxes, the [`Radio`] and its attackers, a bearing sensor's packets |
+//! | radio delivery | `sampled/delivery.rs` | inboxes, outboxes, the [`Radio`](super::radio::Radio) and its attackers, a bearing sensor's packets |
 //! | world | `sampled/world_state.rs` | headings, own clocks, wind |
-//! | sensing | `sampled/sensing.rs` | each agent's measurements ([`Scene::measure`]) |
+//! | sensing | `sampled/sensing.rs` | each agent's measurements (`Scene::measure`) |
 //! | control | `sampled/tick.rs`, `sampled/parallel.rs` | each agent's tick of its controller |
 //! | actuation and plant | `sampled/actuation.rs` | the policies, the held forces, the plant's RK4 steps |
 //! | statistics | `sampled/statistics.rs`, `sampled/estimates.rs` | frame counters, control statistics, the estimates the diagnostics read |
 //!
 //! This file composes them ([`SampledSim::control`]); faults and attacks act through the
-//! radio ([`Radio`], [`crate::engine::attack`]), the sensors ([`crate::engine::sensors`])
+//! radio ([`Radio`](super::radio::Radio), [`crate::engine::attack`]), the sensors ([`crate::engine::sensors`])
 //! and the world. Large runs with local controllers compute the agents' ticks and the
 //! plant in parallel ([`PARALLEL_MIN_AGENTS`], `sampled/parallel.rs`): every agent draws
 //! its sensors' noise from its own stream of the tick

@@ -8,9 +8,9 @@
 //! protocol: the port sees every message the session writes (one COBS frame per write)
 //! and counts the `Output`s to know which tick an answer belongs to.
 
+use firmware_example::boards::uart::{self, Event, SerialPort, Session};
 use ph_formation_core::link::{TargetMsg, LINK_VERSION, MAX_LINK_MSG};
 use ph_formation_core::wire::{cobs_decode, cobs_encode};
-use firmware_example::boards::uart::{self, Event, SerialPort, Session};
 use std::io::{BufReader, Read, Write};
 use std::net::TcpStream;
 use std::thread::JoinHandle;
