@@ -1,5 +1,7 @@
-//! The layers of `host-sim/src` import one way only (`docs/architecture.md`), and no
-//! source file is too long to read in one sitting.
+//! The layers of `host-sim/src` import one way only (`docs/architecture.md`), no source
+//! file is too long to read in one sitting (a file of the engine, one stage, is shorter
+//! still), and no two files of `host-sim/src/engine/` or of `controller-core/src/` import
+//! each other, directly or around a loop (`layers/imports.rs`).
 //!
 //! Every file under `src/` belongs to the layer named by its first path component
 //! (`src/engine/hil/qemu.rs` is in `engine`; `src/exit_code.rs` in `exit_code`); the
