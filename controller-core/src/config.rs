@@ -5,28 +5,12 @@ use crate::Real;
 use serde::{Deserialize, Serialize};
 
 pub use crate::wire::Integrity;
+pub use shared::{AgentId, EstimatorMode};
 
-/// An agent identifier on the wire. It must be unique among the agents within two hops of
-/// each agent in the graph (frames name neighbours and their neighbours by id) and among
-/// the agents whose frames one receiver can hear; a formation of at most 256 agents can
-/// simply number them, a larger one colours its graph (host-sim does).
-pub type AgentId = u8;
+mod shared;
 
 /// Capacity of a piecewise-constant schedule (`v*`, `z*`).
 pub const MAX_SCHEDULE_STEPS: usize = 8;
-
-/// How the controller gets the distances it needs in S8 (SPEC §6).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum EstimatorMode {
-    /// One passive estimate per angle and edge, owned by the apex and sent to the far vertex (S9, S10).
-    #[default]
-    Shared,
-    /// The paper's structure: every agent of an angle keeps its own copies (not passive).
-    PerAgent,
-    /// A range sensor measures the distances (e.g. UWB); no estimator.
-    Measured,
-}
 
 /// How the agent turns successive bearings into the bearing and the bearing rate the law
 /// uses (SPEC §2, §11). A bearing measured with its rate (an optical-flow sensor) is used

@@ -1,5 +1,7 @@
-//! The layers of `host-sim/src` import one way only (`docs/architecture.md`), and no
-//! source file is too long to read in one sitting.
+//! The layers of `host-sim/src` import one way only (`docs/architecture.md`), no source
+//! file is too long to read in one sitting (a file of the engine, one stage, is shorter
+//! still), and no two files of `host-sim/src/engine/` or of `controller-core/src/` import
+//! each other, directly or around a loop (`layers/imports.rs`).
 //!
 //! Every file under `src/` belongs to the layer named by its first path component
 //! (`src/engine/hil/qemu.rs` is in `engine`; `src/exit_code.rs` in `exit_code`); the
@@ -9,6 +11,10 @@
 //! module it names. A layer may name itself and the layers [`LAYERS`] allows it;
 //! anything else is a violation, reported with file, line and the rule.
 
+#[path = "layers/imports.rs"]
+mod imports;
+
+use imports::module_path;
 use proc_macro2::{TokenStream, TokenTree};
 use std::path::{Path, PathBuf};
 use syn::visit::Visit;
@@ -67,6 +73,10 @@ const LAYERS: &[(&str, &[&str])] = &[
 /// Hard limit on the length of a source file (lines).
 const MAX_LINES: usize = 800;
 
+/// Hard limit on the length of a file of the engine (`src/engine/`, lines): one stage of
+/// the simulator per file.
+const MAX_ENGINE_LINES: usize = 500;
+
 /// One import that breaks the rules.
 #[derive(Debug, PartialEq, Eq)]
 struct Violation {
@@ -77,22 +87,6 @@ struct Violation {
 
 fn allowed(from: &str) -> Option<&'static [&'static str]> {
     LAYERS.iter().find(|(l, _)| *l == from).map(|(_, a)| *a)
-}
-
-/// The module path of a source file relative to `src/`: `engine/hil/mod.rs` →
-/// `[engine, hil]`, `lib.rs` → `[]`.
-fn module_path(rel: &Path) -> Vec<String> {
-    let mut parts: Vec<String> = rel
-        .iter()
-        .map(|p| p.to_string_lossy().into_owned())
-        .collect();
-    if let Some(last) = parts.pop() {
-        let stem = last.trim_end_matches(".rs");
-        if !matches!(stem, "mod" | "lib" | "main") {
-            parts.push(stem.to_owned());
-        }
-    }
-    parts
 }
 
 /// Walks one file: `module` is the module the code being visited is in.
@@ -277,6 +271,11 @@ fn violations_in(rel: &Path, text: &str) -> Result<Vec<Violation>, String> {
 }
 
 fn sources() -> Vec<(PathBuf, String)> {
+    sources_of(&Path::new(env!("CARGO_MANIFEST_DIR")).join("src"))
+}
+
+/// Every `.rs` file under `src` (path relative to it, text), in path order.
+fn sources_of(src: &Path) -> Vec<(PathBuf, String)> {
     fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
         let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
             .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
@@ -291,14 +290,13 @@ fn sources() -> Vec<(PathBuf, String)> {
             }
         }
     }
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let mut files = Vec::new();
-    walk(&src, &mut files);
+    walk(src, &mut files);
     files
         .into_iter()
         .map(|p| {
             let text = std::fs::read_to_string(&p).expect("read source");
-            (p.strip_prefix(&src).expect("under src").to_owned(), text)
+            (p.strip_prefix(src).expect("under src").to_owned(), text)
         })
         .collect()
 }
@@ -379,4 +377,133 @@ fn the_check_finds_upward_imports() {
     assert!(violations_in(Path::new("gui/mod.rs"), "").is_err());
     // The crate root may name anything.
     assert!(bad("lib.rs", "pub use cli::main;\nuse crate::cli::execute;\n").is_empty());
+}
+
+#[test]
+fn engine_files_are_at_most_500_lines() {
+    let long: Vec<String> = sources()
+        .into_iter()
+        .filter(|(rel, _)| rel.starts_with("engine"))
+        .filter_map(|(rel, text)| {
+            let n = text.lines().count();
+            (n > MAX_ENGINE_LINES).then(|| format!("src/{}: {n} lines", rel.display()))
+        })
+        .collect();
+    assert!(
+        long.is_empty(),
+        "longer than {MAX_ENGINE_LINES} lines: {long:?}"
+    );
+}
+
+/// The files of `src` under `under` (relative to `src`, as `engine/driver.rs`).
+fn part(src: &Path, under: &str) -> Vec<(String, String)> {
+    sources_of(src)
+        .into_iter()
+        .filter(|(rel, _)| rel.starts_with(under))
+        .map(|(rel, text)| (rel.display().to_string(), text))
+        .collect()
+}
+
+#[test]
+fn no_import_loops_between_files_of_the_engine_or_the_core() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let parts = [
+        ("host-sim/src/engine", part(&root.join("src"), "engine")),
+        (
+            "controller-core/src",
+            part(&root.join("../controller-core/src"), ""),
+        ),
+    ];
+    let mut problems = Vec::new();
+    for (name, files) in parts {
+        assert!(files.len() > 20, "{name}: only {} files found", files.len());
+        let graph = imports::Graph::of(&files).unwrap_or_else(|e| panic!("{name}: {e}"));
+        problems.extend(graph.loops().into_iter().map(|l| format!("{name}: {l}")));
+    }
+    assert!(
+        problems.is_empty(),
+        "{} import loops between files (docs/architecture.md, \"One seam per stage\"):\n{}",
+        problems.len(),
+        problems.join("\n")
+    );
+}
+
+#[test]
+fn the_loop_check_finds_loops() {
+    let files = |list: &[(&str, &str)]| -> Vec<(String, String)> {
+        list.iter()
+            .map(|(a, b)| ((*a).to_owned(), (*b).to_owned()))
+            .collect()
+    };
+    let loops = |list: &[(&str, &str)]| imports::Graph::of(&files(list)).expect("parses").loops();
+    // Two siblings that import each other: found, with the lines of the imports.
+    let found = loops(&[
+        ("engine/mod.rs", "mod a;\nmod b;\n"),
+        ("engine/a.rs", "use super::b::B;\npub struct A;\n"),
+        (
+            "engine/b.rs",
+            "pub struct B;\nfn f() { let _ = crate::engine::a::A; }\n",
+        ),
+    ]);
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert!(
+        found[0].contains("engine/a.rs:1 → engine/b.rs:2 → engine/a.rs"),
+        "{found:?}"
+    );
+    // Through a re-export of the parent (`super::A` is `a.rs`'s), and a child module named
+    // by a relative path, which the parent imports: a loop of three.
+    let found = loops(&[
+        ("engine/mod.rs", "mod a;\nmod c;\npub use a::A;\n"),
+        ("engine/a.rs", "use super::c::inner::C;\npub struct A;\n"),
+        ("engine/c.rs", "mod inner;\n"),
+        ("engine/c/inner.rs", "use super::super::A;\npub struct C;\n"),
+    ]);
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert!(found[0].contains("engine/c/inner.rs"), "{found:?}");
+    assert!(!found[0].contains("engine/mod.rs"), "{found:?}");
+    // Declaring children, re-exporting them, and children naming each other one way only,
+    // and a test module naming its own file: no loop.
+    let found = loops(&[
+        (
+            "engine/mod.rs",
+            "mod a;\nmod b;\npub use a::A;\npub use b::B;\n",
+        ),
+        ("engine/a.rs", "use super::B;\npub struct A;\n"),
+        (
+            "engine/b.rs",
+            "pub struct B;\nmod tests { use super::*; }\n",
+        ),
+    ]);
+    assert!(found.is_empty(), "{found:?}");
+    // A child using its parent's own item while the parent uses the child: a loop; while
+    // the parent only re-exports it: none.
+    let found = loops(&[
+        (
+            "wire/mod.rs",
+            "mod frame;\nuse frame::Frame;\npub struct Mode;\n",
+        ),
+        ("wire/frame.rs", "use super::Mode;\npub struct Frame;\n"),
+    ]);
+    assert_eq!(found.len(), 1, "{found:?}");
+    let found = loops(&[
+        (
+            "wire/mod.rs",
+            "mod frame;\npub use frame::Frame;\npub struct Mode;\n",
+        ),
+        ("wire/frame.rs", "use super::Mode;\npub struct Frame;\n"),
+    ]);
+    assert!(found.is_empty(), "{found:?}");
+    // Re-exporting what another module (not a descendant) defines is an import.
+    let found = loops(&[
+        ("lib.rs", "mod config;\nmod wire;\n"),
+        (
+            "config.rs",
+            "pub use crate::wire::Integrity;\npub struct Mode;\n",
+        ),
+        (
+            "wire.rs",
+            "use crate::config::Mode;\npub struct Integrity;\n",
+        ),
+    ]);
+    assert_eq!(found.len(), 1, "{found:?}");
 }

@@ -6,9 +6,10 @@
 //! long as the run's is what the controller achieves under that sensing.
 
 use super::continuous::ContinuousSim;
-use super::driver::{simulate, Engine};
 use super::record::NullRecorder;
 use super::sampled::SampledSim;
+use super::simulator::Engine;
+use super::time_loop::simulate;
 use crate::analysis::bands::{caps, Bands, Calibration};
 use crate::analysis::steady::{Quantity, Window};
 use crate::model::shape::fit_similarity;

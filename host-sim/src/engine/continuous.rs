@@ -6,10 +6,10 @@
 //! agent (time = stage time, `dt = 0`, exact rates), pass every neighbour's data with
 //! `receive_direct`, then `evaluate` every agent for its force and estimate rates.
 
-use super::driver::Engine;
 use super::error::SetupError;
 use super::plant::acceleration;
 use super::sensors::{quiet_bearing, Sight};
+use super::simulator::Engine;
 use super::slot_order::SlotOrder;
 use super::stats::{ControlStats, FrameCounts};
 use crate::model::{

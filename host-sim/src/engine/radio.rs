@@ -16,10 +16,10 @@
 //! per-link faults above, from the end of their transmission.
 
 use super::channel::{Channel, ChannelStats};
+pub use super::frame::RadioFrame;
 use crate::model::graph::Adjacency;
 use crate::model::RadioModel;
-use ph_formation_core::wire::CrcCheck;
-use ph_formation_core::{Vec2, MAX_FRAME_LEN};
+use ph_formation_core::Vec2;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::cmp::Ordering;
@@ -31,77 +31,6 @@ const RADIO_STREAM: u64 = 2;
 const TIME_EPS: f64 = 1e-9;
 /// The sender index of frames from outside the swarm ([`Radio::inject`]).
 const EXTERNAL: usize = u32::MAX as usize;
-
-/// One frame on the air: up to [`MAX_FRAME_LEN`] bytes, stored inline (no heap), with
-/// its CRC check ([`CrcCheck`], for `crc16` frames), done once when the frame is made
-/// (or corrupted) instead of once by every receiver: every copy of a broadcast carries
-/// it ([`Self::crc_check`], `ph_formation_core::Agent::receive_checked`).
-///
-/// 64 bytes, aligned to 64: one cache line per frame.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(align(64))]
-pub struct RadioFrame {
-    len: u8,
-    bytes: [u8; MAX_FRAME_LEN],
-    crc: Option<CrcCheck>,
-}
-
-// One cache line: the length byte, 60 bytes and the 3-byte check.
-const _: () = assert!(std::mem::size_of::<RadioFrame>() == 64);
-
-impl RadioFrame {
-    /// Copies `bytes` (truncated to [`MAX_FRAME_LEN`]; the core never produces more) and
-    /// checks their CRC if they are a `crc16` frame.
-    pub fn new(bytes: &[u8]) -> Self {
-        let mut f = Self::copy(bytes);
-        f.crc = CrcCheck::of(f.as_bytes());
-        f
-    }
-
-    /// Copies `bytes` (truncated to [`MAX_FRAME_LEN`]), without a CRC check.
-    fn copy(bytes: &[u8]) -> Self {
-        let n = bytes.len().min(MAX_FRAME_LEN);
-        let mut f = Self {
-            len: n as u8,
-            bytes: [0; MAX_FRAME_LEN],
-            crc: None,
-        };
-        if let (Some(dst), Some(src)) = (f.bytes.get_mut(..n), bytes.get(..n)) {
-            dst.copy_from_slice(src);
-        }
-        f
-    }
-
-    /// A frame of `bytes` whose CRC check its writer gave
-    /// (`ph_formation_core::Agent::frames_checked`).
-    pub fn checked(bytes: &[u8], crc: Option<CrcCheck>) -> Self {
-        let mut f = Self::copy(bytes);
-        f.crc = crc;
-        f
-    }
-
-    /// The frame's CRC check, if it is a `crc16` frame.
-    pub fn crc_check(&self) -> Option<CrcCheck> {
-        self.crc
-    }
-
-    /// The frame's bytes.
-    pub fn as_bytes(&self) -> &[u8] {
-        self.bytes.get(..usize::from(self.len)).unwrap_or(&[])
-    }
-
-    /// Flips bit `bit` (modulo the frame length in bits).
-    fn flip(&mut self, bit: usize) {
-        let n = usize::from(self.len) * 8;
-        if n > 0 {
-            let b = bit % n;
-            if let Some(byte) = self.bytes.get_mut(b / 8) {
-                *byte ^= 1 << (b % 8);
-            }
-            self.crc = CrcCheck::of(self.as_bytes());
-        }
-    }
-}
 
 /// Counters of the radio, per link copy (a broadcast to `k` neighbours is `k` copies).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -343,7 +272,7 @@ impl Radio {
         }
         let mut copy = frame;
         if self.chance(self.model.corruption) {
-            let bit = self.rng.random_range(0..usize::from(copy.len).max(1) * 8);
+            let bit = self.rng.random_range(0..copy.as_bytes().len().max(1) * 8);
             copy.flip(bit);
             self.stats.corrupted += 1;
         }

@@ -296,6 +296,9 @@ mod plant_tests {
         assert!(why.contains("point_mass"), "{why}");
         let (key, _) = spec("model = \"crazyflie_pid\"\nmax_tilt_deg = 30.0").unwrap_err();
         assert_eq!(key, "plant.max_tilt_deg");
+        let (key, why) = spec("model = \"velocity_tracking\"\nsecond_lead_s2 = 0.1").unwrap_err();
+        assert_eq!(key, "plant.second_lead_s2");
+        assert!(why.contains("velocity_tracking"), "{why}");
         let (key, why) = spec("model = \"quadrotor\"").unwrap_err();
         assert_eq!(key, "plant.model");
         assert!(why.contains("crazyflie_pid"), "{why}");

@@ -27,7 +27,7 @@ mod stats;
 
 pub use stats::ChannelStats;
 
-use super::radio::RadioFrame;
+use super::frame::RadioFrame;
 use crate::model::graph::Adjacency;
 use crate::model::{Access, ChannelModel};
 use age::Ages;

@@ -1,7 +1,7 @@
 //! Host-in-the-loop failures: when they happened and what went wrong, each kind with its
 //! exit code (`docs/outputs.md`).
 
-use super::options::{FIRMWARE_BUILD, FIRMWARE_ENV};
+use super::firmware::{FIRMWARE_BUILD, FIRMWARE_ENV};
 use super::qemu;
 use crate::exit_code;
 use std::fmt;

@@ -19,6 +19,7 @@ mod error;
 #[cfg(feature = "fake-target")]
 #[doc(hidden)]
 pub mod fake;
+mod firmware;
 mod options;
 mod stats;
 
@@ -30,9 +31,10 @@ pub use qemu_harness::qemu;
 
 pub use config::target_config;
 pub use error::{HilError, When};
+pub use firmware::{default_firmware, FIRMWARE_BUILD, FIRMWARE_ENV, FIRMWARE_REL};
 pub use options::{
-    agent_indices, default_firmware, preflight, timeout, HilOptions, Launcher, DEFAULT_TIMEOUT_S,
-    FIRMWARE_BUILD, FIRMWARE_ENV, FIRMWARE_REL, STARTUP_TIMEOUT_S, TARGET_NB,
+    agent_indices, preflight, timeout, HilOptions, Launcher, DEFAULT_TIMEOUT_S, STARTUP_TIMEOUT_S,
+    TARGET_NB,
 };
 pub use stats::LinkStats;
 

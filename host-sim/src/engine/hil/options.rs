@@ -4,6 +4,7 @@
 use super::error::HilError;
 #[cfg(feature = "fake-target")]
 use super::fake::FakeBehaviour;
+use super::firmware::default_firmware;
 use super::qemu;
 use crate::model::{Mode, Model};
 use std::path::{Path, PathBuf};
@@ -11,32 +12,10 @@ use std::time::Duration;
 
 /// Neighbour capacity of the firmware's agent (`Agent<f32, 4, 8>`).
 pub const TARGET_NB: usize = 8;
-/// Environment variable overriding the default firmware ELF.
-pub const FIRMWARE_ENV: &str = "HOST_SIM_FIRMWARE";
-/// The firmware ELF, relative to the cargo target directory.
-pub const FIRMWARE_REL: &str = "thumbv7em-none-eabihf/release/qemu-uart";
-/// The command that builds the firmware ELF.
-pub const FIRMWARE_BUILD: &str =
-    "cargo build -p firmware-example --target thumbv7em-none-eabihf --release --bin qemu-uart";
 /// Default per-reply timeout (s).
 pub const DEFAULT_TIMEOUT_S: f64 = 10.0;
 /// Time QEMU has to start and connect, at least (s).
 pub const STARTUP_TIMEOUT_S: f64 = 10.0;
-
-/// The default firmware ELF: `$HOST_SIM_FIRMWARE`, else
-/// `<target dir>/thumbv7em-none-eabihf/release/qemu-uart`, where the target directory is
-/// `$CARGO_TARGET_DIR` (relative paths from the workspace root) or `<workspace>/target`.
-pub fn default_firmware() -> PathBuf {
-    if let Some(p) = std::env::var_os(FIRMWARE_ENV).filter(|p| !p.is_empty()) {
-        return PathBuf::from(p);
-    }
-    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let workspace = manifest.parent().unwrap_or(manifest);
-    let target = std::env::var_os("CARGO_TARGET_DIR")
-        .filter(|p| !p.is_empty())
-        .map_or_else(|| workspace.join("target"), |t| workspace.join(t));
-    target.join(FIRMWARE_REL)
-}
 
 /// How the emulated targets are started.
 #[derive(Clone, Debug, PartialEq)]

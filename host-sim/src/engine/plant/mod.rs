@@ -2,61 +2,25 @@
 //! ticks. One [`Plant`] per run, holding every agent's state; the paper's point mass S1
 //! ([`PointMass`]), a generic velocity-tracking vehicle ([`VelocityTrackingPlant`]) and a
 //! Crazyflie flying its firmware's PID cascade ([`CrazyfliePidPlant`]).
-//! `docs/architecture.md` ("Add a vehicle") says how to add one: a file here and a
-//! variant of [`crate::model::VehicleModel`].
+//! `docs/architecture.md` ("Add a vehicle") says how to add one: a file here that
+//! implements [`Plant`] (the seam, `vehicle.rs`), declared below and given its line in
+//! [`new_plant`], the registry.
 
 mod crazyflie_pid;
 mod point_mass;
+mod vehicle;
 mod velocity_tracking;
 
 pub use crazyflie_pid::{
     derived_lead, derived_second_lead, firmware, total_tilt, CrazyfliePidPlant,
 };
 pub use point_mass::{acceleration, PointMass};
+pub(crate) use vehicle::command_setpoint;
+pub use vehicle::{Held, Plant};
 pub use velocity_tracking::{tracking_acceleration, VelocityTrackingPlant};
 
 use super::error::SetupError;
 use crate::model::{Model, VehicleModel};
-use ph_formation_core::Vec2;
-
-/// What the plant holds between ticks: every agent's last force (N, world frame) and
-/// the wind's acceleration on it (m/s²; empty: no wind).
-#[derive(Clone, Copy, Debug)]
-pub struct Held<'a> {
-    /// The forces of the agents' last ticks, in agent order.
-    pub forces: &'a [Vec2<f64>],
-    /// The wind on each agent, in agent order, or empty.
-    pub wind: &'a [Vec2<f64>],
-}
-
-/// Every agent's vehicle: its state, what it does with a tick's force, and its motion
-/// between ticks.
-pub trait Plant: Send + Sync {
-    /// Positions `q_n` (m, world frame).
-    fn q(&self) -> &[Vec2<f64>];
-    /// Velocities `v_n` (m/s, world frame).
-    fn v(&self) -> &[Vec2<f64>];
-    /// Whether the plant needs [`Plant::command`] at every tick (a point mass reads the
-    /// held forces in [`Plant::step`] and needs nothing more).
-    fn takes_commands(&self) -> bool {
-        false
-    }
-    /// Agent `i`'s force of its tick (N, world frame), `period` seconds by its own clock
-    /// after its previous tick.
-    fn command(&mut self, _i: usize, _force: Vec2<f64>, _period: f64) {}
-    /// Holds agent `i`'s velocity setpoint (m/s, world frame) directly, bypassing the
-    /// virtual mass (`host-sim vehicle step`); false if the vehicle has no velocity loop.
-    fn set_velocity_setpoint(&mut self, _i: usize, _setpoint: Vec2<f64>) -> bool {
-        false
-    }
-    /// Agent `i`'s tilt from vertical (rad), if the vehicle models one.
-    fn tilt(&self, _i: usize) -> Option<f64> {
-        None
-    }
-    /// `steps` RK4 steps of length `dt` under `held`; `chunk`: on every thread of the
-    /// current rayon pool, `chunk` agents per work item (the same bits either way).
-    fn step(&mut self, held: &Held<'_>, dt: f64, steps: usize, chunk: Option<usize>);
-}
 
 /// The plant of `model`'s vehicle, at the model's initial state.
 pub fn new_plant(model: &Model) -> Result<Box<dyn Plant>, SetupError> {
@@ -65,21 +29,4 @@ pub fn new_plant(model: &Model) -> Result<Box<dyn Plant>, SetupError> {
         VehicleModel::VelocityTracking(v) => Box::new(VelocityTrackingPlant::new(model, v)?),
         VehicleModel::CrazyfliePid(v) => Box::new(CrazyfliePidPlant::new(model, v)?),
     })
-}
-
-/// The velocity setpoint of agent `i` of a velocity-setpoint vehicle: its virtual mass
-/// (`command`, SPEC S20 with the leads of S21/S21b) integrates S1 over `period` under
-/// `force` from the vehicle's velocity `v`. The one implementation both such plants call.
-pub(crate) fn command_setpoint(
-    command: &mut [ph_formation_core::actuate::VelocityCommand<f64>],
-    v: &[Vec2<f64>],
-    setpoint: &mut [Vec2<f64>],
-    i: usize,
-    force: Vec2<f64>,
-    period: f64,
-) {
-    if let (Some(c), Some(v), Some(sp)) = (command.get_mut(i), v.get(i), setpoint.get_mut(i)) {
-        let next = c.step([force.x, force.y], [v.x, v.y], period);
-        *sp = Vec2::new(next[0], next[1]);
-    }
 }

@@ -1,4 +1,4 @@
-//! The parallel tick of [`SampledSim`]: every agent's sensing, controller tick, force and
+//! The parallel form of the control stage of `SampledSim`: every agent's sensing, controller tick, force and
 //! counters on every thread of the current rayon pool, bit-identical to the sequential
 //! tick (`tests/scaling.rs`): each agent draws its sensors' noise from its own stream of
 //! the tick ([`crate::engine::sensors::Sensors::stream`]). Only the radio's broadcasts
@@ -6,8 +6,7 @@
 //! estimates for the diagnostics while its state is in cache (a separate pass over
 //! 100,000 agents' states costs a second walk through memory).
 
-use super::tick::{world_force, AgentSlots, AgentTick, Walk};
-use super::{SampledSim, Scene};
+use super::tick::{world_force, AgentSlots, Walk};
 use crate::engine::controller::AgentController;
 use crate::engine::radio::RadioFrame;
 use crate::engine::speed::CHUNK;
@@ -16,14 +15,14 @@ use ph_formation_core::Vec2;
 
 /// What the parallel walk of a tick sums over the agents (in agent order).
 #[derive(Clone, Copy, Debug, Default)]
-struct TickSums {
+pub(super) struct TickSums {
     /// Frames read straight from the senders' outboxes.
-    delivered: u64,
+    pub(super) delivered: u64,
     /// Frames broadcast, and their copies to every radio neighbour.
-    broadcasts: u64,
-    copies: u64,
+    pub(super) broadcasts: u64,
+    pub(super) copies: u64,
     /// The controllers' outputs.
-    stats: ControlStats,
+    pub(super) stats: ControlStats,
 }
 
 impl TickSums {
@@ -40,16 +39,16 @@ impl TickSums {
 /// The agents `first..first + controllers.len()` with their parts of the simulator's
 /// per-agent buffers: disjoint from every other `Agents`, so halves go to different
 /// threads.
-struct Agents<'s> {
-    first: usize,
-    controllers: &'s mut [Box<dyn AgentController>],
-    inboxes: &'s mut [Vec<RadioFrame>],
-    outboxes: &'s mut [Vec<RadioFrame>],
-    forces: &'s mut [Vec2<f64>],
+pub(super) struct Agents<'s> {
+    pub(super) first: usize,
+    pub(super) controllers: &'s mut [Box<dyn AgentController>],
+    pub(super) inboxes: &'s mut [Vec<RadioFrame>],
+    pub(super) outboxes: &'s mut [Vec<RadioFrame>],
+    pub(super) forces: &'s mut [Vec2<f64>],
     /// Their estimates: agent `first + k`'s at `est_start[k] - est_start[0]..est_start[k + 1]
     /// - est_start[0]` (`est_start` has one entry more than the agents).
-    estimates: &'s mut [f64],
-    est_start: &'s [usize],
+    pub(super) estimates: &'s mut [f64],
+    pub(super) est_start: &'s [usize],
 }
 
 impl<'s> Agents<'s> {
@@ -152,41 +151,8 @@ impl Walk<'_> {
     }
 }
 
-impl SampledSim<'_> {
-    /// Every agent's tick on every thread ([`Walk::agent`]), its force and estimates, and
-    /// the counters and statistics of all, summed in agent order.
-    pub(super) fn tick_parallel(&mut self, t: f64, dt: f64, tick: u64) {
-        let model = self.model;
-        let walk = Walk {
-            at: AgentTick { time: t, dt, tick },
-            headings: self.world.headings.as_ref(),
-            scene: Scene::of(model, &*self.plant, &self.senses, &self.world.truth),
-            radio: &model.graph.radio,
-            slot_order: &self.slot_order,
-            sent: &self.sent,
-            footprints: &self.footprints,
-            copy_estimates: self.viewed,
-        };
-        // Each agent's parts (the slices are disjoint fields).
-        let sums = walk.agents(Agents {
-            first: 0,
-            controllers: &mut self.controllers,
-            inboxes: &mut self.inboxes,
-            outboxes: &mut self.outboxes,
-            forces: &mut self.forces,
-            estimates: &mut self.estimates,
-            est_start: &self.est_start,
-        });
-        self.estimates_fresh = self.viewed;
-        self.count_direct(sums.delivered);
-        if self.direct {
-            self.radio.count_direct_sums(sums.broadcasts, sums.copies);
-        }
-        self.stats.merge(&sums.stats);
-        if self.plant.takes_commands() {
-            for (i, f) in self.forces.iter().enumerate() {
-                self.plant.command(i, *f, dt);
-            }
-        }
-    }
+/// Every agent's tick on every thread ([`Walk::agent`]), its force and estimates, and
+/// the counters and statistics of all, summed in agent order.
+pub(super) fn tick_all(walk: &Walk<'_>, agents: Agents<'_>) -> TickSums {
+    walk.agents(agents)
 }

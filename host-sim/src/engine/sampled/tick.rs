@@ -3,7 +3,8 @@
 //! ([`Scene::measure`], the bearings in its core's slot order), its inbox, its controller's
 //! tick, and the copy of its estimates while its state is in cache.
 
-use super::{prefetch_agent, SampledSim, Scene};
+use super::delivery::inbox;
+use super::sensing::Scene;
 use crate::engine::controller::AgentController;
 use crate::engine::hil::HilError;
 use crate::engine::radio::RadioFrame;
@@ -34,7 +35,7 @@ pub(super) struct Walk<'a> {
     pub(super) slot_order: &'a SlotOrder,
     pub(super) sent: &'a [Vec<RadioFrame>],
     pub(super) footprints: &'a [Footprint],
-    /// Each agent copies its estimates after its tick ([`SampledSim`]'s `viewed`).
+    /// Each agent copies its estimates after its tick (`SampledSim`'s `viewed`).
     pub(super) copy_estimates: bool,
 }
 
@@ -88,7 +89,7 @@ impl Walk<'_> {
             partner_offset,
         };
         a.outbox.clear();
-        let frames = SampledSim::inbox(a.inbox, self.sent, self.radio, i);
+        let frames = inbox(a.inbox, self.sent, self.radio, i);
         let delivered = frames.len() as u64;
         let out = a.controller.start_tick(frames, &m, a.outbox)?;
         if self.copy_estimates && out.is_some() {
@@ -112,5 +113,19 @@ pub(super) fn world_force(
     match headings {
         Some(h) => h.frames(i, at.time, at.tick).applied(&force),
         None => force,
+    }
+}
+
+/// Prefetches what agent `i`'s tick will read: its controller and, with direct delivery,
+/// its frames of the last tick (read by its radio neighbours, the first of which ticks
+/// about when `i` does). Takes the parts it reads, not the simulator: the parallel walk
+/// holds the controllers mutably.
+#[inline]
+fn prefetch_agent(footprints: &[Footprint], sent: &[Vec<RadioFrame>], i: usize) {
+    if let Some(f) = footprints.get(i) {
+        f.prefetch();
+    }
+    if let Some(frames) = sent.get(i) {
+        prefetch::prefetch(frames.as_slice());
     }
 }

@@ -237,7 +237,21 @@ impl BearingSensor for SharedPositions {
         Some(draws.offset(&self.own[i], &other))
     }
 
-    fn positions(&mut self) -> Option<&mut SharedPositions> {
-        Some(self)
+    fn uses_radio(&self) -> bool {
+        true
+    }
+
+    fn hear_radio(
+        &mut self,
+        now: f64,
+        tick: u64,
+        q: &[Vec2<f64>],
+        inboxes: &mut [Vec<RadioFrame>],
+    ) {
+        self.hear(now, tick, q, inboxes);
+    }
+
+    fn radio_packet(&mut self, i: usize) -> Option<RadioFrame> {
+        Some(self.packet(i))
     }
 }

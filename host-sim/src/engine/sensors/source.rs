@@ -13,18 +13,19 @@
 //!    agent's own stream of the tick ([`Draws`]): a sensor that draws the same numbers in
 //!    the same order for the same state gives the same bits on any number of threads.
 //!
-//! The shared positions ([`SharedPositions`]) are a bearing sensor whose data comes over
-//! the radio: the simulator hands it the delivered inboxes and sends its packets
-//! ([`BearingSensor::positions`]).
+//! A bearing sensor whose data comes over the radio (the shared positions,
+//! `shared_positions.rs`) says so ([`BearingSensor::uses_radio`]); the simulator then hands
+//! it the delivered inboxes at every tick ([`BearingSensor::hear_radio`]) and broadcasts
+//! each agent's packet after its frames ([`BearingSensor::radio_packet`]): the engine
+//! knows the seam, not the sensor.
 //!
 //! A new bearing sensor is one file beside this one that implements the trait, and one
-//! line in [`bearing_sensor`] that picks it from the [`SensorModel`] (docs/architecture.md,
+//! line in [`bearing_sensor`](super::bearing_sensor) (`sensors.rs`, the registry, beside its
+//! `mod` line) that picks it from the [`SensorModel`] (docs/architecture.md,
 //! "Add a sensor").
 
-use super::camera::Camera;
-use super::shared_positions::SharedPositions;
 use super::Draws;
-use crate::model::Model;
+use crate::engine::radio::RadioFrame;
 use ph_formation_core::{BearingMeasurement, Vec2};
 
 /// The true state of every agent at a control tick, as a bearing sensor reads it (world
@@ -79,20 +80,30 @@ pub trait BearingSensor: Send + Sync + std::fmt::Debug {
         Some(draws.offset(&world.q[i], &world.q[p]))
     }
 
-    /// The shared positions, when this sensor is theirs (the simulator then carries their
-    /// packets over the radio).
-    fn positions(&mut self) -> Option<&mut SharedPositions> {
+    /// Whether this sensor sends packets of its own over the radio
+    /// ([`Self::radio_packet`]): every frame then goes through the radio's queue (no
+    /// direct delivery, `sampled/delivery.rs`). By default, no.
+    fn uses_radio(&self) -> bool {
+        false
+    }
+
+    /// At control tick `tick` (time `now`, the true positions `q`), before any agent is
+    /// measured and after the radio delivered what is due: takes this sensor's packets
+    /// out of the receivers' `inboxes` (the controllers never see them). By default,
+    /// nothing.
+    fn hear_radio(
+        &mut self,
+        _now: f64,
+        _tick: u64,
+        _q: &[Vec2<f64>],
+        _inboxes: &mut [Vec<RadioFrame>],
+    ) {
+    }
+
+    /// Agent `i`'s packet of this tick, which the radio broadcasts to its radio
+    /// neighbours after its frames (`None`: none; the default). `&mut`: a packet may
+    /// advance the sender's state (an `auth` counter).
+    fn radio_packet(&mut self, _i: usize) -> Option<RadioFrame> {
         None
     }
-}
-
-/// The bearing sensor of `model`'s run with control period `period` (s): the shared
-/// positions (`sensors.bearing_source = "shared_positions"`), the camera, or `None` for
-/// the omnidirectional ideal sensor.
-pub fn bearing_sensor(model: &Model, period: f64) -> Option<Box<dyn BearingSensor>> {
-    if let Some(p) = &model.sensors.positions {
-        return Some(Box::new(SharedPositions::new(model, p)));
-    }
-    let camera = model.sensors.camera.as_ref()?;
-    Some(Box::new(Camera::new(camera, model.n(), period)))
 }
