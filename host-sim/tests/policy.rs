@@ -5,16 +5,20 @@
 
 use ph_formation_core::policy::PolicyReason;
 use ph_formation_sim::engine::{self as sim, NullRecorder, RunResult};
-use ph_formation_sim::load;
+use ph_formation_sim::load_toml;
 
+/// crazyflie-app/formation.toml without its own `[policy]` and `[battery]` (each test
+/// sets its policies), named after the file for the errors.
 fn room(overrides: &[&str]) -> Result<ph_formation_sim::model::Model, String> {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../crazyflie-app/formation.toml"
     );
+    let text = std::fs::read_to_string(path).map_err(|e| e.to_string())?;
+    let bare = text.split("\n[policy]").next().unwrap_or(&text);
     let mut o: Vec<String> = vec!["duration=10".to_owned()];
     o.extend(overrides.iter().map(|s| (*s).to_owned()));
-    load(path, &o).map_err(|e| e.to_string())
+    load_toml(bare, "formation.toml", &o).map_err(|e| e.to_string())
 }
 
 fn run(overrides: &[&str]) -> RunResult {
