@@ -101,13 +101,18 @@ ph_status agent_loop_tick(agent_loop *loop, uint32_t now_ms, agent_loop_send_fn 
         loop->setpoint[0] = loop->setpoint[1] = 0.0f;
 
     frame_sink sink = {send, ctx};
-    (void)ph_frames_cb(loop->agent, send_frame, &sink, NULL);
-    uint8_t packet[FORMATION_POSITION_LEN];
-    size_t n = formation_position_packet(loop->agent, position, loop->position_counter, packet,
-                                         sizeof packet);
-    loop->position_counter++;
-    if (n > 0)
-        send(ctx, FORMATION_POSITION_PORT, packet, n);
+    size_t frames = 0;
+    (void)ph_frames_cb(loop->agent, send_frame, &sink, &frames);
+    /* The position goes with the frames, at the configuration's communication rate
+     * (comm_rate_hz: every tick by default), as host-sim sends it. */
+    if (frames > 0) {
+        uint8_t packet[FORMATION_POSITION_LEN];
+        size_t n = formation_position_packet(loop->agent, position, loop->position_counter,
+                                             packet, sizeof packet);
+        loop->position_counter++;
+        if (n > 0)
+            send(ctx, FORMATION_POSITION_PORT, packet, n);
+    }
 
     loop->first = false;
     loop->ticks++;

@@ -482,3 +482,66 @@ fn the_shared_channel_tables_of_radio_md_are_measured() {
         .collect();
     jobs.par_iter().for_each(|(s, r)| check_channel_row(s, r));
 }
+
+/// An ALOHA channel carrying more than a tenth of its air time is named in the run's
+/// warnings with the communication rate (and timeouts) that bring the load under it:
+/// the 20-agent strip in the Crazyflie world offers about half of the air time; at the
+/// suggested rate the warning is gone and the load is under 10 % (the frames and the
+/// position packets both go at the communication rate). The app's 4-drone square in the
+/// same world (9.5 %) gets no warning (negative control).
+#[test]
+fn an_overloaded_aloha_channel_names_the_rate_that_fits() {
+    let strip = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/strip20.toml");
+    let crazy = |file: &str, extra: &[&str]| {
+        let mut o = vec!["world=crazyflie".to_owned(), "duration=10".to_owned()];
+        o.extend(extra.iter().map(|s| (*s).to_owned()));
+        let m = load(file, &o).expect("load");
+        let r = sim::run(&m, &mut NullRecorder, &mut |_| {}).expect("run");
+        (m, r)
+    };
+    let (m, r) = crazy(strip, &[]);
+    let note = r
+        .warnings
+        .iter()
+        .find(|w| w.contains("overloaded for ALOHA"))
+        .unwrap_or_else(|| panic!("no channel warning: {:?}", r.warnings));
+    let ch = r.channel.as_ref().expect("channel");
+    let load_now = ch.utilisation(r.final_time);
+    assert!(load_now > 0.4, "{load_now}");
+    // The suggested rate: the control rate over ⌈G / 0.1⌉.
+    let rate: f64 = note
+        .split("controller.comm_rate_hz = ")
+        .nth(1)
+        .and_then(|s| s.split_whitespace().next())
+        .and_then(|s| s.parse().ok())
+        .expect("a rate in the note");
+    let control = 1.0 / (m.dt * m.steps_per_tick as f64);
+    assert_eq!(rate, control / (load_now / 0.1).ceil(), "{note}");
+    let timeout = format!("{:.3}", 3.5 / rate);
+    assert!(note.contains(&timeout), "{note}");
+    let set = [
+        format!("controller.comm_rate_hz={rate}"),
+        format!("controller.neighbour_timeout={timeout}"),
+        format!("sensors.positions.max_age_s={timeout}"),
+        format!("controller.bearing_hold_s={timeout}"),
+    ];
+    let set: Vec<&str> = set.iter().map(String::as_str).collect();
+    let (_, slow) = crazy(strip, &set);
+    let ch = slow.channel.as_ref().expect("channel");
+    assert!(ch.utilisation(slow.final_time) <= 0.1, "{:?}", ch);
+    assert!(
+        slow.warnings.iter().all(|w| !w.contains("ALOHA")),
+        "{:?}",
+        slow.warnings
+    );
+    let square = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../crazyflie-app/formation.toml"
+    );
+    let (_, quiet) = crazy(square, &[]);
+    assert!(
+        quiet.warnings.iter().all(|w| !w.contains("ALOHA")),
+        "{:?}",
+        quiet.warnings
+    );
+}

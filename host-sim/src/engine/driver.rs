@@ -121,7 +121,7 @@ pub fn drive(
     engine: &mut dyn Engine,
     recorder: &mut dyn Recorder,
     progress: &mut dyn FnMut(f64),
-    warnings: Vec<String>,
+    mut warnings: Vec<String>,
 ) -> Result<RunResult, RunError> {
     let started = Instant::now();
     let sim = simulate(model, engine, recorder, progress)?;
@@ -134,6 +134,7 @@ pub fn drive(
     let steady_control = engine.control_stats().window;
     let channel = engine.channel_stats();
     let policy = engine.policy_counts();
+    let frames = engine.frame_counts();
     let (q, v, est) = engine.view();
     let verdict = sim
         .monitor
@@ -161,6 +162,16 @@ pub fn drive(
     }
     if let Some(note) = super::policy::landings_note(&policy, model) {
         reason = format!("{reason}; {note}");
+    }
+    let period = model.dt * model.steps_per_tick as f64;
+    let collisions = channel
+        .as_ref()
+        .and_then(|c| c.collision_note(sim.diag.snap.t, frames.sent, period, model.comm_every));
+    if let Some(note) = collisions {
+        if verdict.outcome != crate::analysis::Outcome::Converged {
+            reason = format!("{reason}; {note}");
+        }
+        warnings.push(note);
     }
     let tri = model.triangles.iter().map(|t| t.vertices);
     let s = &sim.diag.snap;
@@ -194,7 +205,7 @@ pub fn drive(
             .zip(&sim.area0)
             .map(|(t, &a0)| signed_area(q, t).signum() == a0.signum())
             .collect(),
-        frames: engine.frame_counts(),
+        frames,
         control: engine.control_stats(),
         channel,
         attacks: engine.attack_counts(),

@@ -135,7 +135,12 @@ impl Delivery {
                     .overhear(t, i, f.as_bytes(), q, model, &mut self.radio);
             }
         }
-        // Its sensor's packet, after its frames (`sensors/shared_positions.rs`).
+        // Its sensor's packet, after its frames, when it broadcast any: at the
+        // communication rate, as the Crazyflie app sends its position
+        // (`sensors/shared_positions.rs`, crazyflie-app/src/agent_loop.c).
+        if self.outboxes[i].is_empty() {
+            return;
+        }
         if let Some(p) = sensor.and_then(|s| s.radio_packet(i)) {
             self.radio.broadcast_frame(t, i, receivers, p);
         }
