@@ -63,7 +63,7 @@ impl ChannelStats {
         every: usize,
     ) -> Option<String> {
         let load = self.utilisation(elapsed);
-        if self.collided == 0 || load <= ALOHA_LOAD_TARGET || !(period > 0.0) {
+        if self.collided == 0 || load <= ALOHA_LOAD_TARGET || period.is_nan() || period <= 0.0 {
             return None;
         }
         let slower = (load / ALOHA_LOAD_TARGET).ceil();
