@@ -49,11 +49,11 @@ impl ChannelStats {
     }
 
     /// With collisions (ALOHA access), when the offered load `G` (the utilisation over
-    /// `elapsed`) is above [`ALOHA_LOAD_TARGET`]: the share of the `copies` link copies
+    /// `elapsed`) is above `ALOHA_LOAD_TARGET` (0.1): the share of the `copies` link copies
     /// lost to collisions and the communication rate that brings `G` to the target,
     /// `1 / (period · every · ⌈G / target⌉)` (the frames and the position packets go at
     /// that rate, so the load scales with it), with the timeouts that span
-    /// [`TIMEOUT_BROADCASTS`] of its broadcasts. `period` is the control period (s),
+    /// `TIMEOUT_BROADCASTS` (3.5) of its broadcasts. `period` is the control period (s),
     /// `every` the control ticks per broadcast now.
     pub fn collision_note(
         &self,
@@ -84,7 +84,7 @@ impl ChannelStats {
 
 /// The offered load (share of the air time) up to which ALOHA access is taken as
 /// working: an unslotted transmission survives with probability `e^{−2G}`, 82 % at
-/// `G` = 0.1, so a neighbour whose timeout spans [`TIMEOUT_BROADCASTS`] broadcasts (three
+/// `G` = 0.1, so a neighbour whose timeout spans `TIMEOUT_BROADCASTS` (3.5) broadcasts (three
 /// lost in a row) goes silent with probability about 0.18³ = 0.6 %, well under the
 /// verdict's 5 % of safe outputs (docs/radio.md).
 pub const ALOHA_LOAD_TARGET: f64 = 0.1;
