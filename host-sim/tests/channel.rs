@@ -500,6 +500,8 @@ fn an_overloaded_aloha_channel_names_the_rate_that_fits() {
         (m, r)
     };
     let (m, r) = crazy(strip, &[]);
+    // `host-sim validate` says it before the run, with the same rate.
+    let before = ph_formation_sim::engine::load::overload_warning(&m).expect("validate warns");
     let note = r
         .warnings
         .iter()
@@ -519,6 +521,10 @@ fn an_overloaded_aloha_channel_names_the_rate_that_fits() {
     assert_eq!(rate, control / (load_now / 0.1).ceil(), "{note}");
     let timeout = format!("{:.3}", 3.5 / rate);
     assert!(note.contains(&timeout), "{note}");
+    assert!(
+        before.contains(&format!("controller.comm_rate_hz = {rate} ")),
+        "{before}"
+    );
     let set = [
         format!("controller.comm_rate_hz={rate}"),
         format!("controller.neighbour_timeout={timeout}"),
@@ -538,7 +544,11 @@ fn an_overloaded_aloha_channel_names_the_rate_that_fits() {
         env!("CARGO_MANIFEST_DIR"),
         "/../crazyflie-app/formation.toml"
     );
-    let (_, quiet) = crazy(square, &[]);
+    let (square_model, quiet) = crazy(square, &[]);
+    assert_eq!(
+        ph_formation_sim::engine::load::overload_warning(&square_model),
+        None
+    );
     assert!(
         quiet.warnings.iter().all(|w| !w.contains("ALOHA")),
         "{:?}",

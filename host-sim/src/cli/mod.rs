@@ -296,6 +296,9 @@ fn validate_command(
             if let Some(w) = crate::engine::speed_limit_note(&m) {
                 eprintln!("warning: {w}");
             }
+            if let Some(w) = crate::engine::load::overload_warning(&m) {
+                eprintln!("warning: {w}");
+            }
             exit_code::CONVERGED
         }
         Err(e) => report(&e),

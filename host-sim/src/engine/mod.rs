@@ -17,6 +17,7 @@ mod driver;
 mod error;
 mod frame;
 pub mod hil;
+pub mod load;
 pub mod plant;
 pub mod policy;
 pub mod radio;

@@ -25,7 +25,7 @@
 mod age;
 mod stats;
 
-pub use stats::ChannelStats;
+pub use stats::{ChannelStats, ALOHA_LOAD_TARGET, TIMEOUT_BROADCASTS};
 
 use super::frame::RadioFrame;
 use crate::model::graph::Adjacency;
