@@ -2,11 +2,13 @@
 //! round trips, refusal of a key with another integrity, the boot epoch, and the new
 //! frame statuses and counters.
 
+mod fixture;
+
 use ph_formation_core::{Integrity, SwarmKey};
 use ph_formation_ffi::api::{
     ph_agent_init, ph_agent_set_boot_epoch, ph_frames, ph_receive, ph_stats,
 };
-use ph_formation_ffi::config::{default_config, from_core, ph_integrity};
+use ph_formation_ffi::config::{from_core, ph_integrity};
 use ph_formation_ffi::storage::ph_agent;
 use ph_formation_ffi::tick::ph_frame_stats;
 use ph_formation_ffi::{decode_blob, encode_blob, ph_config, ph_status, to_core, PH_AGENT_SIZE};
@@ -15,17 +17,7 @@ const KEY: [u8; 16] = *b"ffi swarm key 16";
 
 /// Agent `id` of triangle (1, 2, 3) with angles at 1 and 2 (60° each), `auth`.
 fn config(id: u8) -> ph_config {
-    let mut c = default_config(id);
-    c.triangle_count = 1;
-    c.triangles[0].vertices = [1, 2, 3];
-    c.triangles[0].angles[0].apex = 1;
-    c.triangles[0].angles[1].apex = 2;
-    for a in &mut c.triangles[0].angles {
-        a.cos_desired = 0.5;
-        a.stiffness = 1.0;
-        a.damping = 0.5;
-        a.estimator_gain = 1.0;
-    }
+    let mut c = fixture::triangle_config(id);
     c.integrity = ph_integrity::PH_INTEGRITY_AUTH as u8;
     c.auth_key = KEY;
     c
@@ -48,8 +40,7 @@ fn the_key_round_trips_through_the_c_form_and_the_blob() {
     assert_eq!(to_core(&crc).map(|c| c.integrity), Ok(Integrity::Crc16));
 }
 
-#[repr(C, align(8))]
-struct Memory([u8; PH_AGENT_SIZE]);
+use fixture::Memory;
 
 fn init(mem: &mut Memory, c: &ph_config) -> *mut ph_agent {
     let a = mem.0.as_mut_ptr().cast::<ph_agent>();

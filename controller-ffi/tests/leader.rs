@@ -1,27 +1,17 @@
 //! `ph_leader_partner`: the leader partner of an agent (what the Crazyflie app needs to
 //! find the partner offset among its neighbours' positions), none for a follower.
 
+mod fixture;
+
 use ph_formation_ffi::api::{ph_agent_init, ph_leader_partner};
-use ph_formation_ffi::config::default_config;
 use ph_formation_ffi::storage::ph_agent;
 use ph_formation_ffi::{ph_config, ph_status, PH_AGENT_SIZE};
 
-#[repr(C, align(8))]
-struct Memory([u8; PH_AGENT_SIZE]);
+use fixture::Memory;
 
 /// Agent `id` of triangle (1, 2, 3); agents 1 and 2 are the leaders.
 fn config(id: u8) -> ph_config {
-    let mut c = default_config(id);
-    c.triangle_count = 1;
-    c.triangles[0].vertices = [1, 2, 3];
-    c.triangles[0].angles[0].apex = 1;
-    c.triangles[0].angles[1].apex = 2;
-    for a in &mut c.triangles[0].angles {
-        a.cos_desired = 0.5;
-        a.stiffness = 1.0;
-        a.damping = 0.5;
-        a.estimator_gain = 1.0;
-    }
+    let mut c = fixture::triangle_config(id);
     if id <= 2 {
         c.has_leader = 1;
         c.leader.role = id - 1; // PH_LEADER_A, PH_LEADER_B

@@ -3,28 +3,18 @@
 //! `PH_FAULT_NON_FINITE_MEASUREMENT`; and `ph_limits.bearing_hold` reaches the agent
 //! (SPEC §12): a bearing missing for a tick is held with a hold, missing without.
 
+mod fixture;
+
 use ph_formation_ffi::api::{ph_agent_init, ph_receive, ph_step};
-use ph_formation_ffi::config::default_config;
 use ph_formation_ffi::storage::ph_agent;
 use ph_formation_ffi::tick::{ph_bearing, ph_fault, ph_measurements, ph_output, ph_output_status};
 use ph_formation_ffi::{ph_config, ph_status, PH_AGENT_SIZE};
 
-#[repr(C, align(8))]
-struct Memory([u8; PH_AGENT_SIZE]);
+use fixture::Memory;
 
 /// Agent `id` of the triangle (1, 2, 3) with angles at 1 and 2, finite differences.
 fn config(id: u8, hold: f32) -> ph_config {
-    let mut c = default_config(id);
-    c.triangle_count = 1;
-    c.triangles[0].vertices = [1, 2, 3];
-    c.triangles[0].angles[0].apex = 1;
-    c.triangles[0].angles[1].apex = 2;
-    for a in &mut c.triangles[0].angles {
-        a.cos_desired = 0.5;
-        a.stiffness = 1.0;
-        a.damping = 0.5;
-        a.estimator_gain = 1.0;
-    }
+    let mut c = fixture::triangle_config(id);
     c.bearing_filter = ph_formation_ffi::config::ph_bearing_filter {
         kind: ph_formation_ffi::config::ph_filter_kind::PH_FILTER_FINITE_DIFFERENCE as u8,
         ..Default::default()

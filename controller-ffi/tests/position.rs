@@ -2,8 +2,10 @@
 //! position packet (`ph_formation_core::wire::position`) with the agent's integrity mode;
 //! under `auth` a spoofed or replayed packet is refused.
 
+mod fixture;
+
 use ph_formation_ffi::api::ph_agent_init;
-use ph_formation_ffi::config::{default_config, ph_integrity};
+use ph_formation_ffi::config::ph_integrity;
 use ph_formation_ffi::position::{
     ph_position_decode, ph_position_encode, ph_position_peer, ph_position_sender,
     PH_MAX_POSITION_LEN,
@@ -12,17 +14,7 @@ use ph_formation_ffi::storage::ph_agent;
 use ph_formation_ffi::{ph_config, ph_status, PH_AGENT_SIZE};
 
 fn config(id: u8, auth: bool) -> ph_config {
-    let mut c = default_config(id);
-    c.triangle_count = 1;
-    c.triangles[0].vertices = [1, 2, 3];
-    c.triangles[0].angles[0].apex = 1;
-    c.triangles[0].angles[1].apex = 2;
-    for a in &mut c.triangles[0].angles {
-        a.cos_desired = 0.5;
-        a.stiffness = 1.0;
-        a.damping = 0.5;
-        a.estimator_gain = 1.0;
-    }
+    let mut c = fixture::triangle_config(id);
     if auth {
         c.integrity = ph_integrity::PH_INTEGRITY_AUTH as u8;
         c.auth_key = *b"position key 16b";
@@ -30,8 +22,7 @@ fn config(id: u8, auth: bool) -> ph_config {
     c
 }
 
-#[repr(C, align(8))]
-struct Memory([u8; PH_AGENT_SIZE]);
+use fixture::Memory;
 
 fn agent(mem: &mut Memory, c: &ph_config) -> *mut ph_agent {
     let a = mem.0.as_mut_ptr().cast::<ph_agent>();

@@ -1,28 +1,18 @@
 //! `ph_actuator_set_second_lead` (SPEC S21b): the C API's second-order lead is the
 //! core's, kept across calls in the `ph_actuator`, and refuses what it must.
 
+mod fixture;
+
 use ph_formation_core::actuate::{VelocityCommand, VirtualMass};
 use ph_formation_ffi::actuate::{ph_actuate, ph_actuator_init, ph_actuator_set_second_lead};
 use ph_formation_ffi::api::ph_agent_init;
-use ph_formation_ffi::config::default_config;
 use ph_formation_ffi::storage::ph_agent;
 use ph_formation_ffi::{ph_actuator, ph_config, ph_status, PH_AGENT_SIZE};
 
-#[repr(C, align(8))]
-struct Memory([u8; PH_AGENT_SIZE]);
+use fixture::Memory;
 
 fn config() -> ph_config {
-    let mut c = default_config(1);
-    c.triangle_count = 1;
-    c.triangles[0].vertices = [1, 2, 3];
-    c.triangles[0].angles[0].apex = 1;
-    c.triangles[0].angles[1].apex = 2;
-    for a in &mut c.triangles[0].angles {
-        a.cos_desired = 0.5;
-        a.stiffness = 1.0;
-        a.damping = 0.5;
-        a.estimator_gain = 1.0;
-    }
+    let mut c = fixture::triangle_config(1);
     c.friction = [0.5, 0.25];
     c
 }

@@ -83,6 +83,9 @@ fn phases(
     phase("clippy and builds (thumbv7em-none-eabihf)", &mut || {
         let core = ["-p", "ph-formation-core"];
         tools::run(cargo().arg("clippy").args(core).args(thumb).args(deny))?;
+        // The other no_std crate: the vehicle models (in the C API's QEMU tests).
+        let vehicle = ["-p", "ph-formation-vehicle"];
+        tools::run(cargo().arg("clippy").args(vehicle).args(thumb).args(deny))?;
         tools::run(
             cargo()
                 .arg("clippy")
