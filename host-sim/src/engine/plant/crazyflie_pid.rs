@@ -4,10 +4,9 @@
 //! cascade, which the Crazyflie app's C tests fly too), driven by the agent's virtual
 //! mass (S20, with the leads of S21 and S21b derived from the cascade).
 
-use super::{Held, Plant};
+use super::{Held, Plant, Setpoints};
 use crate::engine::error::SetupError;
 use crate::model::{CrazyfliePid, Model};
-use ph_formation_core::actuate::{VelocityCommand, VirtualMass};
 use ph_formation_core::Vec2;
 use ph_formation_vehicle::crazyflie::Crazyflie;
 pub use ph_formation_vehicle::crazyflie::{
@@ -19,40 +18,31 @@ pub use ph_formation_vehicle::crazyflie::{
 pub struct CrazyfliePidPlant {
     q: Vec<Vec2<f64>>,
     v: Vec<Vec2<f64>>,
-    setpoint: Vec<Vec2<f64>>,
+    /// The velocity setpoints and the virtual masses behind them.
+    setpoints: Setpoints,
     drones: Vec<Crazyflie>,
-    command: Vec<VelocityCommand<f64>>,
 }
 
 impl CrazyfliePidPlant {
     /// The model's agents hovering at their initial positions and velocities, each
     /// holding its initial velocity as its setpoint until its first tick.
     pub fn new(model: &Model, vehicle: &CrazyfliePid) -> Result<Self, SetupError> {
-        let a = &model.agents;
-        let command = a
-            .iter()
-            .enumerate()
-            .map(|(i, x)| {
-                VirtualMass::new(x.mass, x.friction, vehicle.max_speed)
-                    .and_then(|m| m.with_lead(vehicle.lead.unwrap_or_else(derived_lead)))
-                    .and_then(|m| {
-                        m.with_second_lead(vehicle.second_lead.unwrap_or_else(derived_second_lead))
-                    })
-                    .map(VelocityCommand::new)
-                    .map_err(|error| SetupError::Vehicle { agent: i, error })
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        let drones: Vec<Crazyflie> = a
+        let setpoints = Setpoints::new(
+            model,
+            vehicle.max_speed,
+            vehicle.lead.unwrap_or_else(derived_lead),
+            Some(vehicle.second_lead.unwrap_or_else(derived_second_lead)),
+        )?;
+        let drones: Vec<Crazyflie> = model
+            .agents
             .iter()
             .map(|x| Crazyflie::new(x.position, x.velocity))
             .collect();
-        let v: Vec<Vec2<f64>> = drones.iter().map(|d| Vec2::from(d.v)).collect();
         Ok(Self {
             q: drones.iter().map(|d| Vec2::from(d.q)).collect(),
-            setpoint: v.clone(),
-            v,
+            v: drones.iter().map(|d| Vec2::from(d.v)).collect(),
+            setpoints,
             drones,
-            command,
         })
     }
 }
@@ -73,18 +63,11 @@ impl Plant for CrazyfliePidPlant {
     /// The virtual mass integrates S1 over `period` under `force` (S20, with the lead of
     /// S21): the new velocity setpoint.
     fn command(&mut self, i: usize, force: Vec2<f64>, period: f64) {
-        super::command_setpoint(
-            &mut self.command,
-            &self.v,
-            &mut self.setpoint,
-            i,
-            force,
-            period,
-        );
+        self.setpoints.command(i, force, &self.v, period);
     }
 
     fn set_velocity_setpoint(&mut self, i: usize, setpoint: Vec2<f64>) -> bool {
-        self.setpoint.get_mut(i).map(|sp| *sp = setpoint).is_some()
+        self.setpoints.set(i, setpoint)
     }
 
     fn tilt(&self, i: usize) -> Option<f64> {
@@ -99,7 +82,7 @@ impl Plant for CrazyfliePidPlant {
             .iter_mut()
             .zip(self.q.iter_mut())
             .zip(self.v.iter_mut())
-            .zip(&self.setpoint)
+            .zip(&self.setpoints.setpoint)
             .enumerate()
         {
             let w = held.wind.get(i).map_or([0.0; 2], |w| [w.x, w.y]);
@@ -115,6 +98,7 @@ impl Plant for CrazyfliePidPlant {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use ph_formation_core::actuate::{VelocityCommand, VirtualMass};
 
     /// The plant is the vehicle crate's Crazyflie, agent by agent: a setpoint step flown
     /// through the plant and through one `Crazyflie` agree exactly.
@@ -123,14 +107,16 @@ mod tests {
         let mut p = CrazyfliePidPlant {
             q: vec![Vec2::zeros(); 2],
             v: vec![Vec2::zeros(); 2],
-            setpoint: vec![Vec2::zeros(); 2],
+            setpoints: Setpoints {
+                command: vec![
+                    VelocityCommand::new(
+                        VirtualMass::new(1.0, [0.0; 2], f64::INFINITY).unwrap()
+                    );
+                    2
+                ],
+                setpoint: vec![Vec2::zeros(); 2],
+            },
             drones: vec![Crazyflie::default(); 2],
-            command: vec![
-                VelocityCommand::new(
-                    VirtualMass::new(1.0, [0.0; 2], f64::INFINITY).unwrap()
-                );
-                2
-            ],
         };
         assert!(p.set_velocity_setpoint(1, Vec2::new(1.0, 0.5)));
         let held = Held {

@@ -15,7 +15,7 @@ pub use crazyflie_pid::{
     derived_lead, derived_second_lead, firmware, total_tilt, CrazyfliePidPlant,
 };
 pub use point_mass::{acceleration, PointMass};
-pub(crate) use vehicle::command_setpoint;
+pub(crate) use vehicle::Setpoints;
 pub use vehicle::{Held, Plant};
 pub use velocity_tracking::{tracking_acceleration, VelocityTrackingPlant};
 

@@ -3,6 +3,9 @@
 //! its own so that every vehicle depends on it, and only `plant/mod.rs` (the registry)
 //! on the vehicles.
 
+use crate::engine::error::SetupError;
+use crate::model::Model;
+use ph_formation_core::actuate::{VelocityCommand, VirtualMass};
 use ph_formation_core::Vec2;
 
 /// What the plant holds between ticks: every agent's last force (N, world frame) and
@@ -44,19 +47,58 @@ pub trait Plant: Send + Sync {
     fn step(&mut self, held: &Held<'_>, dt: f64, steps: usize, chunk: Option<usize>);
 }
 
-/// The velocity setpoint of agent `i` of a velocity-setpoint vehicle: its virtual mass
-/// (`command`, SPEC S20 with the leads of S21/S21b) integrates S1 over `period` under
-/// `force` from the vehicle's velocity `v`. The one implementation both such plants call.
-pub(crate) fn command_setpoint(
-    command: &mut [ph_formation_core::actuate::VelocityCommand<f64>],
-    v: &[Vec2<f64>],
-    setpoint: &mut [Vec2<f64>],
-    i: usize,
-    force: Vec2<f64>,
-    period: f64,
-) {
-    if let (Some(c), Some(v), Some(sp)) = (command.get_mut(i), v.get(i), setpoint.get_mut(i)) {
-        let next = c.step([force.x, force.y], [v.x, v.y], period);
-        *sp = Vec2::new(next[0], next[1]);
+/// The velocity setpoints of a velocity-setpoint vehicle's agents and the virtual masses
+/// that produce them (SPEC S20, with the leads of S21/S21b): the one implementation both
+/// such plants hold.
+#[derive(Clone, Debug)]
+pub(crate) struct Setpoints {
+    /// Each agent's virtual mass and its state (the setpoint it integrates).
+    pub(crate) command: Vec<VelocityCommand<f64>>,
+    /// The velocity setpoints (m/s, world frame).
+    pub(crate) setpoint: Vec<Vec2<f64>>,
+}
+
+impl Setpoints {
+    /// Every agent of `model` with its virtual mass (its mass and friction, the speed
+    /// limit `max_speed`, the lead and, if given, the second-order lead), holding its
+    /// initial velocity as its setpoint until its first tick.
+    pub(crate) fn new(
+        model: &Model,
+        max_speed: f64,
+        lead: f64,
+        second_lead: Option<f64>,
+    ) -> Result<Self, SetupError> {
+        let a = &model.agents;
+        let command = a
+            .iter()
+            .enumerate()
+            .map(|(i, x)| {
+                VirtualMass::new(x.mass, x.friction, max_speed)
+                    .and_then(|m| m.with_lead(lead))
+                    .and_then(|m| second_lead.map_or(Ok(m), |s| m.with_second_lead(s)))
+                    .map(VelocityCommand::new)
+                    .map_err(|error| SetupError::Vehicle { agent: i, error })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let setpoint = a
+            .iter()
+            .map(|x| Vec2::new(x.velocity[0], x.velocity[1]))
+            .collect();
+        Ok(Self { command, setpoint })
+    }
+
+    /// Agent `i`'s new setpoint: its virtual mass integrates S1 over `period` under
+    /// `force` from the vehicle's velocity `v` (at the first tick; its own after).
+    pub(crate) fn command(&mut self, i: usize, force: Vec2<f64>, v: &[Vec2<f64>], period: f64) {
+        let (c, v, sp) = (self.command.get_mut(i), v.get(i), self.setpoint.get_mut(i));
+        if let (Some(c), Some(v), Some(sp)) = (c, v, sp) {
+            let next = c.step([force.x, force.y], [v.x, v.y], period);
+            *sp = Vec2::new(next[0], next[1]);
+        }
+    }
+
+    /// Sets agent `i`'s setpoint (false: no agent `i`).
+    pub(crate) fn set(&mut self, i: usize, setpoint: Vec2<f64>) -> bool {
+        self.setpoint.get_mut(i).map(|sp| *sp = setpoint).is_some()
     }
 }

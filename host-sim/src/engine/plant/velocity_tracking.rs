@@ -9,10 +9,9 @@
 //! mass of SPEC S20 with the lead of S21 (`ph_formation_core::actuate::VelocityCommand`,
 //! the same code the Crazyflie app calls through `ph_actuate`), limited to `v_max`.
 
-use super::{Held, Plant};
+use super::{Held, Plant, Setpoints};
 use crate::engine::error::SetupError;
 use crate::model::{Model, VelocityTracking};
-use ph_formation_core::actuate::{VelocityCommand, VirtualMass};
 use ph_formation_core::Vec2;
 
 /// Every agent's velocity-tracking vehicle.
@@ -20,10 +19,8 @@ use ph_formation_core::Vec2;
 pub struct VelocityTrackingPlant {
     q: Vec<Vec2<f64>>,
     v: Vec<Vec2<f64>>,
-    /// The velocity setpoints (m/s, world frame).
-    setpoint: Vec<Vec2<f64>>,
-    /// Each agent's virtual mass and its state (the setpoint it integrates).
-    command: Vec<VelocityCommand<f64>>,
+    /// The velocity setpoints and the virtual masses behind them.
+    setpoints: Setpoints,
     vehicle: VelocityTracking,
 }
 
@@ -47,35 +44,22 @@ impl VelocityTrackingPlant {
     /// The model's agents at their initial state, each holding its initial velocity
     /// until its first tick.
     pub fn new(model: &Model, vehicle: &VelocityTracking) -> Result<Self, SetupError> {
-        let a = &model.agents;
-        let command = a
-            .iter()
-            .enumerate()
-            .map(|(i, x)| {
-                VirtualMass::new(x.mass, x.friction, vehicle.max_speed)
-                    .and_then(|m| m.with_lead(vehicle.lead))
-                    .map(VelocityCommand::new)
-                    .map_err(|error| SetupError::Vehicle { agent: i, error })
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        let v: Vec<Vec2<f64>> = a
-            .iter()
-            .map(|x| Vec2::new(x.velocity[0], x.velocity[1]))
-            .collect();
+        let setpoints = Setpoints::new(model, vehicle.max_speed, vehicle.lead, None)?;
         Ok(Self {
-            q: a.iter()
+            q: model
+                .agents
+                .iter()
                 .map(|x| Vec2::new(x.position[0], x.position[1]))
                 .collect(),
-            setpoint: v.clone(),
-            v,
-            command,
+            v: setpoints.setpoint.clone(),
+            setpoints,
             vehicle: *vehicle,
         })
     }
 
     /// The current velocity setpoints.
     pub fn setpoints(&self) -> &[Vec2<f64>] {
-        &self.setpoint
+        &self.setpoints.setpoint
     }
 }
 
@@ -95,18 +79,11 @@ impl Plant for VelocityTrackingPlant {
     /// The virtual mass integrates S1 over `period` under `force` (from the vehicle's
     /// velocity at the first tick): the new setpoint.
     fn command(&mut self, i: usize, force: Vec2<f64>, period: f64) {
-        super::command_setpoint(
-            &mut self.command,
-            &self.v,
-            &mut self.setpoint,
-            i,
-            force,
-            period,
-        );
+        self.setpoints.command(i, force, &self.v, period);
     }
 
     fn set_velocity_setpoint(&mut self, i: usize, setpoint: Vec2<f64>) -> bool {
-        self.setpoint.get_mut(i).map(|sp| *sp = setpoint).is_some()
+        self.setpoints.set(i, setpoint)
     }
 
     /// RK4 per agent, the setpoint and wind held over the step.
@@ -117,7 +94,7 @@ impl Plant for VelocityTrackingPlant {
                 .q
                 .iter_mut()
                 .zip(self.v.iter_mut())
-                .zip(&self.setpoint)
+                .zip(&self.setpoints.setpoint)
                 .enumerate()
             {
                 let w = held.wind.get(i).copied().unwrap_or_else(Vec2::zeros);
@@ -139,15 +116,18 @@ impl Plant for VelocityTrackingPlant {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use ph_formation_core::actuate::{VelocityCommand, VirtualMass};
 
     fn plant(tau: f64, a_max: f64) -> VelocityTrackingPlant {
         VelocityTrackingPlant {
             q: vec![Vec2::zeros()],
             v: vec![Vec2::zeros()],
-            setpoint: vec![Vec2::new(0.6, -0.8)],
-            command: vec![VelocityCommand::new(
-                VirtualMass::new(1.0, [0.5; 2], 1.0).unwrap(),
-            )],
+            setpoints: Setpoints {
+                command: vec![VelocityCommand::new(
+                    VirtualMass::new(1.0, [0.5; 2], 1.0).unwrap(),
+                )],
+                setpoint: vec![Vec2::new(0.6, -0.8)],
+            },
             vehicle: VelocityTracking {
                 time_constant: tau,
                 max_acceleration: a_max,
@@ -216,8 +196,8 @@ mod tests {
         p.v[0] = Vec2::new(0.1, 0.0);
         p.command(0, Vec2::new(2.0, 0.0), 0.01);
         // (0.1 + 0.01 · 2) / (1 + 0.01 · 0.5).
-        assert!((p.setpoint[0].x - 0.12 / 1.005).abs() < 1e-15);
+        assert!((p.setpoints.setpoint[0].x - 0.12 / 1.005).abs() < 1e-15);
         p.command(0, Vec2::new(1e6, 0.0), 0.01);
-        assert!((p.setpoint[0].norm() - 1.0).abs() < 1e-12);
+        assert!((p.setpoints.setpoint[0].norm() - 1.0).abs() < 1e-12);
     }
 }
