@@ -27,8 +27,11 @@ use std::path::{Path, PathBuf};
 /// Loads a scenario: an existing file, else a built-in name (`host-sim list`), with
 /// `key=value` overrides applied before validation (`radio.loss=0.2`, `agents.0.mass=2`,
 /// as `--set`).
+///
+/// `controller.comm_rate_hz = "auto"` is resolved here, by measuring the channel's load
+/// (`docs/radio.md`).
 pub fn load(scenario: &str, overrides: &[String]) -> Result<Model, ScenarioErrors> {
-    scenario::load(scenario, overrides)
+    scenario::load(scenario, overrides).map(crate::engine::load::resolve_auto)
 }
 
 /// Loads a scenario from TOML text (the schema of `docs/scenarios.md`); `name` labels
@@ -37,6 +40,7 @@ pub fn load_toml(text: &str, name: &str, overrides: &[String]) -> Result<Model, 
     let source = Source::from_text(name, text);
     let file = source.parse(overrides)?;
     scenario::validate_text(&file, &source.label, &source.default_name, &source.text)
+        .map(crate::engine::load::resolve_auto)
 }
 
 /// What stopped a library call: an invalid scenario, a run that could not finish, or an

@@ -493,7 +493,12 @@ fn the_shared_channel_tables_of_radio_md_are_measured() {
 fn an_overloaded_aloha_channel_names_the_rate_that_fits() {
     let strip = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/strip20.toml");
     let crazy = |file: &str, extra: &[&str]| {
-        let mut o = vec!["world=crazyflie".to_owned(), "duration=10".to_owned()];
+        // The file's own rate (every tick), not the preset's "auto".
+        let mut o = vec![
+            "world=crazyflie".to_owned(),
+            "duration=10".to_owned(),
+            "controller.comm_rate_hz=100".to_owned(),
+        ];
         o.extend(extra.iter().map(|s| (*s).to_owned()));
         let m = load(file, &o).expect("load");
         let r = sim::run(&m, &mut NullRecorder, &mut |_| {}).expect("run");
@@ -553,5 +558,85 @@ fn an_overloaded_aloha_channel_names_the_rate_that_fits() {
         quiet.warnings.iter().all(|w| !w.contains("ALOHA")),
         "{:?}",
         quiet.warnings
+    );
+}
+
+/// `controller.comm_rate_hz = "auto"` (the Crazyflie preset's): the strip's 20 agents,
+/// which offer 54 % of the air time at every tick, broadcast at the highest rate
+/// `100 / k` Hz that keeps the measured load at or under ALOHA's 10 % (k = 6, 16.7 Hz:
+/// k = 5 measures above it), with the timeouts raised to 3.5 broadcast periods; the run
+/// then stays under 10 %, without the overload warning, and in control. The app's
+/// square (9.5 %) keeps every tick and its timeouts. Negative control: the strip at the
+/// file's rate is overloaded. A word other than "auto" is refused naming the field.
+#[test]
+fn comm_rate_auto_picks_the_highest_rate_the_channel_carries() {
+    let set = ["world=crazyflie", "duration=10"];
+    let m = model(&strip20(), &set);
+    let auto = m.comm_auto.as_ref().expect("the preset asks for auto");
+    assert_eq!(m.comm_every, 6, "{auto:?}");
+    assert!((auto.rate_hz - 100.0 / 6.0).abs() < 1e-9, "{auto:?}");
+    let (g1, g) = (auto.load_every_tick.unwrap(), auto.load.unwrap());
+    assert!(g1 > 0.5 && g <= 0.1, "{auto:?}");
+    // k = 5 would not fit: the highest rate is the one chosen.
+    let five = model(
+        &strip20(),
+        &[
+            &set[..],
+            &[
+                "controller.comm_rate_hz=20",
+                "controller.neighbour_timeout=0.2",
+                "sensors.positions.max_age_s=0.2",
+                "controller.bearing_hold_s=0.2",
+            ],
+        ]
+        .concat(),
+    );
+    let g5 = ph_formation_sim::engine::load::offered_load(&five).unwrap();
+    assert!(g5 > 0.1, "{g5}");
+    let need = 3.5 * 6.0 / 100.0;
+    assert!((m.limits.neighbour_timeout - need).abs() < 1e-12);
+    assert!((m.limits.bearing_hold - need).abs() < 1e-12);
+    assert!((m.sensors.positions.as_ref().unwrap().max_age - need).abs() < 1e-12);
+    assert_eq!(auto.raised.len(), 3, "{auto:?}");
+    let r = run(&m);
+    let ch = r.channel.as_ref().expect("channel");
+    assert!(ch.utilisation(r.final_time) <= 0.1, "{ch:?}");
+    assert!(
+        r.warnings.iter().all(|w| !w.contains("overloaded")),
+        "{:?}",
+        r.warnings
+    );
+    assert!(
+        r.warnings
+            .iter()
+            .any(|w| w.contains("\"auto\" chose 16.6667 Hz")),
+        "{:?}",
+        r.warnings
+    );
+    assert_ne!(r.outcome, Outcome::NotInControl, "{}", r.reason);
+    // Negative control: the file's rate.
+    let every = model(
+        &strip20(),
+        &[&set[..], &["controller.comm_rate_hz=100"]].concat(),
+    );
+    assert!(every.comm_auto.is_none());
+    assert!(ph_formation_sim::engine::load::overload_warning(&every).is_some());
+    // The square fits at every tick and keeps its timeouts.
+    let square = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../crazyflie-app/formation.toml"
+    );
+    let sq = model(square, &set);
+    assert_eq!(sq.comm_every, 1);
+    let auto = sq.comm_auto.as_ref().unwrap();
+    assert!(
+        auto.raised.is_empty() && auto.load.unwrap() <= 0.1,
+        "{auto:?}"
+    );
+    assert_eq!(sq.limits.neighbour_timeout, 0.1);
+    let e = refused("paper", &["controller.comm_rate_hz=fast"]);
+    assert!(
+        e.contains("`controller.comm_rate_hz`") && e.contains("auto"),
+        "{e}"
     );
 }

@@ -291,6 +291,9 @@ fn validate_command(
                     m.estimator.as_str(),
                     m.duration
                 );
+                if let Some(auto) = &m.comm_auto {
+                    println!("note: {}", crate::engine::load::auto_note(auto));
+                }
             }
             // Printed even with --quiet, as warnings are.
             if let Some(w) = crate::engine::speed_limit_note(&m) {

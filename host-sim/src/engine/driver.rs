@@ -81,6 +81,9 @@ pub fn run(
     progress: &mut dyn FnMut(f64),
 ) -> Result<RunResult, RunError> {
     let mut warnings = Vec::new();
+    if let Some(auto) = &model.comm_auto {
+        warnings.push(super::load::auto_note(auto));
+    }
     if let Some(w) = speed_limit_note(model) {
         warnings.push(w);
     }

@@ -8,7 +8,7 @@
 use super::channel::{ALOHA_LOAD_TARGET, TIMEOUT_BROADCASTS};
 use super::sampled::SampledSim;
 use super::simulator::Engine;
-use crate::model::{Access, Mode, Model};
+use crate::model::{Access, AutoRate, Mode, Model};
 
 /// Communication periods left out, then measured (fewer read the strip's load low: 48 %
 /// over periods 3 to 6).
@@ -72,4 +72,102 @@ pub fn overload_warning(model: &Model) -> Option<String> {
         100.0 * target,
         TIMEOUT_BROADCASTS / rate
     ))
+}
+
+/// The offered load the channel is taken to carry: [`ALOHA_LOAD_TARGET`] with ALOHA
+/// (collisions), the whole air time with TDMA.
+fn load_target(model: &Model) -> f64 {
+    match model.radio.channel.as_ref().map(|c| c.access) {
+        Some(Access::Aloha) => ALOHA_LOAD_TARGET,
+        _ => 1.0,
+    }
+}
+
+/// The most broadcasts per control tick `resolve_auto` slows to (`rate_hz / 64`).
+const MAX_EVERY: usize = 64;
+
+/// Resolves `controller.comm_rate_hz = "auto"` (docs/radio.md): the highest rate
+/// `rate_hz / k` (whole `k`) whose offered load, measured as [`offered_load`], stays at or
+/// under the channel's target ([`ALOHA_LOAD_TARGET`] with ALOHA, the whole air time with
+/// TDMA); every tick without a shared channel or in continuous mode. The timeouts that
+/// must span several broadcasts (`controller.neighbour_timeout`, and where used
+/// `sensors.positions.max_age_s` and `controller.bearing_hold_s`) are raised to
+/// [`TIMEOUT_BROADCASTS`] broadcast periods when shorter. A model without `"auto"` is
+/// returned as it is.
+pub fn resolve_auto(mut model: Model) -> Model {
+    let Some(mut auto) = model.comm_auto.take() else {
+        return model;
+    };
+    let period = model.control_period();
+    let target = load_target(&model);
+    model.comm_every = 1;
+    let first = offered_load(&model);
+    auto.load_every_tick = first;
+    auto.load = first;
+    if let Some(g) = first.filter(|&g| g > target) {
+        // The load scales with the broadcast rate; measure again, since frames at a
+        // lower rate carry what more ticks gathered (a few per cent).
+        let mut k = ((g / target).ceil() as usize).clamp(2, MAX_EVERY);
+        loop {
+            model.comm_every = k;
+            raise_timeouts(&mut model, &mut auto.raised);
+            let g = offered_load(&model).unwrap_or(0.0);
+            auto.load = Some(g);
+            if g <= target || k == MAX_EVERY {
+                break;
+            }
+            k = (k + 1)
+                .max((k as f64 * g / target).ceil() as usize)
+                .min(MAX_EVERY);
+        }
+    }
+    auto.rate_hz = 1.0 / (period * model.comm_every as f64);
+    model.comm_auto = Some(auto);
+    model
+}
+
+/// Raises the timeouts shorter than [`TIMEOUT_BROADCASTS`] broadcast periods to that,
+/// recording each in `raised` (once, with its file value).
+fn raise_timeouts(model: &mut Model, raised: &mut Vec<(&'static str, f64, f64)>) {
+    let need = TIMEOUT_BROADCASTS * model.comm_period();
+    let mut raise = |key: &'static str, value: &mut f64| {
+        let from = raised.iter().find(|r| r.0 == key).map_or(*value, |r| r.1);
+        if from < need {
+            *value = need;
+            raised.retain(|r| r.0 != key);
+            raised.push((key, from, need));
+        }
+    };
+    raise(
+        "controller.neighbour_timeout",
+        &mut model.limits.neighbour_timeout,
+    );
+    if model.limits.bearing_hold > 0.0 {
+        raise("controller.bearing_hold_s", &mut model.limits.bearing_hold);
+    }
+    if let Some(p) = model.sensors.positions.as_mut() {
+        raise("sensors.positions.max_age_s", &mut p.max_age);
+    }
+}
+
+/// The run's note on a resolved `"auto"` rate: the rate, the loads and the raised
+/// timeouts.
+pub fn auto_note(auto: &AutoRate) -> String {
+    let mut s = format!(
+        "controller.comm_rate_hz = \"auto\" chose {:.4} Hz",
+        auto.rate_hz
+    );
+    match (auto.load_every_tick, auto.load) {
+        (Some(g1), Some(g)) if g1 != g => s += &format!(
+            " (the agents offer {:.0} % of the shared channel's air time at every tick, {:.1} % at this rate)",
+            100.0 * g1,
+            100.0 * g
+        ),
+        (Some(g), _) => s += &format!(" (every tick: {:.1} % of the shared channel's air time)", 100.0 * g),
+        _ => s += " (every tick: no shared channel)",
+    }
+    for (key, from, to) in &auto.raised {
+        s += &format!("; {key} raised from {from} s to {to:.3} s");
+    }
+    s
 }

@@ -12,6 +12,22 @@ pub const CRAZYFLIE_OVERHEAD_BYTES: f64 = 89.0 / 8.0;
 /// TX settling before each packet (nRF24L01+ `Tstby2a` = 130 µs).
 pub const CRAZYFLIE_TURNAROUND: f64 = 130e-6;
 
+/// `controller.comm_rate_hz = "auto"` (docs/radio.md): requested by the file, then
+/// resolved by the API (`engine::load::resolve_auto`) into `Model::comm_every` and the
+/// timeouts, with what it measured for the run's report.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct AutoRate {
+    /// The offered load broadcasting at every control tick (share of the air time;
+    /// `None` before resolution, or without a shared channel).
+    pub load_every_tick: Option<f64>,
+    /// The offered load at the chosen rate.
+    pub load: Option<f64>,
+    /// The chosen rate (Hz).
+    pub rate_hz: f64,
+    /// Timeouts raised to span the broadcasts they need: `(key, from s, to s)`.
+    pub raised: Vec<(&'static str, f64, f64)>,
+}
+
 /// How agents share the medium.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]

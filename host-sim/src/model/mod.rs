@@ -25,7 +25,7 @@ pub mod world;
 
 pub use attack::{AttackKind, AttackModel};
 pub use battery::BatteryModel;
-pub use channel::{Access, ChannelModel, IntegrityMode};
+pub use channel::{Access, AutoRate, ChannelModel, IntegrityMode};
 pub use core_config::{CoreAgent, MT, NB};
 pub use criteria::Criteria;
 pub use devices::PositionsModel;
@@ -66,6 +66,9 @@ pub struct Model {
     pub steps_per_tick: usize,
     /// Control ticks per broadcast (`rate_hz / comm_rate_hz`, ≥ 1).
     pub comm_every: usize,
+    /// `controller.comm_rate_hz = "auto"`: requested (and, once the API resolved it,
+    /// what it chose); `None`: the file's rate.
+    pub comm_auto: Option<AutoRate>,
     /// How frames are protected (the same for every agent).
     pub integrity: IntegrityMode,
     /// The swarm key of `auth` integrity (zero otherwise). Never written to any output.

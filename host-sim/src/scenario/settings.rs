@@ -46,9 +46,10 @@ pub struct ControllerSpec {
     pub safe_damping: f64,
     /// Margin (degrees) that desired and current angles must keep from 0 and 180°.
     pub angle_margin_deg: f64,
-    /// Broadcast rate (Hz): `≤ rate_hz`, and `rate_hz` a whole multiple of it; default
-    /// `rate_hz` (broadcast every tick).
-    pub comm_rate_hz: Option<f64>,
+    /// Broadcast rate (Hz): `≤ rate_hz`, and `rate_hz` a whole multiple of it, or
+    /// `"auto"` (the highest such rate the shared channel carries, docs/radio.md);
+    /// default `rate_hz` (broadcast every tick).
+    pub comm_rate_hz: Option<CommRate>,
     /// Frame integrity of the swarm: `crc16`, `link` or `auth`.
     pub integrity: IntegrityMode,
     /// `auth`: the 128-bit swarm key as 32 hexadecimal digits.
@@ -71,6 +72,55 @@ impl Default for ControllerSpec {
             integrity: IntegrityMode::Crc16,
             auth_key: None,
         }
+    }
+}
+
+/// `controller.comm_rate_hz`: a rate in Hz, or `"auto"`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum CommRate {
+    /// Broadcast at this rate (Hz).
+    Hz(f64),
+    /// The highest rate `rate_hz / k` whose offered load the shared channel carries
+    /// (`engine::load::resolve_auto`, docs/radio.md "comm_rate_hz = auto").
+    Auto,
+}
+
+impl Serialize for CommRate {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            Self::Hz(hz) => s.serialize_f64(*hz),
+            Self::Auto => s.serialize_str("auto"),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for CommRate {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visit;
+        impl serde::de::Visitor<'_> for Visit {
+            type Value = CommRate;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("a rate in Hz or \"auto\"")
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<CommRate, E> {
+                Ok(CommRate::Hz(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<CommRate, E> {
+                Ok(CommRate::Hz(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<CommRate, E> {
+                Ok(CommRate::Hz(v as f64))
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<CommRate, E> {
+                match v {
+                    "auto" => Ok(CommRate::Auto),
+                    _ => Err(E::custom(format!(
+                        "expected a rate in Hz or \"auto\", got \"{v}\""
+                    ))),
+                }
+            }
+        }
+        d.deserialize_any(Visit)
     }
 }
 

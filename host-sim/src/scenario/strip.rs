@@ -65,6 +65,7 @@ pub fn strip_model(n: usize, duration: f64) -> Result<Model, ScenarioErrors> {
         log_every: 10,
         steps_per_tick: 10,
         comm_every: 1,
+        comm_auto: None,
         integrity: IntegrityMode::Crc16,
         auth_key: [0; 16],
         estimator: Estimator::Shared,

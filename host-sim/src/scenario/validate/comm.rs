@@ -5,13 +5,15 @@ use super::checker::Checker;
 use crate::model::channel::{CRAZYFLIE_BIT_RATE, CRAZYFLIE_OVERHEAD_BYTES, CRAZYFLIE_TURNAROUND};
 use crate::model::{Access, ChannelModel, IntegrityMode};
 use crate::scenario::error::ErrorKind::InvalidValue;
+use crate::scenario::settings::CommRate;
 use crate::scenario::ScenarioFile;
 use ph_formation_core::MAX_FRAME_LEN;
 
-/// Ticks per broadcast from `controller.comm_rate_hz` (1 when absent or invalid).
+/// Ticks per broadcast from `controller.comm_rate_hz` (1 when absent, `"auto"` or
+/// invalid: the API resolves `"auto"` after validation, `engine::load::resolve_auto`).
 pub(super) fn comm_every(c: &mut Checker<'_>, s: &ScenarioFile, period: f64) -> usize {
     let ctl = &s.controller;
-    let Some(comm) = ctl.comm_rate_hz else {
+    let Some(CommRate::Hz(comm)) = ctl.comm_rate_hz else {
         return 1;
     };
     let field = "controller.comm_rate_hz";

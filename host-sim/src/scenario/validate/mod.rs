@@ -110,6 +110,8 @@ fn check(
         log_every,
         steps_per_tick,
         comm_every,
+        comm_auto: (s.controller.comm_rate_hz == Some(crate::scenario::settings::CommRate::Auto))
+            .then(crate::model::AutoRate::default),
         integrity: ctl.integrity,
         auth_key,
         estimator: ctl.estimator,
