@@ -36,6 +36,8 @@ pub enum ActuateError {
     Lead,
     /// The second-order lead is not finite and non-negative.
     SecondLead,
+    /// The jerk filter's time constant is not finite and non-negative.
+    JerkFilter,
 }
 
 /// The virtual plant of SPEC S1 for one agent: mass, friction `D^r` per axis, the
@@ -48,6 +50,7 @@ pub struct VirtualMass<T> {
     max_speed: T,
     lead: T,
     second_lead: T,
+    jerk_filter: T,
 }
 
 impl<T: Real> VirtualMass<T> {
@@ -70,6 +73,7 @@ impl<T: Real> VirtualMass<T> {
             max_speed,
             lead: T::zero(),
             second_lead: T::zero(),
+            jerk_filter: T::zero(),
         })
     }
 
@@ -96,6 +100,26 @@ impl<T: Real> VirtualMass<T> {
             second_lead,
             ..self
         })
+    }
+
+    /// The same plant with the second-order lead's jerk taken through a first-order
+    /// filter of time constant `jerk_filter` (s, finite, ≥ 0; S21c): the jerk is the
+    /// virtual acceleration's distance from its filtered value over `jerk_filter + Δt`,
+    /// so that velocity noise differenced twice does not reach the vehicle's velocity
+    /// loop tick by tick. 0 (the default): S21b's plain difference.
+    pub fn with_jerk_filter(self, jerk_filter: T) -> Result<Self, ActuateError> {
+        if !(jerk_filter.finite() && jerk_filter >= T::zero()) {
+            return Err(ActuateError::JerkFilter);
+        }
+        Ok(Self {
+            jerk_filter,
+            ..self
+        })
+    }
+
+    /// The jerk filter's time constant (s, S21c).
+    pub fn jerk_filter(&self) -> T {
+        self.jerk_filter
     }
 
     /// The second-order lead (s²).
@@ -259,11 +283,22 @@ impl<T: Real> VelocityCommand<T> {
         if !(p.second_lead > T::zero() && dt > T::zero() && dt.finite()) {
             return p.setpoint(from, next, dt);
         }
-        // S21b: S21 plus `τ₂` times the virtual jerk, the change of the virtual
-        // acceleration over the period (none on the first step after a (re)start).
+        // S21b: S21 plus `τ₂` times the virtual jerk (none on the first step after a
+        // (re)start). S21c: the jerk is the acceleration's distance from its filtered
+        // value `ā` over `τ_f + Δt`, and `ā` moves by `Δt` times it; with `τ_f = 0`,
+        // `ā` is the last acceleration and the jerk S21b's difference (the same bits).
         let ([x, y], [x0, y0]) = (next, from);
         let (ax, ay) = ((x - x0) / dt, (y - y0) / dt);
         let [px, py] = self.accel.unwrap_or([ax, ay]);
+        if p.jerk_filter > T::zero() {
+            let span = p.jerk_filter + dt;
+            let (jx, jy) = ((ax - px) / span, (ay - py) / span);
+            self.accel = Some([px + dt * jx, py + dt * jy]);
+            return p.limit([
+                x + p.lead * ax + p.second_lead * jx,
+                y + p.lead * ay + p.second_lead * jy,
+            ]);
+        }
         self.accel = Some([ax, ay]);
         let k = p.second_lead / dt;
         p.limit([
@@ -391,10 +426,11 @@ mod tests {
     #[test]
     fn the_second_lead_cancels_a_second_order_velocity_loop() {
         let (tau, tau_a) = (0.2337_f64, 1.0 / 6.0);
-        let lag = |second: f64| {
+        let lag = |second: f64, filter: f64| {
             let plant = VirtualMass::new(1.0, [0.0; 2], f64::INFINITY)
                 .and_then(|p| p.with_lead(tau))
                 .and_then(|p| p.with_second_lead(second))
+                .and_then(|p| p.with_jerk_filter(filter))
                 .unwrap();
             let mut c = VelocityCommand::new(plant);
             let (dt, sub) = (0.01, 100);
@@ -416,12 +452,67 @@ mod tests {
             }
             worst
         };
-        let (first, second) = (lag(0.0), lag(tau * tau_a));
+        let (first, second) = (lag(0.0, 0.0), lag(tau * tau_a, 0.0));
         assert!(first > 0.02, "{first}");
         assert!(second < 0.1 * first, "{second} vs {first}");
+        // S21c's filter (30 ms) keeps most of the cancellation.
+        let filtered = lag(tau * tau_a, 0.03);
+        assert!(filtered < 0.25 * first, "{filtered} vs {first}");
         assert_eq!(
             VirtualMass::new(1.0_f64, [0.0; 2], 1.0).and_then(|p| p.with_second_lead(f64::NAN)),
             Err(ActuateError::SecondLead)
+        );
+    }
+
+    /// S21c: under a constant virtual jerk `J` the filtered jerk converges to `J`
+    /// exactly (the filter's steady state, `ā = a − τ_f J`), so the setpoint gains `τ₂ J`
+    /// as S21b's does; under white force noise the setpoint's change from tick to tick
+    /// is several times smaller than S21b's; the lead still cancels the second-order
+    /// loop; a bad time constant is refused.
+    #[test]
+    fn the_jerk_filter_keeps_the_lead_and_drops_tick_noise() {
+        let (tau, tau2, tf, dt) = (0.2337_f64, 0.039, 0.03, 0.01);
+        let plant = |filter: f64| {
+            VirtualMass::new(1.0, [0.0; 2], f64::INFINITY)
+                .and_then(|p| p.with_lead(tau))
+                .and_then(|p| p.with_second_lead(tau2))
+                .and_then(|p| p.with_jerk_filter(filter))
+                .unwrap()
+        };
+        // A force ramp U = J t on a unit mass: acceleration J t, jerk J.
+        let jerk = 2.0;
+        let mut c = VelocityCommand::new(plant(tf));
+        let mut sp = [0.0; 2];
+        for k in 0..200 {
+            sp = c.step([jerk * f64::from(k) * dt, 0.0], [0.0; 2], dt);
+        }
+        let v = c.command().unwrap()[0];
+        let a = jerk * 199.0 * dt;
+        let expected = v + tau * a + tau2 * jerk;
+        assert!((sp[0] - expected).abs() < 1e-9, "{} vs {expected}", sp[0]);
+        // White force noise: the setpoint's tick-to-tick change.
+        let spread = |filter: f64| {
+            let mut c = VelocityCommand::new(plant(filter));
+            let mut rng = 0x2545_f491_u32;
+            let (mut last, mut sum) = (0.0, 0.0);
+            for k in 0..2000 {
+                rng ^= rng << 13;
+                rng ^= rng >> 17;
+                rng ^= rng << 5;
+                let u = f64::from(rng) / f64::from(u32::MAX) - 0.5;
+                let sp = c.step([u, 0.0], [0.0; 2], dt)[0];
+                if k > 0 {
+                    sum += (sp - last) * (sp - last);
+                }
+                last = sp;
+            }
+            libm::sqrt(sum / 1999.0)
+        };
+        let (plain, filtered) = (spread(0.0), spread(tf));
+        assert!(filtered < plain / 3.0, "{filtered} vs {plain}");
+        assert_eq!(
+            VirtualMass::new(1.0_f64, [0.0; 2], 1.0).and_then(|p| p.with_jerk_filter(-1.0)),
+            Err(ActuateError::JerkFilter)
         );
     }
 

@@ -27,6 +27,7 @@ pub fn add_json(obj: &mut Map<String, Value>, model: &Model) {
             "second_lead_s2": v
                 .second_lead
                 .unwrap_or_else(crate::engine::plant::derived_second_lead),
+            "jerk_filter_s": v.jerk_filter,
         }),
     };
     let wind = w.wind.map(|x| {

@@ -46,6 +46,10 @@ pub enum PlantSpec {
         /// `τ / K_p^a` (0.039 s²).
         #[serde(default)]
         second_lead_s2: Option<f64>,
+        /// The time constant of the filter on the second-order lead's jerk (s, SPEC
+        /// S21c); default 0.03 s (docs/world.md).
+        #[serde(default)]
+        jerk_filter_s: Option<f64>,
     },
 }
 
@@ -280,6 +284,7 @@ mod plant_tests {
                 max_speed: 1.0,
                 lead_s: None,
                 second_lead_s2: None,
+                jerk_filter_s: None,
             })
         );
         assert!(matches!(

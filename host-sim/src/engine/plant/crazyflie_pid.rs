@@ -31,7 +31,10 @@ impl CrazyfliePidPlant {
             model,
             vehicle.max_speed,
             vehicle.lead.unwrap_or_else(derived_lead),
-            Some(vehicle.second_lead.unwrap_or_else(derived_second_lead)),
+            Some((
+                vehicle.second_lead.unwrap_or_else(derived_second_lead),
+                vehicle.jerk_filter,
+            )),
         )?;
         let drones: Vec<Crazyflie> = model
             .agents

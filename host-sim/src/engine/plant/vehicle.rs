@@ -60,13 +60,14 @@ pub(crate) struct Setpoints {
 
 impl Setpoints {
     /// Every agent of `model` with its virtual mass (its mass and friction, the speed
-    /// limit `max_speed`, the lead and, if given, the second-order lead), holding its
-    /// initial velocity as its setpoint until its first tick.
+    /// limit `max_speed`, the lead and, if given, the second-order lead with its jerk
+    /// filter's time constant, S21b/S21c), holding its initial velocity as its setpoint
+    /// until its first tick.
     pub(crate) fn new(
         model: &Model,
         max_speed: f64,
         lead: f64,
-        second_lead: Option<f64>,
+        second_lead: Option<(f64, f64)>,
     ) -> Result<Self, SetupError> {
         let a = &model.agents;
         let command = a
@@ -75,7 +76,11 @@ impl Setpoints {
             .map(|(i, x)| {
                 VirtualMass::new(x.mass, x.friction, max_speed)
                     .and_then(|m| m.with_lead(lead))
-                    .and_then(|m| second_lead.map_or(Ok(m), |s| m.with_second_lead(s)))
+                    .and_then(|m| {
+                        second_lead.map_or(Ok(m), |(s, f)| {
+                            m.with_second_lead(s).and_then(|m| m.with_jerk_filter(f))
+                        })
+                    })
                     .map(VelocityCommand::new)
                     .map_err(|error| SetupError::Vehicle { agent: i, error })
             })

@@ -54,7 +54,10 @@ pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile, period: f64) -> World
             max_speed,
             lead_s,
             second_lead_s2,
+            jerk_filter_s,
         }) => {
+            let jerk_filter = jerk_filter_s.unwrap_or(crate::model::world::JERK_FILTER_S);
+            c.non_negative(InvalidValue, "plant.jerk_filter_s", jerk_filter);
             c.positive(InvalidValue, "plant.max_speed", max_speed);
             if let Some(lead) = lead_s {
                 c.non_negative(InvalidValue, "plant.lead_s", lead);
@@ -66,6 +69,7 @@ pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile, period: f64) -> World
                 max_speed,
                 lead: lead_s,
                 second_lead: second_lead_s2,
+                jerk_filter,
             });
         }
     }
