@@ -239,8 +239,13 @@ fn the_crazyflie_world_flies_the_apps_square() {
     // (S21b; docs/crazyflie.md: "to settle in 14 s") and settles only after 60 s without
     // it. Nothing here is random: another seed gives the same bits, so one seed is
     // every seed.
+    // S21b as it was (no S21c filter), then S21c's default.
     let alone = |extra: &[&str]| {
-        let mut o = vec!["plant.model=crazyflie_pid", "duration=60"];
+        let mut o = vec![
+            "plant.model=crazyflie_pid",
+            "duration=60",
+            "plant.jerk_filter_s=0",
+        ];
         o.extend_from_slice(extra);
         run(&model(square, &o))
     };
@@ -285,8 +290,30 @@ fn the_crazyflie_world_flies_the_apps_square() {
         docs::shows(got, &said),
         "docs/world.md: {said} s, run {got} s"
     );
+    let filtered = run(&model(
+        square,
+        &["plant.model=crazyflie_pid", "duration=60"],
+    ));
+    let t = filtered.settle_time.expect("settled");
+    let said = docs::between(
+        &world,
+        "jerk filter (the default 0.03 s, below) the square settles in",
+        " s and",
+    );
+    assert!(docs::shows(t, &said), "docs/world.md: {said} s, run {t} s");
     let strip = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/strip20.toml");
-    let strip_led = run(&model(strip, &["plant.model=crazyflie_pid", "duration=60"]));
+    let strip_filtered = run(&model(strip, &["plant.model=crazyflie_pid", "duration=60"]));
+    let t = strip_filtered.settle_time.expect("settled");
+    let said = docs::between(&world, " s and the strip in", " s (");
+    assert!(docs::shows(t, &said), "docs/world.md: {said} s, run {t} s");
+    let strip_led = run(&model(
+        strip,
+        &[
+            "plant.model=crazyflie_pid",
+            "duration=60",
+            "plant.jerk_filter_s=0",
+        ],
+    ));
     assert_eq!(
         strip_led.outcome,
         Outcome::Converged,
