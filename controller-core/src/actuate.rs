@@ -103,7 +103,7 @@ impl<T: Real> VirtualMass<T> {
     }
 
     /// The same plant with the second-order lead's jerk taken through a first-order
-    /// filter of time constant `jerk_filter` (s, finite, ≥ 0; S21c): the jerk is the
+    /// filter of time constant `jerk_filter` (s, finite, ≥ 0; S21d): the jerk is the
     /// virtual acceleration's distance from its filtered value over `jerk_filter + Δt`,
     /// so that velocity noise differenced twice does not reach the vehicle's velocity
     /// loop tick by tick. 0 (the default): S21b's plain difference.
@@ -117,7 +117,7 @@ impl<T: Real> VirtualMass<T> {
         })
     }
 
-    /// The jerk filter's time constant (s, S21c).
+    /// The jerk filter's time constant (s, S21d).
     pub fn jerk_filter(&self) -> T {
         self.jerk_filter
     }
@@ -284,7 +284,7 @@ impl<T: Real> VelocityCommand<T> {
             return p.setpoint(from, next, dt);
         }
         // S21b: S21 plus `τ₂` times the virtual jerk (none on the first step after a
-        // (re)start). S21c: the jerk is the acceleration's distance from its filtered
+        // (re)start). S21d: the jerk is the acceleration's distance from its filtered
         // value `ā` over `τ_f + Δt`, and `ā` moves by `Δt` times it; with `τ_f = 0`,
         // `ā` is the last acceleration and the jerk S21b's difference (the same bits).
         let ([x, y], [x0, y0]) = (next, from);
@@ -455,7 +455,7 @@ mod tests {
         let (first, second) = (lag(0.0, 0.0), lag(tau * tau_a, 0.0));
         assert!(first > 0.02, "{first}");
         assert!(second < 0.1 * first, "{second} vs {first}");
-        // S21c's filter (30 ms) keeps most of the cancellation.
+        // S21d's filter (30 ms) keeps most of the cancellation.
         let filtered = lag(tau * tau_a, 0.03);
         assert!(filtered < 0.25 * first, "{filtered} vs {first}");
         assert_eq!(
@@ -464,7 +464,7 @@ mod tests {
         );
     }
 
-    /// S21c: under a constant virtual jerk `J` the filtered jerk converges to `J`
+    /// S21d: under a constant virtual jerk `J` the filtered jerk converges to `J`
     /// exactly (the filter's steady state, `ā = a − τ_f J`), so the setpoint gains `τ₂ J`
     /// as S21b's does; under white force noise the setpoint's change from tick to tick
     /// is several times smaller than S21b's; the lead still cancels the second-order

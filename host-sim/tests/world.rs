@@ -239,7 +239,7 @@ fn the_crazyflie_world_flies_the_apps_square() {
     // (S21b; docs/crazyflie.md: "to settle in 14 s") and settles only after 60 s without
     // it. Nothing here is random: another seed gives the same bits, so one seed is
     // every seed.
-    // S21b as it was (no S21c filter), then S21c's default.
+    // S21b as it was (no S21d filter), then S21d's default.
     let alone = |extra: &[&str]| {
         let mut o = vec![
             "plant.model=crazyflie_pid",

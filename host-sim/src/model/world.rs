@@ -30,11 +30,11 @@ pub struct CrazyfliePid {
     /// The second-order lead of the agent's setpoints (s², ≥ 0; SPEC S21b); `None`: the
     /// derived `engine::plant::derived_second_lead`.
     pub second_lead: Option<f64>,
-    /// The time constant of the filter on that lead's jerk (s, ≥ 0; SPEC S21c).
+    /// The time constant of the filter on that lead's jerk (s, ≥ 0; SPEC S21d).
     pub jerk_filter: f64,
 }
 
-/// The default [`CrazyfliePid::jerk_filter`] (s, SPEC S21c): three of the velocity loop's
+/// The default [`CrazyfliePid::jerk_filter`] (s, SPEC S21d): three of the velocity loop's
 /// 10 ms periods, a sixth of the attitude loop's `τ_a` = 1/6 s (docs/world.md measures
 /// 0, 0.02, 0.03, 0.05 and 0.1 s).
 pub const JERK_FILTER_S: f64 = 0.03;

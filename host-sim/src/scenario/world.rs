@@ -47,7 +47,7 @@ pub enum PlantSpec {
         #[serde(default)]
         second_lead_s2: Option<f64>,
         /// The time constant of the filter on the second-order lead's jerk (s, SPEC
-        /// S21c); default 0.03 s (docs/world.md).
+        /// S21d); default 0.03 s (docs/world.md).
         #[serde(default)]
         jerk_filter_s: Option<f64>,
     },

@@ -61,7 +61,7 @@ pub(crate) struct Setpoints {
 impl Setpoints {
     /// Every agent of `model` with its virtual mass (its mass and friction, the speed
     /// limit `max_speed`, the lead and, if given, the second-order lead with its jerk
-    /// filter's time constant, S21b/S21c), holding its initial velocity as its setpoint
+    /// filter's time constant, S21b/S21d), holding its initial velocity as its setpoint
     /// until its first tick.
     pub(crate) fn new(
         model: &Model,
