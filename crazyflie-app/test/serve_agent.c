@@ -3,7 +3,7 @@
  * services the app calls, the vehicle, the P2P radio and the paced clock.
  *
  *   cfapp-agent --id N --crtp-port P --p2p-port P --relay-port P --x X --y Y
- *               --blob FILE [--speed F]
+ *               --blob FILE [--speed F] [--relay-clock 0|1]
  *
  * prints "CFAGENT ready id=N crtp=P" on stdout once its sockets are bound, then runs
  * the app's appMain() (crazyflie-app/src/app.c) until killed (SIGTERM from host-sim
@@ -76,6 +76,13 @@
 
 static uint8_t agent_id;
 static double speed = 1.0;
+/* --clock relay: host-sim serve's relay grants time (SERVE_GRANT) and waits for each
+ * agent's tick (SERVE_DONE), so that every drone runs on one clock however loaded the
+ * machine; --clock self: paced by the wall clock alone (one agent on its own). */
+static bool relay_clock;
+static uint32_t granted_ms;
+#define SERVE_GRANT 0xF0u /* relay -> agent: [0xF0, t u32 LE]: run up to t ms */
+#define SERVE_DONE 0xF1u  /* agent -> relay: [0xF1, t u32 LE]: ticked at t ms */
 static int crtp_fd = -1, p2p_fd = -1;
 static struct sockaddr_in relay, client;
 static bool have_client;
@@ -525,6 +532,11 @@ static void receive_all(void)
         ssize_t n = recv(p2p_fd, d, sizeof d, MSG_DONTWAIT);
         if (n <= 0)
             break;
+        if (n == 5 && d[0] == SERVE_GRANT) {
+            granted_ms = (uint32_t)d[1] | (uint32_t)d[2] << 8 | (uint32_t)d[3] << 16 |
+                         (uint32_t)d[4] << 24;
+            break; /* what follows the grant is heard at the next tick */
+        }
         if (n < 2 || n > P2P_MAX_DATA_SIZE + 1 || p2p_cb == NULL)
             continue;
         P2PPacket p;
@@ -538,10 +550,28 @@ static void receive_all(void)
 
 /* The app task's delay: serve the sockets until the wall clock reaches the wake
  * time (scaled by --speed), then run the firmware's ticks up to it. */
+static bool time_left(uint32_t target)
+{
+    if (relay_clock)
+        return (int32_t)(target - granted_ms) > 0;
+    return (double)target / speed - wall_ms() > 0.0;
+}
+
 void vTaskDelayUntil(TickType_t *const wake, const TickType_t increment)
 {
     uint32_t target = *wake + increment;
-    for (;;) {
+    if (relay_clock) { /* this tick's packets are sent: tell the relay */
+        uint8_t d[5] = {SERVE_DONE, (uint8_t)now_ms, (uint8_t)(now_ms >> 8),
+                        (uint8_t)(now_ms >> 16), (uint8_t)(now_ms >> 24)};
+        (void)sendto(p2p_fd, d, sizeof d, 0, (struct sockaddr *)&relay, sizeof relay);
+    }
+    while (time_left(target)) {
+        if (relay_clock) {
+            struct pollfd fds[2] = {{crtp_fd, POLLIN, 0}, {p2p_fd, POLLIN, 0}};
+            (void)poll(fds, 2, 100);
+            receive_all();
+            continue;
+        }
         double left = (double)target / speed - wall_ms();
         if (left <= 0.0)
             break;
@@ -549,7 +579,8 @@ void vTaskDelayUntil(TickType_t *const wake, const TickType_t increment)
         (void)poll(fds, 2, (int)(left + 0.999));
         receive_all();
     }
-    receive_all();
+    if (!relay_clock)
+        receive_all();
     while ((int32_t)(target - now_ms) > 0) {
         now_ms += TICK_MS;
         firmware_tick();
@@ -583,7 +614,7 @@ static int usage(const char *why)
 {
     fprintf(stderr,
             "cfapp-agent: %s\nusage: cfapp-agent --id N --crtp-port P --p2p-port P --relay-port P "
-            "--x X --y Y --blob FILE [--speed F]\n",
+            "--x X --y Y --blob FILE [--speed F] [--relay-clock 0|1]\n",
             why);
     return 2;
 }
@@ -615,6 +646,8 @@ int main(int argc, char **argv)
             q0[0] = (float)x;
         else if (strcmp(key, "--y") == 0)
             q0[1] = (float)x;
+        else if (strcmp(key, "--relay-clock") == 0)
+            relay_clock = x != 0.0;
         else if (strcmp(key, "--speed") == 0 && x > 0.0)
             speed = x;
         else

@@ -12,6 +12,9 @@
 //! - agent k (scenario order, from 0) answers CRTP on `udp://127.0.0.1:PORT+k`;
 //! - the agents' P2P packets go to the relay at `127.0.0.1:PORT+100` from each agent's
 //!   own socket `PORT+101+k`, and the relay hands each to every other agent;
+//! - the relay keeps one clock for every agent: it grants the next 10 ms tick once
+//!   every agent has done the last one and the wall clock (times `--speed`) has
+//!   reached it, so a loaded machine slows the whole world down evenly;
 //! - standard input takes one command a line: `cut ID` drops every P2P packet to and
 //!   from agent ID (its radio to its neighbours is cut; its CRTP link stays up, so the
 //!   client still sees it), `restore ID` ends that, `quit` (or the end of input) stops
@@ -28,7 +31,7 @@ use std::path::PathBuf;
 use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 /// The environment variable naming the agent program when `--agent` is not given.
 pub const AGENT_ENV: &str = "PH_CFAPP_AGENT";
@@ -62,6 +65,14 @@ fn refusal(model: &Model) -> Option<String> {
             "its agents sense bearings with a camera ([sensors.camera]); the Crazyflie app \
              senses its neighbours only through their shared positions (P2P position packets), \
              so a camera world cannot be served"
+                .to_owned(),
+        );
+    }
+    if model.sensors.positions.is_none() {
+        return Some(
+            "its agents do not share positions: the Crazyflie app computes every bearing \
+             from its neighbours' position packets; set sensors.bearing_source = \
+             \"shared_positions\" (the crazyflie world does: --set world=crazyflie)"
                 .to_owned(),
         );
     }
@@ -144,8 +155,8 @@ pub(super) fn serve_command(args: &ServeArgs) -> u8 {
     let cut = Arc::new(Mutex::new(vec![false; n]));
     let stop = Arc::new(AtomicBool::new(false));
     let relay_thread = {
-        let (cut, stop, port) = (Arc::clone(&cut), Arc::clone(&stop), args.port);
-        std::thread::spawn(move || relay_loop(&relay, port, n, &cut, &stop))
+        let (cut, stop, port, speed) = (Arc::clone(&cut), Arc::clone(&stop), args.port, args.speed);
+        std::thread::spawn(move || relay_loop(&relay, port, speed, n, &cut, &stop))
     };
     println!("serve: ready");
     let _ = std::io::stdout().flush();
@@ -185,7 +196,7 @@ fn spawn_all(
             .args(["--relay-port", &(args.port + RELAY_OFFSET).to_string()])
             .args(["--x", &a.position[0].to_string()])
             .args(["--y", &a.position[1].to_string()])
-            .args(["--speed", &args.speed.to_string()])
+            .args(["--relay-clock", "1"])
             .arg("--blob")
             .arg(&blob)
             .stdin(Stdio::null())
@@ -219,18 +230,64 @@ fn spawn_all(
     Ok(agents)
 }
 
-/// Hands every P2P packet to every other agent, unless the sender's or the
-/// receiver's radio is cut.
-fn relay_loop(relay: &UdpSocket, port: u16, n: usize, cut: &Mutex<Vec<bool>>, stop: &AtomicBool) {
-    let _ = relay.set_read_timeout(Some(Duration::from_millis(50)));
+/// The relay's clock messages (first byte of a datagram; P2P packets start with
+/// their port, 0 or 1): a grant of time to an agent, an agent's tick done.
+const GRANT: u8 = 0xF0;
+const DONE: u8 = 0xF1;
+/// The firmware's tick (ms).
+const TICK_MS: u32 = 10;
+
+/// The relay: hands every P2P packet to every other agent, unless the sender's or
+/// the receiver's radio is cut; and keeps one clock for all agents: time `t` is
+/// granted (`[GRANT, t]`) once every agent has reported its tick at `t − 10 ms`
+/// (`[DONE, t − 10]`) and the wall clock has reached `t / speed`. A loaded machine
+/// slows the whole world down rather than letting one drone fall behind the others.
+fn relay_loop(
+    relay: &UdpSocket,
+    port: u16,
+    speed: f64,
+    n: usize,
+    cut: &Mutex<Vec<bool>>,
+    stop: &AtomicBool,
+) {
     let first = port + RELAY_OFFSET + 1;
+    let mut done = vec![false; n];
+    let mut granted: u32 = 0;
+    let start = Instant::now();
     let mut buf = [0u8; 128];
+    let grant = |t: u32| {
+        let mut d = [GRANT, 0, 0, 0, 0];
+        d[1..].copy_from_slice(&t.to_le_bytes());
+        for j in 0..n {
+            let _ = relay.send_to(&d, ("127.0.0.1", first + j as u16));
+        }
+    };
     while !stop.load(Ordering::Relaxed) {
+        if done.iter().all(|&d| d) {
+            let due = start + Duration::from_secs_f64(f64::from(granted + TICK_MS) / 1e3 / speed);
+            let now = Instant::now();
+            if now >= due {
+                granted += TICK_MS;
+                done.iter_mut().for_each(|d| *d = false);
+                grant(granted);
+                continue;
+            }
+            let _ = relay.set_read_timeout(Some(due - now));
+        } else {
+            let _ = relay.set_read_timeout(Some(Duration::from_millis(50)));
+        }
         let Ok((len, from)) = relay.recv_from(&mut buf) else {
             continue;
         };
         let k = usize::from(from.port().wrapping_sub(first));
-        if k >= n {
+        if k >= n || len == 0 {
+            continue;
+        }
+        if buf[0] == DONE && len == 5 {
+            let t = u32::from_le_bytes([buf[1], buf[2], buf[3], buf[4]]);
+            if t == granted {
+                done[k] = true;
+            }
             continue;
         }
         let cut = cut.lock().map(|c| c.clone()).unwrap_or_default();
