@@ -133,6 +133,15 @@ LOG_GROUP_START(pm)
 LOG_ADD(LOG_FLOAT, vbat, &vbat)
 LOG_GROUP_STOP(pm)
 
+/* The controller's target (controller_pid.c's group ctrltarget): the velocity the
+ * position controller is asked for this tick (m/s). */
+static float target_vx, target_vy;
+
+LOG_GROUP_START(ctrltarget)
+LOG_ADD(LOG_FLOAT, vx, &target_vx)
+LOG_ADD(LOG_FLOAT, vy, &target_vy)
+LOG_GROUP_STOP(ctrltarget)
+
 /* Not the firmware's names: the stand-in's own state (docs/crazyflie.md). */
 LOG_GROUP_START(serve)
 LOG_ADD(LOG_UINT8, flying, &sup_flying)
@@ -486,11 +495,15 @@ static void firmware_tick(void)
         }
         if (z <= 0.0f && vz <= 0.0f)
             cmd[0] = cmd[1] = 0.0f; /* on the ground: no sliding */
+        target_vx = cmd[0];
+        target_vy = cmd[1];
         (void)ph_vehicle_step(&vehicle, cmd, (float)TICK_MS / 1000.0f);
         z += vz * (float)TICK_MS / 1000.0f;
         if (z < 0.0f)
             z = 0.0f;
     }
+    if (!motors)
+        target_vx = target_vy = 0.0f;
     if (!motors || z <= 0.0f) { /* on the ground: at rest */
         float q[2] = {vehicle.q[0], vehicle.q[1]}, v[2] = {0.0f, 0.0f};
         z = 0.0f;
