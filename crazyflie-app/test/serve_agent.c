@@ -133,8 +133,8 @@ LOG_GROUP_START(pm)
 LOG_ADD(LOG_FLOAT, vbat, &vbat)
 LOG_GROUP_STOP(pm)
 
-/* The controller's target (controller_pid.c's group ctrltarget): the velocity the
- * position controller is asked for this tick (m/s). */
+/* The controller's target (stabilizer.c:414-440, group ctrltarget): the current
+ * setpoint's velocity (m/s; in position mode the plan's feed-forward). */
 static float target_vx, target_vy;
 
 LOG_GROUP_START(ctrltarget)
@@ -495,8 +495,8 @@ static void firmware_tick(void)
         }
         if (z <= 0.0f && vz <= 0.0f)
             cmd[0] = cmd[1] = 0.0f; /* on the ground: no sliding */
-        target_vx = cmd[0];
-        target_vy = cmd[1];
+        target_vx = current.velocity.x;
+        target_vy = current.velocity.y;
         (void)ph_vehicle_step(&vehicle, cmd, (float)TICK_MS / 1000.0f);
         z += vz * (float)TICK_MS / 1000.0f;
         if (z < 0.0f)
