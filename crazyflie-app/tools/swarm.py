@@ -201,6 +201,8 @@ def fly(args, scenario, drones):
     for d in drones:
         d.scf.cf.high_level_commander.land(0.0, 3.0)
     wait("landing", lambda: all(d.get("stateEstimate.z", 1) <= 0.05 for d in drones), 10)
+    for d in drones:
+        d.scf.cf.high_level_commander.stop()  # on the ground: motors off
 
 
 def step(args, drones):

@@ -13,6 +13,10 @@
 //!   scripts/cflib-deps.sh; `cargo xtask test` runs it): `crazyflie-app/tools/
 //!   serve_e2e.py` with Bitcraze's cflib, and its negative control (expecting agent 1,
 //!   not a neighbour of the cut agent, to hold fails).
+//! * `the_swarm_tool_flies_the_square_and_writes_its_flight_log` (ignored, as above):
+//!   `crazyflie-app/tools/swarm.py fly --sim` from pre-flight to landing; its flight
+//!   log has docs/crazyflie.md's columns, every drone flew in formation and ended on
+//!   the ground (negative control: the check fails on the log without agent 4).
 
 use std::net::UdpSocket;
 use std::path::{Path, PathBuf};
@@ -339,4 +343,138 @@ fn cflib_flies_the_square_end_to_end() {
     println!("{log}");
     assert!(!passed, "{log}");
     assert!(log.contains("FAILED: cut 4: its neighbours 1"), "{log}");
+}
+
+/// The columns of docs/crazyflie.md's table "The flight log".
+fn documented_columns() -> Vec<String> {
+    let doc = std::fs::read_to_string(root().join("docs/crazyflie.md")).expect("read docs");
+    let table = doc
+        .split("### The flight log")
+        .nth(1)
+        .expect("docs/crazyflie.md has \"### The flight log\"");
+    table
+        .lines()
+        .skip_while(|l| !l.starts_with("| column"))
+        .skip(2)
+        .take_while(|l| l.starts_with('|'))
+        .flat_map(|l| {
+            let first = l.split('|').nth(1).unwrap_or_default().to_owned();
+            first
+                .split(',')
+                .map(|c| c.trim().trim_matches('`').to_owned())
+                .collect::<Vec<_>>()
+        })
+        .collect()
+}
+
+/// What a flight log says per agent: (rows, rows in formation, last z).
+fn flight_summary(csv: &str) -> Result<Vec<(String, usize, usize, f64)>, String> {
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().ok_or("empty log")?.split(',').collect();
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .ok_or(format!("no column {name}"))
+    };
+    let (agent, state, z) = (col("agent")?, col("state")?, col("z")?);
+    let mut out: Vec<(String, usize, usize, f64)> = Vec::new();
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        let name = f[agent].to_owned();
+        let k = match out.iter().position(|o| o.0 == name) {
+            Some(k) => k,
+            None => {
+                out.push((name, 0, 0, f64::NAN));
+                out.len() - 1
+            }
+        };
+        out[k].1 += 1;
+        out[k].2 += usize::from(f[state] == "1");
+        out[k].3 = f[z].parse().map_err(|e| format!("z {:?}: {e}", f[z]))?;
+    }
+    Ok(out)
+}
+
+/// Checks the flight log of the four drones: every agent logged, flew in formation and
+/// ended on the ground (at most 5 cm: where the tool calls a drone landed).
+fn check_flight(csv: &str) -> Result<(), String> {
+    let summary = flight_summary(csv)?;
+    let agents: Vec<&str> = summary.iter().map(|s| s.0.as_str()).collect();
+    if agents != ["1", "2", "3", "4"] {
+        return Err(format!("agents {agents:?}"));
+    }
+    for (agent, rows, formation, z) in &summary {
+        if *rows < 50 || *formation < 20 || !(*z <= 0.05) {
+            return Err(format!(
+                "agent {agent}: {rows} rows, {formation} in formation, last z {z}"
+            ));
+        }
+    }
+    Ok(())
+}
+
+#[test]
+#[ignore = "needs cflib (scripts/cflib-deps.sh); run by cargo xtask test"]
+fn the_swarm_tool_flies_the_square_and_writes_its_flight_log() {
+    let agent = build_agent("serve-agent-swarm");
+    let mut serve = Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .current_dir(root())
+        .args([
+            "serve",
+            "crazyflie-app/formation.toml",
+            "--set",
+            "world=crazyflie",
+        ])
+        .args(["--port", "19910", "--speed", "2", "--agent"])
+        .arg(&agent)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("start host-sim serve");
+    let mut out = std::io::BufReader::new(serve.stdout.take().expect("stdout"));
+    let mut line = String::new();
+    while std::io::BufRead::read_line(&mut out, &mut line).expect("read") > 0
+        && !line.contains("serve: ready")
+    {
+        line.clear();
+    }
+    let stdin = serve.stdin.take();
+    let _guard = Killed(serve);
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("swarm-tool");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch");
+    let log = dir.join("flight.csv");
+    let run = Command::new(cflib_python())
+        .current_dir(&dir)
+        .arg(root().join("crazyflie-app/tools/swarm.py"))
+        .arg("fly")
+        .arg(root().join("crazyflie-app/formation.toml"))
+        .args(["--sim", "--port", "19910", "--seconds", "6", "--log"])
+        .arg(&log)
+        .output()
+        .expect("run swarm.py");
+    drop(stdin); // the end of serve's input: it stops
+    let said = String::from_utf8_lossy(&run.stdout).into_owned();
+    println!("{said}{}", String::from_utf8_lossy(&run.stderr));
+    assert!(run.status.success(), "swarm.py fly failed");
+    assert!(said.contains("swarm: pre-flight passed"), "{said}");
+    assert!(said.contains("swarm: worst angle error"), "{said}");
+    let csv = std::fs::read_to_string(&log).expect("the flight log");
+    let header: Vec<String> = csv
+        .lines()
+        .next()
+        .unwrap_or_default()
+        .split(',')
+        .map(str::to_owned)
+        .collect();
+    assert_eq!(header, documented_columns(), "the documented format");
+    check_flight(&csv).unwrap_or_else(|e| panic!("{e}"));
+    // The negative control: the same check on the log without agent 4's rows fails.
+    let without_4: String = csv
+        .lines()
+        .filter(|l| l.split(',').nth(1) != Some("4"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    assert!(check_flight(&without_4).is_err());
 }
