@@ -405,7 +405,7 @@ fn check_flight(csv: &str) -> Result<(), String> {
         return Err(format!("agents {agents:?}"));
     }
     for (agent, rows, formation, z) in &summary {
-        if *rows < 50 || *formation < 20 || !(*z <= 0.05) {
+        if *rows < 50 || *formation < 20 || z.is_nan() || *z > 0.05 {
             return Err(format!(
                 "agent {agent}: {rows} rows, {formation} in formation, last z {z}"
             ));
