@@ -331,6 +331,13 @@ void serve_hl_stop(void)
     hl = 1;
 }
 
+void serve_emergency_stop(void)
+{
+    if (!locked)
+        consolePrintf("supervisor: emergency stop, locked\n");
+    locked = true;
+}
+
 void serve_client_setpoint(setpoint_t *sp)
 {
     commanderSetSetpoint(sp, COMMANDER_PRIORITY_CRTP);

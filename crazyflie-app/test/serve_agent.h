@@ -62,3 +62,5 @@ void serve_hl_takeoff(float height, float duration_s);
 void serve_hl_land(float height, float duration_s);
 void serve_hl_go_to(float x, float y, float z, float duration_s, bool relative);
 void serve_hl_stop(void);
+/* The client's emergency stop (port 9, or the legacy port 6): the supervisor locks. */
+void serve_emergency_stop(void);

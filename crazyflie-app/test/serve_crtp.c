@@ -23,6 +23,8 @@
  *                  stop, or RPYT with zero thrust) stops the motors.
  *   port 8 high-level commander (src/modules/src/crtp_commander_high_level.c:133-144,
  *                  420-460): take-off 2, land 2, stop, go to (1 and 2).
+ *   port 9 supervisor (src/modules/src/crtp_supervisor.c:136-150) and, legacy, port 6
+ *                  (crtp_localization_service.c:320-330): the emergency stop.
  */
 #include <errno.h>
 #include <string.h>
@@ -35,7 +37,9 @@
 #define PORT_MEM 4u
 #define PORT_LOG 5u
 #define PORT_GENERIC 7u
+#define PORT_LOCALIZATION 6u
 #define PORT_HL 8u
+#define PORT_SUPERVISOR 9u
 #define PORT_PLATFORM 13u
 #define PORT_LINK 15u
 
@@ -563,6 +567,11 @@ void crtp_handle(const crtp_packet *in)
     case PORT_HL:
         if (in->size >= 1)
             hl_packet(in);
+        break;
+    case PORT_SUPERVISOR:  /* channel 1 commands: CMD_EMERGENCY_STOP 0x03 */
+    case PORT_LOCALIZATION: /* channel 1 generic: EMERGENCY_STOP 3 (deprecated) */
+        if (in->channel == 1 && in->size >= 1 && in->data[0] == 3)
+            serve_emergency_stop();
         break;
     default:
         break;

@@ -8,7 +8,8 @@
 //!   memories, the parameter TOC v2 with read and write (unknown ids refused), the log
 //!   TOC v2 and blocks (duplicate and unknown refused), data with timestamps, take-off
 //!   by the high-level commander, a hover setpoint that keeps the motors on (the
-//!   control) and a zero setpoint that stops them.
+//!   control) and a zero setpoint that stops them; notify-stop and take-off again; the
+//!   emergency stop locks the drone on the ground (a take-off no longer lifts it).
 //! * `cflib_flies_the_square_end_to_end` (ignored: needs cflib from
 //!   scripts/cflib-deps.sh; `cargo xtask test` runs it): `crazyflie-app/tools/
 //!   serve_e2e.py` with Bitcraze's cflib, and its negative control (expecting agent 1,
@@ -287,6 +288,22 @@ fn crtp_services_answer_as_the_firmware() {
     // A zero setpoint (generic commander type stop) stops the motors: on the ground.
     link.send(7, 0, &[0]);
     log_until(&link, |flying, z| flying == 0 && z == 0.0);
+    // Notify-stop hands the commander back to the high-level commander: take-off again;
+    // then the emergency stop (supervisor port, CMD_EMERGENCY_STOP) locks the drone on
+    // the ground, and a take-off no longer lifts it (the control).
+    link.send(7, 1, &[0, 0, 0, 0, 0]);
+    link.send(8, 0, &takeoff);
+    log_until(&link, |flying, z| flying == 1 && z > 0.45);
+    link.send(9, 1, &[3]);
+    log_until(&link, |flying, z| flying == 0 && z == 0.0);
+    link.send(8, 0, &takeoff);
+    let first = log_until(&link, |_, _| true)[0].0;
+    let mut last = first;
+    while last < first + 2000 {
+        let (t, flying, z) = log_until(&link, |_, _| true)[0];
+        assert_eq!((flying, z), (0, 0.0), "locked: no take-off at {t} ms");
+        last = t;
+    }
 }
 
 /// The virtual environment of scripts/cflib-deps.sh.
