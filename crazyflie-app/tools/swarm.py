@@ -5,6 +5,7 @@
     swarm.py fly  SCENARIO (--sim ... | --radio ...) [--log flight.csv] [--seconds S]
     swarm.py step SCENARIO (--sim ... | --radio ...) --agent ID [--log step.csv]
                   [--speed 0.3] [--step-s 3]
+    swarm.py compare-step STEP_LOG VEHICLE_STEP_CSV --speed 0.3 [--tolerance 0.03]
 
 The drones are the scenario's agents, in file order: simulated, agent k at
 udp://127.0.0.1:PORT+k (host-sim serve); real, at RADIO/E7E7E7E7NN with NN the agent's
@@ -21,6 +22,12 @@ fault (a drone holding or landing by policy, or stopped by its supervisor) or af
 `step`: one drone takes off, hovers 1 s, flies the velocity step `--speed` m/s along
 x for `--step-s` s (the client's hover setpoints, the app idle), stops, hovers 1 s and
 lands; its log is the same format, to hold against `host-sim vehicle step`.
+
+`compare-step`: the logged velocity along x from the step's first setpoint, for 2 s,
+against `host-sim vehicle step --speed V --out DIR`'s DIR/step.csv (`v_along`),
+aligned by the shift within +-200 ms (four log periods: the setpoint column is the
+second block's latest value) that fits best; prints the RMS
+and largest difference and exits 0 when the RMS is within --tolerance m/s.
 """
 import argparse
 import csv
@@ -222,11 +229,47 @@ def step(args, drones):
     wait("landing", lambda: d.get("stateEstimate.z", 1) <= 0.05, 10)
 
 
+def compare_step(args):
+    """RMS of the logged step response against host-sim vehicle step's (m/s)."""
+    with open(args.scenario) as f:  # the step log (positional argument)
+        rows = [r for r in csv.DictReader(f)]
+    start = next((int(r["drone_ms"]) for r in rows
+                  if r["setpoint_vx"] and abs(float(r["setpoint_vx"]) - args.speed) < 1e-6), None)
+    if start is None:
+        raise RuntimeError(f"{args.scenario}: no setpoint of {args.speed} m/s")
+    logged = [((int(r["drone_ms"]) - start) / 1000.0, float(r["vx"])) for r in rows
+              if r["vx"] and -0.2 <= (int(r["drone_ms"]) - start) / 1000.0 <= 2.0]
+    with open(args.vehicle_step) as f:
+        model = [(float(r["t"]), float(r["v_along"])) for r in csv.DictReader(f)]
+
+    def at(t):
+        if t <= 0.0:
+            return 0.0
+        k = min(int(t * 1000.0), len(model) - 2)  # step.csv: every ms
+        (t0, v0), (t1, v1) = model[k], model[k + 1]
+        return v0 + (v1 - v0) * (t - t0) / (t1 - t0)
+
+    best = None
+    for shift_ms in range(-200, 201, 5):
+        d = [v - at(t + shift_ms / 1000.0) for t, v in logged if t + shift_ms / 1000.0 >= -0.2]
+        rms = math.sqrt(sum(x * x for x in d) / len(d))
+        if best is None or rms < best[0]:
+            best = (rms, max(abs(x) for x in d), shift_ms)
+    rms, worst, shift = best
+    ok = rms <= args.tolerance
+    print(f"swarm: step vs host-sim vehicle step: rms {rms:.4f} m/s, max {worst:.4f} m/s "
+          f"(shift {shift} ms, {len(logged)} samples): {'within' if ok else 'beyond'} "
+          f"{args.tolerance} m/s")
+    return 0 if ok else 1
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("command", choices=["uris", "fly", "step"])
-    ap.add_argument("scenario")
-    where = ap.add_mutually_exclusive_group(required=True)
+    ap.add_argument("command", choices=["uris", "fly", "step", "compare-step"])
+    ap.add_argument("scenario", help="the scenario (compare-step: the step's flight log)")
+    ap.add_argument("vehicle_step", nargs="?", help="compare-step: host-sim vehicle step's step.csv")
+    ap.add_argument("--tolerance", type=float, default=0.03)
+    where = ap.add_mutually_exclusive_group()
     where.add_argument("--sim", action="store_true", help="host-sim serve's drones")
     where.add_argument("--radio", help="real drones: the Crazyradio URI prefix, e.g. radio://0/80/2M")
     ap.add_argument("--port", type=int, default=19850)
@@ -237,6 +280,14 @@ def main():
     ap.add_argument("--speed", type=float, default=0.3)
     ap.add_argument("--step-s", type=float, default=3.0)
     args = ap.parse_args()
+    if args.command == "compare-step":
+        try:
+            return compare_step(args)
+        except (RuntimeError, OSError, KeyError, ValueError) as e:
+            print(f"swarm: {e}", file=sys.stderr)
+            return 1
+    if not (args.sim or args.radio):
+        ap.error("give --sim or --radio")
     scenario, agents = scenario_agents(args.scenario)
     uris = uris_of(args, agents)
     if args.command == "uris":

@@ -17,7 +17,10 @@
 //! * `the_swarm_tool_flies_the_square_and_writes_its_flight_log` (ignored, as above):
 //!   `crazyflie-app/tools/swarm.py fly --sim` from pre-flight to landing; its flight
 //!   log has docs/crazyflie.md's columns, every drone flew in formation and ended on
-//!   the ground (negative control: the check fails on the log without agent 4).
+//!   the ground (negative control: the check fails on the log without agent 4); then
+//!   `swarm.py step` flies agent 1 through a 0.3 m/s velocity step and `compare-step`
+//!   holds its log against `host-sim vehicle step` (negative control: the 0.6 m/s step
+//!   does not match).
 
 use std::net::UdpSocket;
 use std::path::{Path, PathBuf};
@@ -471,10 +474,47 @@ fn the_swarm_tool_flies_the_square_and_writes_its_flight_log() {
         .arg(&log)
         .output()
         .expect("run swarm.py");
-    drop(stdin); // the end of serve's input: it stops
     let said = String::from_utf8_lossy(&run.stdout).into_owned();
     println!("{said}{}", String::from_utf8_lossy(&run.stderr));
     assert!(run.status.success(), "swarm.py fly failed");
+    // The step test on the same served drones: agent 1 through a 0.3 m/s step, held
+    // against host-sim vehicle step (the same cascade: within 3 cm/s RMS); the
+    // negative control holds it against the 0.6 m/s step, which must not match.
+    let swarm = |args: &[&str]| {
+        let out = Command::new(cflib_python())
+            .current_dir(&dir)
+            .arg(root().join("crazyflie-app/tools/swarm.py"))
+            .args(args)
+            .output()
+            .expect("run swarm.py");
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        println!("{text}{}", String::from_utf8_lossy(&out.stderr));
+        (out.status.success(), text)
+    };
+    let scenario = root().join("crazyflie-app/formation.toml");
+    let scenario = scenario.to_str().expect("utf-8 path");
+    let step_args = ["step", scenario, "--sim", "--port", "19910", "--agent", "1"];
+    let (ok, _) = swarm(&[&step_args[..], &["--log", "step.csv"]].concat());
+    assert!(ok, "swarm.py step failed");
+    drop(stdin); // the end of serve's input: it stops
+    for (speed, matches) in [("0.3", true), ("0.6", false)] {
+        let out = dir.join(format!("vehicle-{speed}"));
+        let (code, err) = host_sim(&[
+            "vehicle",
+            "step",
+            "--set",
+            "world=crazyflie",
+            "--speed",
+            speed,
+            "--out",
+            out.to_str().expect("utf-8 path"),
+        ]);
+        assert_eq!(code, 0, "{err}");
+        let model = out.join("step.csv");
+        let model = model.to_str().expect("utf-8 path");
+        let (ok, text) = swarm(&["compare-step", "step.csv", model, "--speed", "0.3"]);
+        assert_eq!(ok, matches, "against the {speed} m/s step: {text}");
+    }
     assert!(said.contains("swarm: pre-flight passed"), "{said}");
     assert!(said.contains("swarm: worst angle error"), "{said}");
     let csv = std::fs::read_to_string(&log).expect("the flight log");
