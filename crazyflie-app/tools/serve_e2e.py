@@ -17,7 +17,8 @@ taken as a result):
      the hold below is the cut's doing);
   5. cut the radio of agent CUT (serve's `cut ID`): its neighbours hold (state HOLD),
      then land by policy (LANDING, fault "lost: landing"), and reach the ground;
-  6. land the others: enable = 0, then the high-level commander lands them; every
+  6. restore the radio (serve's `restore ID`): every neighbour heard again;
+  7. land the others: enable = 0, then the high-level commander lands them; every
      drone on the ground with its motors off.
 
 Prints one line per step with the simulated time it took; exits 0 when every check
@@ -179,6 +180,15 @@ def fly(args, drones, serve):
         if d.states.index(HOLD) > d.states.index(LANDING) if LANDING in d.states and HOLD in d.states else False:
             raise Failed(f"drone {d.name} landed before holding: {d.states}")
 
+    serve.stdin.write(f"restore {args.cut}\n")
+    serve.stdin.flush()
+    wait_for(
+        f"restore {args.cut}: every neighbour heard again",
+        every(lambda d: d.get("formation.heard") == d.get("formation.neighbours")),
+        1,
+        speed,
+        drones,
+    )
     for d in drones:
         d.scf.cf.param.set_value("formation.enable", 0)
     wait_for("disable: nobody in FORMATION", every(lambda d: d.get("formation.state") != FORMATION), 3, speed, drones)

@@ -353,6 +353,7 @@ fn cflib_flies_the_square_end_to_end() {
         "control: nobody held",
         "hold",
         "land by policy",
+        "restore 4: every neighbour heard again",
         "land all",
     ] {
         assert!(log.contains(step), "{step}: {log}");
