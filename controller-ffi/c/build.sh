@@ -13,6 +13,10 @@
 #                                                flight states and commands against a
 #                                                model of the firmware's commander and
 #                                                supervisor (crazyflie-app/test/flight_test.c)
+#   controller-ffi/c/build.sh cfapp-agent OUT_DIR      OUT_DIR/cfapp-agent: one simulated
+#                                                Crazyflie for `host-sim serve` (the app's
+#                                                appMain against the firmware stand-ins of
+#                                                crazyflie-app/test/serve_*.c, CRTP over UDP)
 #   (CFAPP_CFLAGS: extra flags for the app, e.g. -DFORMATION_USE_STRUCT)
 #
 # The staticlib: for the firmware `cargo rustc -p ph-formation-ffi --release --lib
@@ -111,8 +115,20 @@ cfapp-flight)
         "$lib" -lgcc_s -lutil -lrt -lpthread -lm -ldl
     echo "$out/cfapp-flight"
     ;;
+cfapp-agent)
+    (cd "$root" && "$cargo" build -q -p ph-formation-ffi --release --lib "${features[@]}")
+    lib=$target_dir/release/libph_formation_ffi.a
+    # serve_sections.ld: the PARAM_GROUP/LOG_GROUP tables, as the firmware links them.
+    "${CC:-cc}" "${cflags[@]}" "${app_cflags[@]}" -o "$out/cfapp-agent" \
+        "$app/test/serve_agent.c" "$app/test/serve_crtp.c" "$app/src/app.c" \
+        "$app/src/agent_loop.c" "$app/src/formation.c" "$app/src/flight.c" \
+        "$app/src/commands.c" "$app/src/epoch.c" "$app/src/blobs/ph_blobs.c" \
+        -Wl,-T,"$app/test/serve_sections.ld" \
+        "$lib" -lgcc_s -lutil -lrt -lpthread -lm -ldl
+    echo "$out/cfapp-agent"
+    ;;
 *)
-    echo "$0: unknown target '$what' (host, firmware, cfapp-host, cfapp-firmware or cfapp-flight)" >&2
+    echo "$0: unknown target '$what' (host, firmware, cfapp-host, cfapp-firmware, cfapp-flight or cfapp-agent)" >&2
     exit 2
     ;;
 esac

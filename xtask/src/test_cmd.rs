@@ -181,6 +181,12 @@ fn phases(
         // The ignored browser test of tests/replay.rs (Chromium from scripts/browser-deps.sh).
         tools::run(cargo().args(["test", "--test", "replay", "--", "--ignored"]))
     })?;
+    phase("cflib flies host-sim serve (end to end)", &mut || {
+        // Bitcraze's cflib (scripts/cflib-deps.sh) against `host-sim serve
+        // crazyflie-app/formation.toml --set world=crazyflie` (docs/crazyflie.md), the
+        // ignored test of host-sim/tests/serve.rs; the binary `cargo test` built.
+        tools::run(cargo().args(["test", "--test", "serve", "--", "--ignored", "--nocapture"]))
+    })?;
     phase("host-in-the-loop (host-sim QEMU tests)", &mut || {
         // No `-p ph-formation-sim`: the default members' feature set, as `cargo test` built it.
         tools::run(cargo().args(["test", "--test", "hil", "--", "--include-ignored"]))

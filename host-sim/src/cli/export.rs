@@ -65,13 +65,13 @@ pub(super) enum ExportError {
 }
 
 /// One agent's blob.
-struct Exported {
+pub(super) struct Exported {
     /// The id as written in the scenario.
     name: String,
     /// Wire id (what the app matches against its radio address).
-    id: u8,
+    pub(super) id: u8,
     triangles: usize,
-    blob: Vec<u8>,
+    pub(super) blob: Vec<u8>,
 }
 
 /// Runs `host-sim export`; returns the exit code.
@@ -147,7 +147,7 @@ pub(super) fn export_command(args: &ExportArgs, quiet: bool) -> u8 {
 }
 
 /// Agent `i`'s blob, checked by the C API's encoder.
-fn export_agent(model: &Model, i: usize) -> Result<Exported, ExportError> {
+pub(super) fn export_agent(model: &Model, i: usize) -> Result<Exported, ExportError> {
     let name = model
         .agents
         .get(i)

@@ -5,12 +5,14 @@
 mod design;
 mod export;
 mod run;
+mod serve;
 mod step;
 mod sweep;
 mod vehicle;
 mod view;
 
 pub use design::{DesignArgs, Shape};
+pub use serve::ServeArgs;
 
 use crate::engine::hil;
 use crate::exit_code;
@@ -65,6 +67,9 @@ pub enum Command {
     Sweep(sweep::SweepArgs),
     /// Write agents' configurations as the C API's checked blobs (docs/c-api.md).
     Export(ExportArgs),
+    /// The scenario's drones as simulated Crazyflies that cflib flies over
+    /// `udp://127.0.0.1:PORT+k`, paced at real time (docs/crazyflie.md).
+    Serve(ServeArgs),
     /// A vehicle on its own: `vehicle step` (docs/world.md).
     #[command(subcommand)]
     Vehicle(step::VehicleCommand),
@@ -200,6 +205,7 @@ pub fn execute(cli: Cli) -> u8 {
         ),
         Some(Command::Run(args)) => run_command(&args, quiet),
         Some(Command::Export(args)) => export::export_command(&args, quiet),
+        Some(Command::Serve(args)) => serve::serve_command(&args),
         Some(Command::Vehicle(cmd)) => step::command(&cmd, quiet),
         Some(Command::Validate {
             scenario,
