@@ -112,6 +112,10 @@ fn phases(
         tools::run(cargo().arg("test"))
     })?;
     phase(
+        "cargo package (core, vehicle, C ABI; built from the .crate files)",
+        &mut crate::package::run,
+    )?;
+    phase(
         "firmware-check (QEMU)",
         &mut || match firmware_check::run(fw)? {
             true => Ok(()),
