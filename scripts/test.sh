@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs every test of ph-formation on a fresh Debian machine with rustup.
 # Installs what it needs first (rustup target and components, qemu-system-arm,
-# defmt-print, the QEMU instruction-counting plugin; idempotent), then runs
+# defmt-print, the QEMU instruction-counting plugin, a Python venv; idempotent), then runs
 # every check with `cargo xtask test` (xtask/src/test_cmd.rs), which ends with
 # the duration of each phase.
 set -euo pipefail
@@ -17,6 +17,7 @@ rustup component add rustfmt clippy llvm-tools >/dev/null
 bash scripts/firmware-deps.sh
 bash scripts/browser-deps.sh
 bash scripts/bench-deps.sh    # valgrind, for cargo xtask bench-counts
+bash scripts/python-deps.sh   # target/py-venv with PyPI mcap, for host-sim/tests/mcap.rs
 
 XTASK_TEST_INSTALLED=$(date +%s.%N)
 export XTASK_TEST_INSTALLED
