@@ -185,10 +185,13 @@ fn phases(
         // The ignored browser test of tests/replay.rs (Chromium from scripts/browser-deps.sh).
         tools::run(cargo().args(["test", "--test", "replay", "--", "--ignored"]))
     })?;
-    phase("run.mcap read back by the PyPI mcap reader (host-sim)", &mut || {
-        // The ignored test of tests/mcap.rs (the venv of scripts/python-deps.sh).
-        tools::run(cargo().args(["test", "--test", "mcap", "--", "--ignored"]))
-    })?;
+    phase(
+        "run.mcap read back by the PyPI mcap reader (host-sim)",
+        &mut || {
+            // The ignored test of tests/mcap.rs (the venv of scripts/python-deps.sh).
+            tools::run(cargo().args(["test", "--test", "mcap", "--", "--ignored"]))
+        },
+    )?;
     phase("host-in-the-loop (host-sim QEMU tests)", &mut || {
         // No `-p ph-formation-sim`: the default members' feature set, as `cargo test` built it.
         tools::run(cargo().args(["test", "--test", "hil", "--", "--include-ignored"]))
