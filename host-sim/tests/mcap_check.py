@@ -89,6 +89,30 @@ def main(run_dir):
     ids = {e["id"] for e in scenes[0][2]["entities"]}
     if not {"agents", "edges"} <= ids:
         fail(f"scene entities {sorted(ids)} lack agents or edges")
+    # Every scene's edges and leader edge join the agents of summary.json's edges and
+    # leaders, at the positions of the CSV row of the same time.
+    row_at = {round(r[0] * 1e9): r for r in rows}
+    edges = sorted(tuple(sorted(str(v) for v in e)) for e in summary["edges"])
+    leaders = [tuple(sorted(str(v) for v in summary["leaders"]))] if summary.get("leaders") else []
+    for _, log_time, msg in scenes:
+        row = row_at.get(log_time)
+        if row is None:
+            fail(f"a scene update at {log_time} ns matches no row")
+        where = {a: (row[col[f"x_{a}"]], row[col[f"y_{a}"]]) for a in agents}
+        entities = {e["id"]: e for e in msg["entities"]}
+        for eid, pairs in (("edges", edges), ("leader_edge", leaders)):
+            if not pairs:
+                if eid in entities:
+                    fail(f"a {eid} entity without {eid} in summary.json")
+                continue
+            pts = entities[eid]["lines"][0]["points"]
+            segments = [tuple(sorted([(p["x"], p["y"]) for p in pts[i:i + 2]]))
+                        for i in range(0, len(pts), 2)]
+            want = [tuple(sorted([where[a], where[b]])) for a, b in pairs]
+            if sorted(segments) != sorted(want):
+                fail(f"t = {row[0]}: the {eid} entity's segments are not summary.json's "
+                     f"{eid} at the CSV's positions")
+
     span = rows[-1][0] - rows[0][0]
     if len(scenes) < span / SCENE_PERIOD * 0.99:
         fail(f"{len(scenes)} scene updates over {span} s")

@@ -13,8 +13,9 @@ use crate::analysis::Event;
 use crate::engine::{Recorder, Row};
 use crate::model::{EstimateInfo, Model};
 use mcap::records::MessageHeader;
-use serde_json::{json, Map, Value};
+use serde_json::{json, Value};
 use std::collections::BTreeMap;
+use std::fmt::Write as _;
 use std::fs::File;
 use std::io::{self, BufWriter};
 use std::path::Path;
@@ -59,6 +60,10 @@ pub struct McapRecorder {
     sequence: u32,
     /// Time of the last scene update.
     last_scene: Option<f64>,
+    /// Each column's JSON key, `"name":`.
+    keys: Vec<String>,
+    /// The message being written (reused).
+    text: String,
 }
 
 struct Channels {
@@ -146,7 +151,7 @@ impl McapRecorder {
         edges.dedup();
         Ok(Self {
             writer: w,
-            columns,
+            columns: columns.clone(),
             names: model.agents.iter().map(|a| a.name.clone()).collect(),
             edges,
             leader: model.leader.as_ref().map(|l| (l.a, l.b)),
@@ -163,11 +168,20 @@ impl McapRecorder {
             values: Vec::new(),
             sequence: 0,
             last_scene: None,
+            keys: columns
+                .iter()
+                .map(|c| format!("{}:", Value::String(c.clone())))
+                .collect(),
+            text: String::new(),
         })
     }
 
-    fn write(&mut self, channel_id: u16, t: f64, message: &Value) -> io::Result<()> {
+    fn write_value(&mut self, channel_id: u16, t: f64, message: &Value) -> io::Result<()> {
         let data = serde_json::to_vec(message).map_err(io::Error::other)?;
+        self.write(channel_id, t, &data)
+    }
+
+    fn write(&mut self, channel_id: u16, t: f64, data: &[u8]) -> io::Result<()> {
         let time = nanos(t);
         self.sequence = self.sequence.wrapping_add(1);
         let header = MessageHeader {
@@ -177,16 +191,24 @@ impl McapRecorder {
             publish_time: time,
         };
         self.writer
-            .write_to_known_channel(&header, &data)
+            .write_to_known_channel(&header, data)
             .map_err(io_err)
     }
 
-    /// The values `range` of a row as a JSON object keyed by column name.
-    fn object(&self, values: &[f64], range: std::ops::Range<usize>) -> Value {
-        let m: Map<String, Value> = range
-            .map(|k| (self.columns[k].clone(), json!(values[k])))
-            .collect();
-        Value::Object(m)
+    /// Writes the values `range` of a row as a JSON object keyed by column name into
+    /// `out` (cleared first).
+    fn object(&self, out: &mut String, values: &[f64], range: std::ops::Range<usize>) {
+        out.clear();
+        out.push('{');
+        for k in range {
+            out.push_str(&self.keys[k]);
+            number(out, values[k]);
+            out.push(',');
+        }
+        if out.ends_with(',') {
+            out.pop();
+        }
+        out.push('}');
     }
 
     /// Writes the run's events (`foxglove.Log`, level ERROR) and finishes the file (its
@@ -201,7 +223,7 @@ impl McapRecorder {
                 "file": "",
                 "line": 0,
             });
-            self.write(self.channels.events, e.t, &msg)?;
+            self.write_value(self.channels.events, e.t, &msg)?;
         }
         self.writer.finish().map_err(io_err)?;
         Ok(())
@@ -234,91 +256,173 @@ impl McapRecorder {
             let i = base + 4 * k;
             (values[i], values[i + 1])
         };
-        let poses: Vec<Value> = (0..n).map(|k| pose(q(k))).collect();
-        let msg = json!({"timestamp": stamp(t), "frame_id": FRAME, "poses": poses});
-        self.write(self.channels.poses, t, &msg)?;
+        let mut out = std::mem::take(&mut self.text);
+        // foxglove.PosesInFrame. Every message is written as text (serde_json's `Value`s
+        // cost 3 times the simulation of paper in instructions, callgrind).
+        out.clear();
+        let ns = nanos(t);
+        let _ = write!(
+            out,
+            r#"{{"timestamp":{{"sec":{},"nsec":{}}},"frame_id":"{FRAME}","poses":["#,
+            ns / 1_000_000_000,
+            ns % 1_000_000_000
+        );
+        for k in 0..n {
+            pose(&mut out, q(k));
+            out.push(',');
+        }
+        if n > 0 {
+            out.pop();
+        }
+        out.push_str("]}");
+        let mut result = self.write(self.channels.poses, t, out.as_bytes());
         // A tolerance of a microsecond: log instants are multiples of the step.
-        if self
-            .last_scene
-            .is_none_or(|t0| t - t0 >= SCENE_PERIOD - 1e-6)
+        if result.is_ok()
+            && self
+                .last_scene
+                .is_none_or(|t0| t - t0 >= SCENE_PERIOD - 1e-6)
         {
             self.last_scene = Some(t);
-            let scene = self.scene(t, &q);
-            self.write(self.channels.scene, t, &scene)?;
+            self.scene(&mut out, t, &q);
+            result = self.write(self.channels.scene, t, out.as_bytes());
         }
         for k in 0..n {
+            if result.is_err() {
+                break;
+            }
+            // The agent's own channel: its columns without the `_<id>` suffix.
             let i = base + 4 * k;
-            let v = &values[i..i + 4];
-            let msg = json!({"x": v[0], "y": v[1], "vx": v[2], "vy": v[3]});
-            self.write(self.channels.agents[k], t, &msg)?;
+            out.clear();
+            for (key, x) in [r#"{"x":"#, r#","y":"#, r#","vx":"#, r#","vy":"#]
+                .iter()
+                .zip(&values[i..i + 4])
+            {
+                out.push_str(key);
+                number(&mut out, *x);
+            }
+            out.push('}');
+            result = self.write(self.channels.agents[k], t, out.as_bytes());
         }
-        let diag = self.object(values, 1..base);
-        self.write(self.channels.diagnostics, t, &diag)?;
         let a0 = base + 4 * n;
-        let angles = self.object(values, a0..a0 + self.n_angles);
-        self.write(self.channels.angles, t, &angles)?;
-        let est = self.object(values, a0 + self.n_angles..self.columns.len());
-        self.write(self.channels.estimates, t, &est)
+        for (channel, range) in [
+            (self.channels.diagnostics, 1..base),
+            (self.channels.angles, a0..a0 + self.n_angles),
+            (
+                self.channels.estimates,
+                a0 + self.n_angles..self.columns.len(),
+            ),
+        ] {
+            if result.is_err() {
+                break;
+            }
+            self.object(&mut out, values, range);
+            result = self.write(channel, t, out.as_bytes());
+        }
+        self.text = out;
+        result
     }
 
-    /// One `SceneUpdate`: a sphere and a label per agent, the triangle edges (grey line
-    /// list) and the leader edge (orange), replacing the previous ones (same ids).
-    fn scene(&self, t: f64, q: &dyn Fn(usize) -> (f64, f64)) -> Value {
-        let point = |(x, y): (f64, f64)| json!({"x": x, "y": y, "z": 0.0});
-        let colour = |r: f64, g: f64, b: f64| json!({"r": r, "g": g, "b": b, "a": 1.0});
-        let line = |pairs: &[(usize, usize)], c: Value, thickness: f64| {
-            let points: Vec<Value> = pairs
-                .iter()
-                .flat_map(|&(a, b)| [point(q(a)), point(q(b))])
-                .collect();
-            json!({"type": 2, "pose": pose((0.0, 0.0)), "thickness": thickness,
-                   "scale_invariant": true, "points": points, "color": c,
-                   "colors": [], "indices": []})
+    /// One `SceneUpdate` into `out` (cleared first): a sphere and a label per agent, the
+    /// triangle edges (grey line list) and the leader edge (orange), replacing the
+    /// previous ones (same ids). Written as text, as the rows' messages.
+    fn scene(&self, out: &mut String, t: f64, q: &dyn Fn(usize) -> (f64, f64)) {
+        const BLUE: &str = r#"{"r":0.12,"g":0.47,"b":0.71,"a":1.0}"#;
+        const BLACK: &str = r#"{"r":0.0,"g":0.0,"b":0.0,"a":1.0}"#;
+        const GREY: &str = r#"{"r":0.5,"g":0.5,"b":0.5,"a":1.0}"#;
+        const ORANGE: &str = r#"{"r":1.0,"g":0.5,"b":0.0,"a":1.0}"#;
+        let ns = nanos(t);
+        let entity = |out: &mut String, id: &str| {
+            let _ = write!(
+                out,
+                r#"{{"timestamp":{{"sec":{},"nsec":{}}},"frame_id":"{FRAME}","id":"{id}","lifetime":{{"sec":0,"nsec":0}},"frame_locked":false,"metadata":[],"arrows":[],"cubes":[],"cylinders":[],"triangles":[],"models":[]"#,
+                ns / 1_000_000_000,
+                ns % 1_000_000_000
+            );
         };
-        let entity = |id: &str, extra: Value| {
-            let mut e = json!({"timestamp": stamp(t), "frame_id": FRAME, "id": id,
-                "lifetime": {"sec": 0, "nsec": 0}, "frame_locked": false, "metadata": [],
-                "arrows": [], "cubes": [], "spheres": [], "cylinders": [], "lines": [],
-                "triangles": [], "texts": [], "models": []});
-            if let (Some(e), Value::Object(x)) = (e.as_object_mut(), extra) {
-                e.extend(x);
+        let line = |out: &mut String, pairs: &[(usize, usize)], colour: &str, thickness: f64| {
+            let _ = write!(
+                out,
+                r#"{{"type":2,"thickness":{thickness:?},"scale_invariant":true,"color":{colour},"colors":[],"indices":[],"pose":"#
+            );
+            pose(out, (0.0, 0.0));
+            out.push_str(r#","points":["#);
+            for &(a, b) in pairs {
+                for p in [q(a), q(b)] {
+                    out.push_str(r#"{"x":"#);
+                    number(out, p.0);
+                    out.push_str(r#","y":"#);
+                    number(out, p.1);
+                    out.push_str(r#","z":0.0},"#);
+                }
             }
-            e
+            if !pairs.is_empty() {
+                out.pop();
+            }
+            out.push_str("]}");
         };
-        let spheres: Vec<Value> = (0..self.names.len())
-            .map(|k| {
-                json!({"pose": pose(q(k)), "size": {"x": 0.1, "y": 0.1, "z": 0.1},
-                       "color": colour(0.12, 0.47, 0.71)})
-            })
-            .collect();
-        let texts: Vec<Value> = self
-            .names
-            .iter()
-            .enumerate()
-            .map(|(k, name)| {
-                json!({"pose": pose(q(k)), "billboard": true, "font_size": 14.0,
-                       "scale_invariant": true, "color": colour(0.0, 0.0, 0.0), "text": name})
-            })
-            .collect();
-        let mut entities = vec![
-            entity("agents", json!({"spheres": spheres, "texts": texts})),
-            entity(
-                "edges",
-                json!({"lines": [line(&self.edges, colour(0.5, 0.5, 0.5), 2.0)]}),
-            ),
-        ];
-        if let Some(l) = self.leader {
-            let lines = [line(&[l], colour(1.0, 0.5, 0.0), 4.0)];
-            entities.push(entity("leader_edge", json!({ "lines": lines })));
+        out.clear();
+        out.push_str(r#"{"deletions":[],"entities":["#);
+        entity(out, "agents");
+        out.push_str(r#","lines":[],"spheres":["#);
+        for k in 0..self.names.len() {
+            out.push_str(if k == 0 {
+                r#"{"pose":"#
+            } else {
+                r#",{"pose":"#
+            });
+            pose(out, q(k));
+            let _ = write!(
+                out,
+                r#","size":{{"x":0.1,"y":0.1,"z":0.1}},"color":{BLUE}}}"#
+            );
         }
-        json!({"deletions": [], "entities": entities})
+        out.push_str(r#"],"texts":["#);
+        for (k, name) in self.names.iter().enumerate() {
+            out.push_str(if k == 0 {
+                r#"{"pose":"#
+            } else {
+                r#",{"pose":"#
+            });
+            pose(out, q(k));
+            let _ = write!(
+                out,
+                r#","billboard":true,"font_size":14.0,"scale_invariant":true,"color":{BLACK},"text":{}}}"#,
+                Value::String(name.clone())
+            );
+        }
+        out.push_str("]},");
+        entity(out, "edges");
+        out.push_str(r#","spheres":[],"texts":[],"lines":["#);
+        line(out, &self.edges, GREY, 2.0);
+        out.push_str("]}");
+        if let Some(l) = self.leader {
+            out.push(',');
+            entity(out, "leader_edge");
+            out.push_str(r#","spheres":[],"texts":[],"lines":["#);
+            line(out, &[l], ORANGE, 4.0);
+            out.push_str("]}");
+        }
+        out.push_str("]}");
     }
 }
 
 /// A pose at `(x, y, 0)`, identity orientation (the agents are points in the plane).
-fn pose((x, y): (f64, f64)) -> Value {
-    json!({"position": {"x": x, "y": y, "z": 0.0},
-           "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}})
+fn pose(out: &mut String, (x, y): (f64, f64)) {
+    out.push_str(r#"{"position":{"x":"#);
+    number(out, x);
+    out.push_str(r#","y":"#);
+    number(out, y);
+    out.push_str(r#","z":0.0},"orientation":{"x":0.0,"y":0.0,"z":0.0,"w":1.0}}"#);
+}
+
+/// `x` as JSON: Rust's shortest round-trip form, as in `timeseries.csv` (`0.35`, `1e-7`),
+/// `null` for NaN and infinities (which JSON lacks).
+fn number(out: &mut String, x: f64) {
+    if x.is_finite() {
+        let _ = write!(out, "{x:?}");
+    } else {
+        out.push_str("null");
+    }
 }
 
 /// Simulated time (s, from 0) in nanoseconds, the MCAP log time.
