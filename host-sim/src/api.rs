@@ -19,7 +19,7 @@ use crate::engine::hil::{self, HilOptions};
 use crate::engine::{self, RunError, RunResult};
 use crate::exit_code;
 use crate::model::{estimate_layout, EstimateInfo, Model};
-use crate::report::{self, CsvRecorder, PlotError, TimeSeries};
+use crate::report::{self, CsvRecorder, McapRecorder, PlotError, TimeSeries};
 use crate::scenario::{self, ScenarioErrors, Source};
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -116,6 +116,7 @@ pub struct Simulation<'a> {
     progress: Option<&'a mut dyn Progress>,
     threads: Option<usize>,
     csv: bool,
+    mcap: bool,
 }
 
 impl<'a> Simulation<'a> {
@@ -129,6 +130,7 @@ impl<'a> Simulation<'a> {
             progress: None,
             threads: None,
             csv: true,
+            mcap: false,
         }
     }
 
@@ -138,6 +140,13 @@ impl<'a> Simulation<'a> {
     /// cost more than the simulation.
     pub fn csv(mut self, csv: bool) -> Self {
         self.csv = csv;
+        self
+    }
+
+    /// Whether [`Self::write_to`] also writes `run.mcap` (default no): the same rows as
+    /// MCAP for Foxglove and PlotJuggler, and the run's events (`docs/outputs.md`).
+    pub fn mcap(mut self, mcap: bool) -> Self {
+        self.mcap = mcap;
         self
     }
 
@@ -204,8 +213,20 @@ impl<'a> Simulation<'a> {
             ),
             None => None,
         };
+        let mcap_path = self
+            .out
+            .as_ref()
+            .filter(|_| self.mcap)
+            .map(|(d, _)| d.join("run.mcap"));
+        let mcap = match &mcap_path {
+            Some(p) => Some(
+                McapRecorder::create(p, model, &estimates)
+                    .map_err(|e| Error::Output(format!("cannot create {}: {e}", p.display())))?,
+            ),
+            None => None,
+        };
         let series = self.keep_series.then(|| TimeSeries::new(model, &estimates));
-        let mut recorder = (csv, series);
+        let mut recorder = (csv, (series, mcap));
         let mut silent = |_: f64| {};
         let progress: &mut dyn Progress = match self.progress {
             Some(p) => p,
@@ -224,8 +245,13 @@ impl<'a> Simulation<'a> {
         };
         progress.finish();
         let result = result?;
+        let (series, mcap) = recorder.1;
+        if let (Some(m), Some(p)) = (mcap, &mcap_path) {
+            m.close(&result.events)
+                .map_err(|e| Error::Output(format!("cannot write {}: {e}", p.display())))?;
+        }
         let mut run = Run {
-            series: recorder.1,
+            series,
             result,
             estimates,
             files: Vec::new(),
@@ -234,6 +260,7 @@ impl<'a> Simulation<'a> {
         };
         if let Some((dir, plots)) = &self.out {
             run.write_outputs(model, dir, csv_path, *plots)?;
+            run.files.extend(mcap_path);
         }
         Ok(run)
     }
@@ -270,7 +297,7 @@ pub struct Run {
     /// Every logged row (when kept, see [`Simulation::keep_series`]).
     pub series: Option<TimeSeries>,
     /// The files written (see [`Simulation::write_to`]): `timeseries.csv`,
-    /// `summary.json`, then the figures and `replay.html`.
+    /// `summary.json`, then the figures and `replay.html`, then `run.mcap`.
     pub files: Vec<PathBuf>,
     /// Why the figures were not drawn (a failed plot does not fail the run).
     pub plot_error: Option<PlotError>,

@@ -11,7 +11,7 @@
 //!   control) and a zero setpoint that stops them; notify-stop and take-off again; the
 //!   emergency stop locks the drone on the ground (a take-off no longer lifts it).
 //! * `cflib_flies_the_square_end_to_end` (ignored: needs cflib from
-//!   scripts/cflib-deps.sh; `cargo xtask test` runs it): `crazyflie-app/tools/
+//!   scripts/python-deps.sh; `cargo xtask test` runs it): `crazyflie-app/tools/
 //!   serve_e2e.py` with Bitcraze's cflib, and its negative control (expecting agent 1,
 //!   not a neighbour of the cut agent, to hold fails).
 //! * `the_swarm_tool_flies_the_square_and_writes_its_flight_log` (ignored, as above):
@@ -309,15 +309,13 @@ fn crtp_services_answer_as_the_firmware() {
     }
 }
 
-/// The virtual environment of scripts/cflib-deps.sh.
+/// The virtual environment of scripts/python-deps.sh.
 fn cflib_python() -> PathBuf {
-    let target = std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| root().join("target"));
-    let python = target.join("cflib-venv/bin/python");
+    // Where the script puts it, whatever CARGO_TARGET_DIR says.
+    let python = root().join("target/py-venv/bin/python");
     assert!(
         python.is_file(),
-        "{} missing: run scripts/cflib-deps.sh",
+        "{} missing: run scripts/python-deps.sh",
         python.display()
     );
     python
@@ -340,7 +338,7 @@ fn e2e(agent: &Path, port: &str, extra: &[&str]) -> (bool, String) {
 }
 
 #[test]
-#[ignore = "needs cflib (scripts/cflib-deps.sh); run by cargo xtask test"]
+#[ignore = "needs cflib (scripts/python-deps.sh); run by cargo xtask test"]
 fn cflib_flies_the_square_end_to_end() {
     let agent = build_agent("serve-agent-e2e");
     let (passed, log) = e2e(&agent, "19890", &[]);
@@ -436,7 +434,7 @@ fn check_flight(csv: &str) -> Result<(), String> {
 }
 
 #[test]
-#[ignore = "needs cflib (scripts/cflib-deps.sh); run by cargo xtask test"]
+#[ignore = "needs cflib (scripts/python-deps.sh); run by cargo xtask test"]
 fn the_swarm_tool_flies_the_square_and_writes_its_flight_log() {
     let agent = build_agent("serve-agent-swarm");
     let mut serve = Command::new(env!("CARGO_BIN_EXE_host-sim"))

@@ -23,6 +23,7 @@ mod check;
 mod cluster;
 mod firmware_check;
 mod fwlog;
+mod package;
 mod profile;
 mod qemu_run;
 mod stack_frames;

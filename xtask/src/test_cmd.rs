@@ -112,6 +112,10 @@ fn phases(
         tools::run(cargo().arg("test"))
     })?;
     phase(
+        "cargo package (core, vehicle, C ABI; built from the .crate files)",
+        &mut crate::package::run,
+    )?;
+    phase(
         "firmware-check (QEMU)",
         &mut || match firmware_check::run(fw)? {
             true => Ok(()),
@@ -182,11 +186,18 @@ fn phases(
         tools::run(cargo().args(["test", "--test", "replay", "--", "--ignored"]))
     })?;
     phase("cflib flies host-sim serve (end to end)", &mut || {
-        // Bitcraze's cflib (scripts/cflib-deps.sh) against `host-sim serve
+        // Bitcraze's cflib (scripts/python-deps.sh) against `host-sim serve
         // crazyflie-app/formation.toml --set world=crazyflie` (docs/crazyflie.md), the
         // ignored test of host-sim/tests/serve.rs; the binary `cargo test` built.
         tools::run(cargo().args(["test", "--test", "serve", "--", "--ignored", "--nocapture"]))
     })?;
+    phase(
+        "run.mcap read back by the PyPI mcap reader (host-sim)",
+        &mut || {
+            // The ignored test of tests/mcap.rs (the venv of scripts/python-deps.sh).
+            tools::run(cargo().args(["test", "--test", "mcap", "--", "--ignored"]))
+        },
+    )?;
     phase("host-in-the-loop (host-sim QEMU tests)", &mut || {
         // No `-p ph-formation-sim`: the default members' feature set, as `cargo test` built it.
         tools::run(cargo().args(["test", "--test", "hil", "--", "--include-ignored"]))

@@ -141,6 +141,10 @@ pub struct RunArgs {
     /// thinner series instead, `--set integration.log_interval=S`).
     #[arg(long)]
     pub summary_only: bool,
+    /// Also write run.mcap: the logged rows and the run's events as MCAP, for Foxglove
+    /// and PlotJuggler (docs/outputs.md). Changes no other output.
+    #[arg(long)]
+    pub mcap: bool,
     /// Worker threads of a large run (at least 2,048 agents; default one per core). The
     /// results are the same for any number.
     #[arg(short = 'j', long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
@@ -195,6 +199,7 @@ pub fn execute(cli: Cli) -> u8 {
                 set: Vec::new(),
                 no_plots: false,
                 summary_only: false,
+                mcap: false,
                 jobs: None,
                 hil: Vec::new(),
                 firmware: None,

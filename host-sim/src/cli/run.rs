@@ -89,6 +89,7 @@ pub(super) fn run_command(args: &RunArgs, quiet: bool) -> u8 {
             },
         )
         .csv(!args.summary_only)
+        .mcap(args.mcap)
         .progress(&mut progress);
     if let Some(n) = args.jobs {
         // One run per process: size rayon's global pool, so that the run stays on this

@@ -7,6 +7,7 @@ mod attack;
 mod channel;
 mod columns;
 mod csv;
+mod mcap;
 pub mod plot;
 pub mod replay;
 mod series;
@@ -17,6 +18,7 @@ mod world;
 
 pub use columns::{for_each_cell, header, Cell, BASE_COLUMNS};
 pub use csv::CsvRecorder;
+pub use mcap::McapRecorder;
 pub use plot::{plot_run, PlotError};
 pub use replay::write_replay;
 pub use series::TimeSeries;
