@@ -515,6 +515,13 @@ fn an_overloaded_aloha_channel_names_the_rate_that_fits() {
     let ch = r.channel.as_ref().expect("channel");
     let load_now = ch.utilisation(r.final_time);
     assert!(load_now > 0.4, "{load_now}");
+    // Every agent loses more than 37 % of its copies: all twenty are named.
+    let lossy = r
+        .warnings
+        .iter()
+        .find(|w| w.starts_with("agents whose link copies were lost more than 37 %"))
+        .unwrap_or_else(|| panic!("no lossy agents named: {:?}", r.warnings));
+    assert_eq!(lossy.matches(" %)").count(), 20, "{lossy}");
     // The suggested rate: the control rate over ⌈G / 0.1⌉.
     let rate: f64 = note
         .split("controller.comm_rate_hz = ")
@@ -541,7 +548,9 @@ fn an_overloaded_aloha_channel_names_the_rate_that_fits() {
     let ch = slow.channel.as_ref().expect("channel");
     assert!(ch.utilisation(slow.final_time) <= 0.1, "{:?}", ch);
     assert!(
-        slow.warnings.iter().all(|w| !w.contains("ALOHA")),
+        slow.warnings
+            .iter()
+            .all(|w| !w.contains("ALOHA") && !w.contains("link copies were lost")),
         "{:?}",
         slow.warnings
     );

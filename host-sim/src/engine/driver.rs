@@ -138,6 +138,7 @@ pub fn drive(
     let channel = engine.channel_stats();
     let policy = engine.policy_counts();
     let frames = engine.frame_counts();
+    let loss = engine.loss_by_sender();
     let (q, v, est) = engine.view();
     let verdict = sim
         .monitor
@@ -171,6 +172,13 @@ pub fn drive(
         .as_ref()
         .and_then(|c| c.collision_note(sim.diag.snap.t, frames.sent, period, model.comm_every));
     if let Some(note) = collisions {
+        if verdict.outcome != crate::analysis::Outcome::Converged {
+            reason = format!("{reason}; {note}");
+        }
+        warnings.push(note);
+    }
+    let names: Vec<&str> = model.agents.iter().map(|a| a.name.as_str()).collect();
+    if let Some(note) = super::channel::lossy_note(&loss, &names) {
         if verdict.outcome != crate::analysis::Outcome::Converged {
             reason = format!("{reason}; {note}");
         }

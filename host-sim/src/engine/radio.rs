@@ -15,7 +15,7 @@
 //! bandwidth limit; the copies that survive collisions and range then suffer the
 //! per-link faults above, from the end of their transmission.
 
-use super::channel::{Channel, ChannelStats};
+use super::channel::{bump, Channel, ChannelStats};
 pub use super::frame::RadioFrame;
 use crate::model::graph::Adjacency;
 use crate::model::RadioModel;
@@ -105,6 +105,10 @@ pub struct Radio {
     busy_until: Vec<f64>,
     stats: RadioStats,
     channel: Option<Channel>,
+    /// Each agent's link copies sent and, of those, lost (random loss, a full queue),
+    /// by sender; the channel keeps its own losses ([`Radio::loss_by_sender`]).
+    sent_from: Vec<u64>,
+    lost_from: Vec<u64>,
 }
 
 impl Radio {
@@ -121,6 +125,8 @@ impl Radio {
             busy_until: vec![0.0; n],
             stats: RadioStats::default(),
             channel: None,
+            sent_from: vec![0; n],
+            lost_from: vec![0; n],
         }
     }
 
@@ -197,9 +203,11 @@ impl Radio {
         self.stats.broadcasts += 1;
         let copies = receivers.len() as u64;
         self.stats.sent += copies;
+        bump(&mut self.sent_from, from, copies);
         if let Some(c) = &mut self.channel {
             if !c.transmit(now, from, frame, self.model.queue_limit) {
                 self.stats.queue_dropped += copies;
+                bump(&mut self.lost_from, from, copies);
             }
             return;
         }
@@ -210,6 +218,7 @@ impl Radio {
             let start = busy.max(now);
             if start - now > self.model.queue_limit + TIME_EPS {
                 self.stats.queue_dropped += copies;
+                bump(&mut self.lost_from, from, copies);
                 return;
             }
             // Bits over bits per second (×8 and the old bytes/s ×8 give the same quotient).
@@ -268,6 +277,7 @@ impl Radio {
     fn link_copy(&mut self, on_air: f64, born: f64, from: usize, to: usize, frame: RadioFrame) {
         if self.chance(self.model.loss) {
             self.stats.lost += 1;
+            bump(&mut self.lost_from, from, 1);
             return;
         }
         let mut copy = frame;
@@ -287,6 +297,22 @@ impl Radio {
             self.push(again, to, from, born, copy);
             self.stats.duplicated += 1;
         }
+    }
+
+    /// Each agent's link copies sent and, of those, never delivered (random loss, a
+    /// full queue, the channel's collisions and range), in agent order. Empty when the
+    /// simulator delivered the copies itself ([`Self::count_direct`]: nothing is lost).
+    pub fn loss_by_sender(&self) -> Vec<(u64, u64)> {
+        let channel = self.channel.as_ref().map(Channel::lost_from);
+        self.sent_from
+            .iter()
+            .zip(&self.lost_from)
+            .enumerate()
+            .map(|(i, (&sent, &lost))| {
+                let more = channel.and_then(|c| c.get(i)).copied().unwrap_or(0);
+                (sent, lost + more)
+            })
+            .collect()
     }
 
     /// Hands every copy due by `now` to its receiver's inbox, in arrival order.

@@ -424,6 +424,10 @@ impl Engine for SampledSim<'_> {
             .map_or_else(Vec::new, super::policy::PolicyRun::counts)
     }
 
+    fn loss_by_sender(&self) -> Vec<(u64, u64)> {
+        self.delivery.radio.loss_by_sender()
+    }
+
     fn channel_stats(&self) -> Option<ChannelStats> {
         self.delivery.radio.channel_stats()
     }

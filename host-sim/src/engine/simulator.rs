@@ -51,6 +51,11 @@ pub trait Engine {
     fn channel_stats(&self) -> Option<ChannelStats> {
         None
     }
+    /// Each agent's link copies sent and lost, in agent order (empty when nothing can
+    /// be lost: no radio, or the simulator delivering the copies itself).
+    fn loss_by_sender(&self) -> Vec<(u64, u64)> {
+        Vec::new()
+    }
     /// What the safety policies did, per agent (empty without `[policy]`).
     fn policy_counts(&self) -> Vec<ph_formation_core::policy::PolicyCounts> {
         Vec::new()

@@ -25,7 +25,7 @@
 mod age;
 mod stats;
 
-pub use stats::{ChannelStats, ALOHA_LOAD_TARGET, TIMEOUT_BROADCASTS};
+pub use stats::{lossy_note, ChannelStats, ALOHA_LOAD_TARGET, LOSSY_SHARE, TIMEOUT_BROADCASTS};
 
 use super::frame::RadioFrame;
 use crate::model::graph::Adjacency;
@@ -71,6 +71,8 @@ pub struct Channel {
     /// Transmitters outside the swarm (attackers): their positions, `None` = heard by
     /// everyone. Transmitter `n + k` is `external[k]`.
     external: Vec<Option<Vec2<f64>>>,
+    /// Each agent's link copies lost (collisions, out of range), by sender.
+    lost_from: Vec<u64>,
 }
 
 impl Channel {
@@ -96,6 +98,7 @@ impl Channel {
             order: 0,
             stats: ChannelStats::default(),
             external: Vec::new(),
+            lost_from: vec![0; n],
         }
     }
 
@@ -104,6 +107,11 @@ impl Channel {
         let mut s = self.stats;
         self.ages.write(&mut s);
         s
+    }
+
+    /// Link copies each agent sent that were lost so far (collisions and out of range).
+    pub fn lost_from(&self) -> &[u64] {
+        &self.lost_from
     }
 
     /// Link copies lost so far (collisions and out of range).
@@ -282,12 +290,14 @@ impl Channel {
             for &to in self.neighbours.of(from) {
                 if !self.in_range(from, to) {
                     self.stats.out_of_range += 1;
+                    bump(&mut self.lost_from, from, 1);
                     continue;
                 }
                 let (collided, seen) = self.collides(k, to);
                 self.stats.inspected += seen;
                 if collided {
                     self.stats.collided += 1;
+                    bump(&mut self.lost_from, from, 1);
                     lost = true;
                 } else {
                     copy(f.end, f.born, from, to, f.frame);
@@ -317,3 +327,10 @@ impl Channel {
 
 #[cfg(test)]
 mod tests;
+
+/// `counts[i] += by` (nothing for an index outside: a transmitter outside the swarm).
+pub(crate) fn bump(counts: &mut [u64], i: usize, by: u64) {
+    if let Some(c) = counts.get_mut(i) {
+        *c += by;
+    }
+}

@@ -93,11 +93,54 @@ pub const ALOHA_LOAD_TARGET: f64 = 0.1;
 /// plus the half period of the clocks' phases.
 pub const TIMEOUT_BROADCASTS: f64 = 3.5;
 
+/// The share of an agent's link copies lost above which the run names it: with a
+/// timeout of [`TIMEOUT_BROADCASTS`] broadcasts its neighbours go silent on three losses
+/// in a row, `0.37³` = 5 % of the time, the verdict's share of safe outputs
+/// (docs/radio.md).
+pub const LOSSY_SHARE: f64 = 0.37;
+
+/// The agents (by their scenario ids `names`) whose copies were lost more than
+/// [`LOSSY_SHARE`] of the time, from `loss` (sent, lost per agent), with their shares;
+/// `None` when there is none.
+pub fn lossy_note(loss: &[(u64, u64)], names: &[&str]) -> Option<String> {
+    let lossy: Vec<String> = loss
+        .iter()
+        .zip(names)
+        .filter(|((sent, lost), _)| *sent > 0 && *lost as f64 > LOSSY_SHARE * *sent as f64)
+        .map(|((sent, lost), name)| {
+            format!("{name} ({:.0} %)", 100.0 * *lost as f64 / *sent as f64)
+        })
+        .collect();
+    (!lossy.is_empty()).then(|| {
+        format!(
+            "agents whose link copies were lost more than {:.0} % of the time (their \
+             neighbours time out on three losses in a row): {}",
+            100.0 * LOSSY_SHARE,
+            lossy.join(", ")
+        )
+    })
+}
+
 /// `x / elapsed`, 0 for an empty interval.
 fn per(x: f64, elapsed: f64) -> f64 {
     if elapsed > 0.0 {
         x / elapsed
     } else {
         0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Named above 37 % of the copies sent (not at it, not without copies), with the
+    /// share rounded.
+    #[test]
+    fn lossy_agents_are_named_above_the_share() {
+        let loss = [(100, 38), (100, 37), (0, 0), (10, 10)];
+        let note = lossy_note(&loss, &["a", "b", "c", "d"]).expect("two lossy");
+        assert!(note.ends_with(": a (38 %), d (100 %)"), "{note}");
+        assert_eq!(lossy_note(&loss[1..3], &["b", "c"]), None);
     }
 }
