@@ -336,3 +336,64 @@ fn the_design_figures_of_n_10_are_measured() {
         assert!(shows(shape, &c[9]), "{c:?}: shape error {shape:e}");
     });
 }
+
+/// `design --vehicle crazyflie` (docs/design.md "Designing for the Crazyflie"): the 2×5
+/// grid of issue 42 (points 0..4 × 0..1, 1 m apart) gets `world = "crazyflie"`, a 2 N
+/// force limit and `D^v` = 1, and converges over 300 s (about one battery) for seeds
+/// 1–3. Negative control: the same grid with the template's settings under `--set
+/// world=crazyflie` does not (the velocity noise is left undamped).
+#[test]
+fn designed_for_the_crazyflie_the_grid_holds_a_battery_long() {
+    let dir = tempfile::tempdir().unwrap();
+    let points = dir.path().join("grid2x5.csv");
+    let mut csv = String::from("x,y\n");
+    for y in 0..2 {
+        for x in 0..5 {
+            csv += &format!("{x},{y}\n");
+        }
+    }
+    std::fs::write(&points, csv).unwrap();
+    let design = |extra: &[&str], file: &str| {
+        let out = dir.path().join(file);
+        let d = bin()
+            .arg("design")
+            .arg(&points)
+            .args(extra)
+            .arg("-o")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert_eq!(d.status.code(), Some(0), "{}", text(&d.stderr));
+        out
+    };
+    let cf = design(&["--vehicle", "crazyflie"], "cf.toml");
+    let toml = std::fs::read_to_string(&cf).unwrap();
+    for want in [
+        "world = \"crazyflie\"",
+        "max_force = 2.0",
+        "velocity_damping = 1.0",
+    ] {
+        assert!(toml.contains(want), "missing {want:?}");
+    }
+    let run = |file: &std::path::Path, extra: &[&str]| {
+        let out = dir.path().join("run");
+        let r = bin()
+            .arg("run")
+            .arg(file)
+            .args(["--set", "duration=300", "--no-plots", "--quiet", "--out"])
+            .arg(&out)
+            .args(extra)
+            .output()
+            .unwrap();
+        r.status.code()
+    };
+    for seed in ["seed=1", "seed=2", "seed=3"] {
+        assert_eq!(run(&cf, &["--set", seed]), Some(0), "{seed}");
+    }
+    let plain = design(&[], "plain.toml");
+    assert_eq!(
+        run(&plain, &["--set", "world=crazyflie", "--set", "seed=1"]),
+        Some(10),
+        "the template's settings converged in the Crazyflie world"
+    );
+}

@@ -93,6 +93,11 @@ pub struct DesignArgs {
     /// Simulated duration (s) [default: the template's].
     #[arg(long, value_name = "S")]
     pub duration: Option<f64>,
+    /// The vehicle the formation is designed for: `crazyflie` writes `world =
+    /// "crazyflie"`, a 2 N/kg force limit and a velocity damping of 1 /s over the
+    /// template's (docs/design.md).
+    #[arg(long, value_enum)]
+    pub vehicle: Option<Vehicle>,
     /// Write the scenario here instead of stdout.
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
@@ -100,6 +105,15 @@ pub struct DesignArgs {
     /// leader edge, initial and target positions) into FILE (.png or .svg).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
+}
+
+/// `--vehicle`: what the formation is designed to fly on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Vehicle {
+    /// The template's settings as they are (the default).
+    Template,
+    /// A Crazyflie team (`world = "crazyflie"`, docs/design.md).
+    Crazyflie,
 }
 
 /// Parses `A,B`.
@@ -248,7 +262,11 @@ fn design(args: &DesignArgs) -> Result<(String, String), DesignError> {
         file: args.template.clone(),
         reason: e.to_string(),
     })?;
-    let template = Some(Template::parse(&src.text, &src.label)?);
+    let template = Template::parse(&src.text, &src.label)?;
+    let template = Some(match args.vehicle {
+        Some(Vehicle::Crazyflie) => template.crazyflie(),
+        Some(Vehicle::Template) | None => template,
+    });
     let margin_deg = args.margin.unwrap_or_else(|| {
         template
             .as_ref()
