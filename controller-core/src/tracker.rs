@@ -135,7 +135,10 @@ impl<T: Real> Track<T> {
             // for two bearings' noise and the inverse distance's share of the motion.
             let moved = rotate_as(&self.outlier, s, &s_pred);
             let f01 = dt * perp(s).dot(over_interval);
-            let gate2 = c.gate * c.gate * (r + r + f01 * f01 * self.p[2]);
+            // The relative velocity changed over the interval by `dv − over_interval`
+            // (known now, not when the interval began): the motion it did not predict.
+            let late = dt * self.inv_range * perp(s).dot(&(dv - over_interval));
+            let gate2 = c.gate * c.gate * (r + r + f01 * f01 * self.p[2]) + late * late;
             if self.rejected > 0 && agree(&moved, z, gate2) {
                 self.rejected = self.rejected.saturating_add(1);
             } else {
