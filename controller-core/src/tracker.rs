@@ -28,7 +28,7 @@ pub struct Track<T: Real> {
     /// Gated-out bearings in a row that agree with the first of them (S16, S15d).
     pub rejected: u8,
     /// Gated-out bearings in a row, agreeing or not (S15d: the track is lost at
-    /// [`MAX_MISSED`]).
+    /// ten (`MAX_MISSED`)).
     pub missed: u8,
     /// The last gated-out bearing of the current run (S15d): the next outlier counts
     /// towards a restart only if it agrees with it.
@@ -83,9 +83,9 @@ impl<T: Real> Track<T> {
     /// - S15b: nothing left to predict (`dt` equal to what was predicted, e.g. 0) is a
     ///   measurement update (S16) alone: the inverse distance is kept;
     /// - S15c: a `dt` above [`TrackLimits::max_interval`] restarts the track at `z`;
-    /// - S15d: gated-out bearings restart it only when [`MAX_REJECTED`] of them in a row
+    /// - S15d: gated-out bearings restart it only when three (`MAX_REJECTED`) of them in a row
     ///   agree (each within the gate of the previous one moved as the prediction moved
-    ///   `ŝ`), or after [`MAX_MISSED`] in a row whatever they are (the track is lost);
+    ///   `ŝ`), or after ten (`MAX_MISSED`) in a row whatever they are (the track is lost);
     /// - S15e: the 90° rule of S16 is not applied while the gate admits every sine.
     ///
     /// Restarts after the first bearing count in [`Track::resets`]. Not inlined: the

@@ -131,7 +131,7 @@ pub unsafe extern "C" fn ph_actuator_set_max_gap(
     max_gap: f32,
 ) -> ph_status {
     let r = (|| {
-        if !(max_gap > 0.0) {
+        if max_gap.is_nan() || max_gap <= 0.0 {
             return Err(ph_status::PH_ERR_ARGUMENT);
         }
         // SAFETY: per this function's contract.
