@@ -113,12 +113,9 @@ impl<T: Real> Track<T> {
             self.start(s, z, r, lim);
             return rate(s, self.inv_range, dv);
         }
-        // S15b: nothing to predict over (dt = 0): the update alone.
-        let (s_pred, inv_range_pred, [p00, p01, p11]) = if dt > T::zero() {
-            self.s15(s, over_interval, dt, c, lim)
-        } else {
-            (*s, self.inv_range, self.p)
-        };
+        // S15b: with nothing to predict over (dt = 0) S15 is the identity: the update
+        // alone.
+        let (s_pred, inv_range_pred, [p00, p01, p11]) = self.s15(s, over_interval, dt, c, lim);
         // S16: the bearing as a measurement of the tangent angle, e = (Jŝ)ᵀz ≈ δθ.
         let tp = perp(&s_pred);
         let (e, along) = (tp.dot(z), s_pred.dot(z));
