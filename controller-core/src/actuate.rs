@@ -38,6 +38,10 @@ pub enum ActuateError {
     SecondLead,
     /// The jerk filter's time constant is not finite and non-negative.
     JerkFilter,
+    /// The gap bound is NaN or not positive (use infinity for none).
+    MaxGap,
+    /// The stall limit is NaN or not positive (use infinity for none).
+    MaxInterval,
 }
 
 /// The virtual plant of SPEC S1 for one agent: mass, friction `D^r` per axis, the
@@ -51,6 +55,8 @@ pub struct VirtualMass<T> {
     lead: T,
     second_lead: T,
     jerk_filter: T,
+    max_gap: T,
+    max_interval: T,
 }
 
 impl<T: Real> VirtualMass<T> {
@@ -74,7 +80,45 @@ impl<T: Real> VirtualMass<T> {
             lead: T::zero(),
             second_lead: T::zero(),
             jerk_filter: T::zero(),
+            max_gap: T::lit(f64::INFINITY),
+            max_interval: T::lit(f64::INFINITY),
         })
+    }
+
+    /// The same plant with the gap bound `max_gap` (m/s, > 0; infinity, the default, for
+    /// none; SPEC S21c): [`VelocityCommand::step`] starts from a virtual velocity at most
+    /// `max_gap` from the measured one. A vehicle that follows its setpoints lags the
+    /// virtual velocity by about its loop's time constant times the virtual acceleration;
+    /// a larger gap means it is not following (blocked, saturated), and the virtual
+    /// velocity would wind up like an integrator without anti-windup.
+    pub fn with_max_gap(self, max_gap: T) -> Result<Self, ActuateError> {
+        if !is_positive(max_gap) {
+            return Err(ActuateError::MaxGap);
+        }
+        Ok(Self { max_gap, ..self })
+    }
+
+    /// The same plant with the stall limit `max_interval` (s, > 0; infinity, the
+    /// default, for none; SPEC S21c): a [`VelocityCommand::step`] over a longer period
+    /// (a stalled task, a jumped clock) starts again from the measured velocity.
+    pub fn with_max_interval(self, max_interval: T) -> Result<Self, ActuateError> {
+        if !is_positive(max_interval) {
+            return Err(ActuateError::MaxInterval);
+        }
+        Ok(Self {
+            max_interval,
+            ..self
+        })
+    }
+
+    /// The gap bound (m/s; S21c).
+    pub fn max_gap(&self) -> T {
+        self.max_gap
+    }
+
+    /// The stall limit (s; S21c).
+    pub fn max_interval(&self) -> T {
+        self.max_interval
     }
 
     /// The same plant with lead `lead` (s, finite, ≥ 0): the time constant of the
@@ -197,6 +241,19 @@ impl<T: Real> VirtualMass<T> {
     }
 }
 
+/// S21c: `c` moved towards `m` until at most `gap` from it (`c` itself when it is
+/// within, or when the distance is NaN).
+fn within<T: Real>(c: [T; 2], m: [T; 2], gap: T) -> [T; 2] {
+    let [x, y] = [c[0] - m[0], c[1] - m[1]];
+    let d = (x * x + y * y).sqrt_fast();
+    if d > gap {
+        let k = gap / d;
+        [m[0] + x * k, m[1] + y * k]
+    } else {
+        c
+    }
+}
+
 /// `x > 0` (false for NaN).
 fn is_positive<T: Real>(x: T) -> bool {
     x.partial_cmp(&T::zero()) == Some(core::cmp::Ordering::Greater)
@@ -254,7 +311,9 @@ impl<T: Real> VelocityCommand<T> {
         self.accel
     }
 
-    /// The next step starts again from the measured velocity.
+    /// The next step starts again from the measured velocity. Call it on the agent's safe
+    /// output (SPEC S21c): the safe force damps the vehicle's own velocity, not a virtual
+    /// one that may have run ahead of it.
     pub fn restart(&mut self) {
         self.command = None;
         self.accel = None;
@@ -274,9 +333,17 @@ impl<T: Real> VelocityCommand<T> {
     /// One control period: integrates S1 from the previous virtual velocity (or, on the
     /// first step, from `measured`, the vehicle's velocity) under `force` for `dt`
     /// seconds (S20) and returns the new setpoint (S21: the new virtual velocity, led by
-    /// the plant's lead).
+    /// the plant's lead). S21c: the previous virtual velocity is first brought within
+    /// the plant's gap bound of `measured` (a finite `measured` only), and a `dt` above
+    /// its stall limit starts again from `measured`.
     pub fn step(&mut self, force: [T; 2], measured: [T; 2], dt: T) -> [T; 2] {
-        let from = self.command.unwrap_or(measured);
+        if dt > self.plant.max_interval {
+            self.restart();
+        }
+        let from = match self.command {
+            Some(c) => within(c, measured, self.plant.max_gap),
+            None => measured,
+        };
         let next = self.plant.step(from, force, dt);
         self.command = Some(next);
         let p = &self.plant;

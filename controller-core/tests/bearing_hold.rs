@@ -55,6 +55,17 @@ impl World {
         }
     }
 
+    /// The same world with neighbour timeout `timeout` (s) instead of the testkit's
+    /// (none to speak of), before the first tick.
+    fn with_timeout(mut self, timeout: f64) -> Self {
+        for a in &mut self.agents {
+            let mut c = a.config().clone();
+            c.limits.neighbour_timeout = timeout;
+            *a = HostAgent::new(c).expect("valid configuration");
+        }
+        self
+    }
+
     fn t(&self) -> f64 {
         self.k as f64 * DT
     }
@@ -252,6 +263,45 @@ fn without_a_hold_a_bearing_missing_for_one_tick_is_missing() {
         let out = w.tick(&GAP);
         assert!(out.iter().all(|o| o.status == Status::Nominal), "{out:?}");
     }
+}
+
+/// S15c through the agent: a bearing back after a gap longer than the neighbour timeout
+/// (0.1 s) and the hold restarts that track, and the agent's reset counter of that
+/// neighbour (and only of it) says so; a gap within the hold does not.
+#[test]
+fn a_bearing_back_after_a_long_gap_restarts_its_track_and_is_counted() {
+    let resets =
+        |w: &World, i: usize| -> Vec<u32> { w.agents[i].track_resets().map(|(_, r)| r).collect() };
+    let mut w =
+        World::new(BearingFilter::Tracker(TrackerConfig::default()), 0.05).with_timeout(0.1);
+    w.run(20);
+    for _ in 0..4 {
+        w.tick(&GAP); // 0.04 s: within the hold
+    }
+    for _ in 0..5 {
+        w.tick(&[]);
+    }
+    assert_eq!(resets(&w, 0), [0, 0]);
+    for _ in 0..20 {
+        w.tick(&GAP); // 0.2 s: beyond the hold and the timeout
+    }
+    w.tick(&[]);
+    let (t, v) = (w.t() - DT, w.agents[0].neighbours().collect::<Vec<_>>());
+    assert_eq!(v, [id(1), id(2)]);
+    assert_eq!(resets(&w, 0), [1, 0]);
+    assert_eq!(resets(&w, 1), [0, 0]);
+    assert_eq!(resets(&w, 2)[0], 1, "{:?}", resets(&w, 2));
+    // Restarted at the measured bearing.
+    let (s, _) = w.used(0, 1).expect("measured");
+    assert!(angle(&s, &w.truth(0, 1, t).0) < 1e-9);
+    // The finite difference has no track to restart.
+    let mut w = World::new(BearingFilter::FiniteDifference, 0.05).with_timeout(0.1);
+    w.run(20);
+    for _ in 0..20 {
+        w.tick(&GAP);
+    }
+    w.tick(&[]);
+    assert_eq!(resets(&w, 0), [0, 0]);
 }
 
 #[test]

@@ -66,6 +66,7 @@ fn config(sigma: f64) -> TrackerConfig<f64> {
 const LIMITS: TrackLimits<f64> = TrackLimits {
     inv_range_initial: 1.0,
     inv_range_max: 10.0,
+    max_interval: 1.0,
 };
 
 /// Runs the tracker over `[0, t_end]` with bearing noise `sigma`; calls `each(t, ŝ, ṡ̂,

@@ -67,10 +67,11 @@
  * `PH_FAULT_NEGATIVE_DT`, `ph_actuator` and `ph_actuator_init` the lead; 5: `ph_actuator`
  * gained the second-order lead and its kept acceleration, `ph_actuator_set_second_lead`;
  * the safety policies `ph_policy_*` and `ph_separation_guard`, the position packet
- * `ph_position_*`). Compare the header's value with `ph_abi_version()` of the library
+ * `ph_position_*`; 7: `ph_frame_stats` gained `track_resets`, `ph_actuator` the gap
+ * bound and stall limit of SPEC S21c, `ph_actuator_set_max_gap`). Compare the header's value with `ph_abi_version()` of the library
  * you link.
  */
-#define PH_ABI_VERSION 6
+#define PH_ABI_VERSION 7
 
 /**
  * Two positions closer than this (m) are coincident: no bearing between them, and
@@ -93,14 +94,14 @@
 /**
  * Bytes of agent memory (`sizeof` the agent, for 32-bit targets such as Cortex-M).
  */
-#define PH_AGENT_SIZE 3716
+#define PH_AGENT_SIZE 3860
 #endif
 
 #if defined(PH_PTR64)
 /**
  * Bytes of agent memory (`sizeof` the agent, for 64-bit hosts).
  */
-#define PH_AGENT_SIZE 4104
+#define PH_AGENT_SIZE 4200
 #endif
 
 #if defined(PH_PTR32)
@@ -637,6 +638,18 @@ typedef struct {
    * 1 once `ph_actuate` has kept a virtual acceleration (with a second-order lead).
    */
   uint8_t has_accel;
+  /**
+   * The gap bound (m/s, ≥ 0; 0 or `INFINITY` for none; SPEC S21c): the virtual
+   * velocity is kept within this of the measured one. `ph_actuator_init` sets
+   * `INFINITY`; `ph_actuator_set_max_gap` sets it.
+   */
+  float max_gap;
+  /**
+   * The stall limit (s, ≥ 0; 0 or `INFINITY` for none; SPEC S21c): a `ph_actuate`
+   * over a longer `dt` starts again from the measured velocity. `ph_actuator_init`
+   * sets the agent's `neighbour_timeout`.
+   */
+  float max_interval;
 } ph_actuator;
 
 /**
@@ -969,7 +982,8 @@ typedef struct {
 typedef void (*ph_send_fn)(void *ctx, const uint8_t *bytes, size_t len);
 
 /**
- * Counters of received frames by outcome (`ph_stats`).
+ * Counters of received frames by outcome, and the bearing trackers' reset counters
+ * (`ph_stats`).
  */
 typedef struct {
   /**
@@ -1020,6 +1034,12 @@ typedef struct {
    * `auth`: no counter known for the sender and none in the frame.
    */
   uint32_t unsynced;
+  /**
+   * Restarts of each neighbour's bearing track after its first bearing (SPEC §11a,
+   * S15c–S15d: a long interval, or agreeing outliers), by neighbour slot (the order
+   * of `ph_neighbours`); 0 past the agent's neighbours and with the finite difference.
+   */
+  uint32_t track_resets[PH_MAX_NEIGHBOURS];
 } ph_frame_stats;
 
 /**
@@ -1204,7 +1224,8 @@ extern "C" {
  * Fills `*actuator` for `agent`: mass `mass`, the friction `D^r` of the agent's
  * configuration (so that the controller cancels the friction the plant has), speed
  * limit `max_speed`, lead `lead` (the vehicle's velocity-loop time constant, SPEC S21;
- * 0 for none), no setpoint yet. `PH_ERR_ARGUMENT` for a mass that is not finite and
+ * 0 for none), no gap bound, the agent's neighbour timeout as the stall limit (S21c),
+ * no setpoint yet. `PH_ERR_ARGUMENT` for a mass that is not finite and
  * positive, a `max_speed` that is NaN or not positive, or a lead that is not finite and
  * non-negative.
  *
@@ -1229,11 +1250,24 @@ ph_status ph_actuator_init(ph_actuator *actuator,
 ph_status ph_actuator_set_second_lead(ph_actuator *actuator, float second_lead);
 
 /**
+ * Sets the gap bound of `*actuator` (m/s, > 0; `INFINITY` for none; SPEC S21c): the
+ * virtual velocity is kept within `max_gap` of the measured one, so that a blocked or
+ * saturated vehicle does not let it run ahead. `PH_ERR_ARGUMENT` (nothing written) for
+ * a NaN or non-positive value.
+ *
+ * # Safety
+ * `actuator` is NULL or points to a `ph_actuator`.
+ */
+ph_status ph_actuator_set_max_gap(ph_actuator *actuator, float max_gap);
+
+/**
  * One control period: integrates S1 from the previous virtual velocity (the first time
  * from `velocity[0..2]`, the vehicle's measured velocity) under `force[0..2]` (the
  * `ph_output.force` of this tick) for `dt` seconds (SPEC S20), keeps the new virtual
  * velocity in `actuator->command`, and writes the setpoint (S21: led by
- * `actuator->lead`) to `setpoint[0..2]`. `PH_ERR_ARGUMENT` (nothing written) for
+ * `actuator->lead`) to `setpoint[0..2]`. S21c: the previous virtual velocity is kept
+ * within `actuator->max_gap` of `velocity`, and a `dt` above `actuator->max_interval`
+ * starts again from `velocity`; set `has_command = 0` on the safe output. `PH_ERR_ARGUMENT` (nothing written) for
  * an actuator whose parameters `ph_actuator_init` would refuse.
  *
  * # Safety
@@ -1367,7 +1401,7 @@ ph_status ph_frames_cb(ph_agent *agent, ph_send_fn send, void *ctx, size_t *coun
 ph_status ph_agent_set_boot_epoch(ph_agent *agent, uint32_t epoch);
 
 /**
- * The counters of received frames.
+ * The counters of received frames, and the bearing trackers' reset counters.
  *
  * # Safety
  * `agent` as for `ph_step` (read only); `out` is NULL or writable.

@@ -35,12 +35,21 @@ pub struct ph_actuator {
     pub accel: [f32; 2],
     /// 1 once `ph_actuate` has kept a virtual acceleration (with a second-order lead).
     pub has_accel: u8,
+    /// The gap bound (m/s, ≥ 0; 0 or `INFINITY` for none; SPEC S21c): the virtual
+    /// velocity is kept within this of the measured one. `ph_actuator_init` sets
+    /// `INFINITY`; `ph_actuator_set_max_gap` sets it.
+    pub max_gap: f32,
+    /// The stall limit (s, ≥ 0; 0 or `INFINITY` for none; SPEC S21c): a `ph_actuate`
+    /// over a longer `dt` starts again from the measured velocity. `ph_actuator_init`
+    /// sets the agent's `neighbour_timeout`.
+    pub max_interval: f32,
 }
 
 /// Fills `*actuator` for `agent`: mass `mass`, the friction `D^r` of the agent's
 /// configuration (so that the controller cancels the friction the plant has), speed
 /// limit `max_speed`, lead `lead` (the vehicle's velocity-loop time constant, SPEC S21;
-/// 0 for none), no setpoint yet. `PH_ERR_ARGUMENT` for a mass that is not finite and
+/// 0 for none), no gap bound, the agent's neighbour timeout as the stall limit (S21c),
+/// no setpoint yet. `PH_ERR_ARGUMENT` for a mass that is not finite and
 /// positive, a `max_speed` that is NaN or not positive, or a lead that is not finite and
 /// non-negative.
 ///
@@ -59,6 +68,7 @@ pub unsafe extern "C" fn ph_actuator_init(
         let friction = a.config().friction;
         let plant = VirtualMass::new(mass, friction, max_speed)
             .and_then(|p| p.with_lead(lead))
+            .and_then(|p| p.with_max_interval(a.config().limits.neighbour_timeout))
             .map_err(|_| ph_status::PH_ERR_ARGUMENT)?;
         let value = ph_actuator {
             mass: plant.mass(),
@@ -70,6 +80,8 @@ pub unsafe extern "C" fn ph_actuator_init(
             second_lead: 0.0,
             accel: [0.0; 2],
             has_accel: 0,
+            max_gap: plant.max_gap(),
+            max_interval: plant.max_interval(),
         };
         // SAFETY: per this function's contract.
         unsafe { write(actuator, value) }
@@ -106,11 +118,38 @@ pub unsafe extern "C" fn ph_actuator_set_second_lead(
     status(r)
 }
 
+/// Sets the gap bound of `*actuator` (m/s, > 0; `INFINITY` for none; SPEC S21c): the
+/// virtual velocity is kept within `max_gap` of the measured one, so that a blocked or
+/// saturated vehicle does not let it run ahead. `PH_ERR_ARGUMENT` (nothing written) for
+/// a NaN or non-positive value.
+///
+/// # Safety
+/// `actuator` is NULL or points to a `ph_actuator`.
+#[no_mangle]
+pub unsafe extern "C" fn ph_actuator_set_max_gap(
+    actuator: *mut ph_actuator,
+    max_gap: f32,
+) -> ph_status {
+    let r = (|| {
+        if max_gap.is_nan() || max_gap <= 0.0 {
+            return Err(ph_status::PH_ERR_ARGUMENT);
+        }
+        // SAFETY: per this function's contract.
+        let a = unsafe { input(actuator.cast_const()) }?;
+        let updated = ph_actuator { max_gap, ..*a };
+        // SAFETY: per this function's contract.
+        unsafe { write(actuator, updated) }
+    })();
+    status(r)
+}
+
 /// One control period: integrates S1 from the previous virtual velocity (the first time
 /// from `velocity[0..2]`, the vehicle's measured velocity) under `force[0..2]` (the
 /// `ph_output.force` of this tick) for `dt` seconds (SPEC S20), keeps the new virtual
 /// velocity in `actuator->command`, and writes the setpoint (S21: led by
-/// `actuator->lead`) to `setpoint[0..2]`. `PH_ERR_ARGUMENT` (nothing written) for
+/// `actuator->lead`) to `setpoint[0..2]`. S21c: the previous virtual velocity is kept
+/// within `actuator->max_gap` of `velocity`, and a `dt` above `actuator->max_interval`
+/// starts again from `velocity`; set `has_command = 0` on the safe output. `PH_ERR_ARGUMENT` (nothing written) for
 /// an actuator whose parameters `ph_actuator_init` would refuse.
 ///
 /// # Safety
@@ -135,6 +174,8 @@ pub unsafe extern "C" fn ph_actuate(
         let plant = VirtualMass::new(a.mass, a.friction, a.max_speed)
             .and_then(|p| p.with_lead(a.lead))
             .and_then(|p| p.with_second_lead(a.second_lead))
+            .and_then(|p| p.with_max_gap(none_if_zero(a.max_gap)))
+            .and_then(|p| p.with_max_interval(none_if_zero(a.max_interval)))
             .map_err(|_| ph_status::PH_ERR_ARGUMENT)?;
         let mut command = VelocityCommand::resume_with_accel(
             plant,
@@ -156,4 +197,13 @@ pub unsafe extern "C" fn ph_actuate(
         unsafe { write(setpoint.cast::<[f32; 2]>(), next) }
     })();
     status(r)
+}
+
+/// 0 (a zero-filled `ph_actuator` of ABI 6) as "none": infinity.
+fn none_if_zero(x: f32) -> f32 {
+    if x == 0.0 {
+        f32::INFINITY
+    } else {
+        x
+    }
 }

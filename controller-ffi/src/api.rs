@@ -391,7 +391,7 @@ pub unsafe extern "C" fn ph_agent_set_boot_epoch(agent: *mut ph_agent, epoch: u3
     status(r)
 }
 
-/// The counters of received frames.
+/// The counters of received frames, and the bearing trackers' reset counters.
 ///
 /// # Safety
 /// `agent` as for `ph_step` (read only); `out` is NULL or writable.
@@ -400,7 +400,12 @@ pub unsafe extern "C" fn ph_stats(agent: *const ph_agent, out: *mut ph_frame_sta
     // SAFETY: per this function's contract.
     let r = unsafe { storage::agent_ref(agent) }
         // SAFETY: per this function's contract.
-        .and_then(|a| unsafe { write(out, stats_from_core(a.stats())) });
+        .and_then(|a| unsafe {
+            write(
+                out,
+                stats_from_core(a.stats(), a.track_resets().map(|(_, r)| r)),
+            )
+        });
     status(r)
 }
 

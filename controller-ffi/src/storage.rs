@@ -27,13 +27,13 @@ pub struct ph_agent {
 
 /// Bytes of agent memory (`sizeof` the agent, for 32-bit targets such as Cortex-M).
 #[cfg(target_pointer_width = "32")]
-pub const PH_AGENT_SIZE: usize = 3716;
+pub const PH_AGENT_SIZE: usize = 3860;
 /// Alignment of the agent memory, in bytes.
 #[cfg(target_pointer_width = "32")]
 pub const PH_AGENT_ALIGN: usize = 4;
 /// Bytes of agent memory (`sizeof` the agent, for 64-bit hosts).
 #[cfg(target_pointer_width = "64")]
-pub const PH_AGENT_SIZE: usize = 4104;
+pub const PH_AGENT_SIZE: usize = 4200;
 /// Alignment of the agent memory, in bytes.
 #[cfg(target_pointer_width = "64")]
 pub const PH_AGENT_ALIGN: usize = 8;

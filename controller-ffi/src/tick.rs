@@ -9,6 +9,7 @@ use ph_formation_core::{
 };
 
 use crate::status::ph_status;
+use crate::PH_MAX_NEIGHBOURS;
 
 /// `ph_bearing.flags`: `rate` holds a measured bearing rate (otherwise the agent takes
 /// finite differences of successive bearings).
@@ -118,7 +119,8 @@ pub struct ph_output {
     pub degenerate: bool,
 }
 
-/// Counters of received frames by outcome (`ph_stats`).
+/// Counters of received frames by outcome, and the bearing trackers' reset counters
+/// (`ph_stats`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ph_frame_stats {
@@ -146,6 +148,10 @@ pub struct ph_frame_stats {
     pub replayed: u32,
     /// `auth`: no counter known for the sender and none in the frame.
     pub unsynced: u32,
+    /// Restarts of each neighbour's bearing track after its first bearing (SPEC §11a,
+    /// S15c–S15d: a long interval, or agreeing outliers), by neighbour slot (the order
+    /// of `ph_neighbours`); 0 past the agent's neighbours and with the finite difference.
+    pub track_resets: [u32; PH_MAX_NEIGHBOURS],
 }
 
 /// One distance estimate this agent owns (`ph_owned_estimates`).
@@ -246,8 +252,13 @@ pub const NO_OUTPUT: ph_output = ph_output {
     degenerate: false,
 };
 
-/// The C form of the frame counters.
-pub fn stats_from_core(s: &FrameStats) -> ph_frame_stats {
+/// The C form of the frame counters and of the trackers' reset counters `resets` (by
+/// neighbour slot; those past `PH_MAX_NEIGHBOURS` are dropped).
+pub fn stats_from_core(s: &FrameStats, resets: impl Iterator<Item = u32>) -> ph_frame_stats {
+    let mut track_resets = [0; PH_MAX_NEIGHBOURS];
+    for (slot, r) in track_resets.iter_mut().zip(resets) {
+        *slot = r;
+    }
     let FrameStats {
         accepted,
         bad_length,
@@ -275,6 +286,7 @@ pub fn stats_from_core(s: &FrameStats) -> ph_frame_stats {
         bad_tag,
         replayed,
         unsynced,
+        track_resets,
     }
 }
 

@@ -27,6 +27,8 @@ ph_status agent_loop_init(agent_loop *loop, uint8_t *memory, size_t size, uint8_
                              FORMATION_LEAD);
     if (s == PH_OK)
         s = ph_actuator_set_second_lead(&loop->actuator, FORMATION_SECOND_LEAD);
+    if (s == PH_OK && FORMATION_MAX_GAP > 0.0f)
+        s = ph_actuator_set_max_gap(&loop->actuator, FORMATION_MAX_GAP);
     if (s == PH_OK)
         s = formation_state_init(&loop->formation, loop->agent);
     return s;
@@ -94,8 +96,9 @@ ph_status agent_loop_tick(agent_loop *loop, uint32_t now_ms, agent_loop_send_fn 
         loop->safe_ticks++;
 
     /* The velocity setpoint: S1 integrated by the core (ph_actuate); the first tick
-     * starts from the measured velocity. */
-    if (loop->first)
+     * and the safe output start from the measured velocity (SPEC S21c: the safe force
+     * damps the vehicle's own velocity, not a virtual one that ran ahead). */
+    if (loop->first || loop->out.status == PH_OUTPUT_SAFE)
         loop->actuator.has_command = 0;
     if (ph_actuate(&loop->actuator, loop->out.force, m.velocity, m.dt, loop->setpoint) != PH_OK)
         loop->setpoint[0] = loop->setpoint[1] = 0.0f;

@@ -46,6 +46,14 @@
 #ifndef FORMATION_SECOND_LEAD
 #define FORMATION_SECOND_LEAD 0.03895f
 #endif
+/* Gap bound (m/s, SPEC S21c): the virtual velocity stays within this of the measured
+ * one, so that a blocked or saturated Crazyflie does not wind it up. Half the speed
+ * limit: a following Crazyflie lags by FORMATION_LEAD times the virtual acceleration
+ * (0.5 m/s would take 2.1 m/s^2 sustained); a larger gap means it is not following.
+ * 0 turns it off. */
+#ifndef FORMATION_MAX_GAP
+#define FORMATION_MAX_GAP 0.5f
+#endif
 /* P2P port of the position packets (the formation's frames use port 0). */
 #define FORMATION_POSITION_PORT 1u
 /* Room for a position packet: the core's (controller-core/src/wire/position.rs, C API

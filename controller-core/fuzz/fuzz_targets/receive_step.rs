@@ -12,7 +12,12 @@
 //! (`postcard::take_from_bytes::<Frame>`, `Frame::decode`) accept and reject alike and
 //! give the same frame. The `crc16` and `auth` agents run the bearing tracker (SPEC §11,
 //! the default), the `link` agent the finite difference: arbitrary bearings, velocities
-//! and time steps reach both, and the force stays finite and bounded.
+//! and time steps reach both, and the force stays finite and bounded. Half the chunks
+//! (bit 7 of the chunk's first byte) give the bearings as angles (unit vectors, which
+//! pass the unit-length check and reach the tracker, the hold and the law), the time step
+//! and the velocity folded into plausible ranges (NaN and ∞ kept), and some bearings
+//! missing; every agent's force also drives its actuator (SPEC S20–S21c, a gap bound and
+//! a stall limit), whose setpoint must stay finite.
 #![no_main]
 
 use ph_formation_core::wire::{
@@ -23,6 +28,7 @@ use ph_formation_core::{
     TriangleConfig, Vec2,
 };
 use libfuzzer_sys::fuzz_target;
+use ph_formation_core::actuate::{VelocityCommand, VirtualMass};
 
 fn agent(integrity: Integrity) -> Agent<f32, 2, 4> {
     let angle = |apex, cos| AngleConfig {
@@ -48,6 +54,15 @@ fn agent(integrity: Integrity) -> Agent<f32, 2, 4> {
     match Agent::new(c) {
         Ok(a) => a,
         Err(_) => unreachable!("the fuzz configuration is valid"),
+    }
+}
+
+/// `x` folded into `(−m, m)` (NaN and ∞ kept: they must be refused).
+fn fold(x: f32, m: f32) -> f32 {
+    if x.is_finite() {
+        x % m
+    } else {
+        x
     }
 }
 
@@ -138,6 +153,15 @@ fuzz_target!(|data: &[u8]| {
     // `auth`: the last carried counter accepted per sender.
     let mut last = [None::<u64>; 256];
     let limit = agents[0].0.config().limits.max_force;
+    let plant = VirtualMass::new(1.0f32, [0.5; 2], 2.0)
+        .and_then(|p| p.with_lead(0.2))
+        .and_then(|p| p.with_second_lead(0.04))
+        .and_then(|p| p.with_max_gap(0.5))
+        .and_then(|p| p.with_max_interval(0.1));
+    let Ok(plant) = plant else {
+        unreachable!("the fuzz plant is valid")
+    };
+    let mut commands = [VelocityCommand::new(plant); 3];
     // Chunks: one byte (bits 0–5: frame length L ≤ 63; bit 6: make the CRC or tag valid), the
     // frame's L bytes, then 40 bytes of measurement floats.
     let mut rest = data;
@@ -145,20 +169,45 @@ fuzz_target!(|data: &[u8]| {
         let len = usize::from(head & 63).min(tail.len());
         let (frame, tail) = tail.split_at(len);
         let m = tail.get(..40).unwrap_or(tail);
-        let bearings: [BearingMeasurement<f32>; 3] = core::array::from_fn(|k| BearingMeasurement {
+        // Bit 7: the math path (angles, plausible dt and velocity, bearings missing).
+        let angles = head & 128 != 0;
+        let missing = m.get(39).copied().unwrap_or(0);
+        let all: [BearingMeasurement<f32>; 3] = core::array::from_fn(|k| BearingMeasurement {
             neighbour: [1, 2, 4][k],
-            bearing: Vec2::new(f32_at(m, 8 * k), f32_at(m, 8 * k + 4)),
+            bearing: if angles {
+                let a = f32_at(m, 8 * k);
+                let (sin, cos) = (libm::sinf(a), libm::cosf(a));
+                // A non-finite angle gives a NaN bearing: refused.
+                Vec2::new(cos, sin) * (1.0 + f32_at(m, 8 * k + 4).abs().min(1.0) * 1e-4)
+            } else {
+                Vec2::new(f32_at(m, 8 * k), f32_at(m, 8 * k + 4))
+            },
             rate: None,
             range: None,
         });
+        let mut kept = [all[0]; 3];
+        let mut n = 0;
+        for (k, b) in all.iter().enumerate() {
+            if !(angles && missing & (1 << k) != 0) {
+                kept[n] = *b;
+                n += 1;
+            }
+        }
+        let bearings = &kept[..n];
+        let (dt, vx, vy) = (f32_at(m, 28), f32_at(m, 32), f32_at(m, 36));
+        let (dt, vx, vy) = if angles {
+            (fold(dt.abs(), 0.3), fold(vx, 3.0), fold(vy, 3.0))
+        } else {
+            (dt, vx, vy)
+        };
         let meas = Measurements {
             time: f32_at(m, 24),
-            dt: f32_at(m, 28),
-            velocity: Vec2::new(f32_at(m, 32), f32_at(m, 36)),
-            bearings: &bearings,
+            dt,
+            velocity: Vec2::new(vx, vy),
+            bearings,
             partner_offset: None,
         };
-        for (a, integrity) in agents.iter_mut() {
+        for ((a, integrity), command) in agents.iter_mut().zip(&mut commands) {
             let mut bytes = frame.to_vec();
             if *integrity == Integrity::Crc16 && head & 64 != 0 && bytes.len() >= 2 {
                 let n = bytes.len() - 2;
@@ -185,6 +234,8 @@ fuzz_target!(|data: &[u8]| {
             let out = a.step(&meas);
             assert!(out.force.x.is_finite() && out.force.y.is_finite());
             assert!(out.force.norm() <= limit * 1.0001);
+            let sp = command.step([out.force.x, out.force.y], [vx, vy], dt);
+            assert!(sp.iter().all(|x| x.is_finite()), "{sp:?}");
             let integrity = *integrity;
             a.frames(|f| {
                 assert!(f.len() <= 60);

@@ -108,6 +108,14 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
         &self.stats
     }
 
+    /// The reset counters of the bearing trackers (SPEC §11a, S15c–S15d), per neighbour
+    /// in slot order ([`Agent::neighbours`]): how many times each track restarted after
+    /// its first bearing (a long interval, or agreeing outliers). Always 0 with the
+    /// finite difference.
+    pub fn track_resets(&self) -> impl Iterator<Item = (AgentId, u32)> + '_ {
+        self.neighbours.iter().map(|n| (n.id, n.track.resets))
+    }
+
     /// The bearing to `neighbour` the law uses this tick and its rate (measured, the finite
     /// difference of SPEC §2 or the tracker's of §11; held or predicted within
     /// [`crate::Limits::bearing_hold`] when none was measured, §12), if there is one.

@@ -78,6 +78,12 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 limits: TrackLimits {
                     inv_range_initial: T::one() / self.config.initial_estimate,
                     inv_range_max: T::one() / self.config.min_estimate,
+                    // S15c: the neighbour timeout, or the hold if longer (a held bearing
+                    // is predicted across the hold by design, S18).
+                    max_interval: larger(
+                        self.config.limits.neighbour_timeout,
+                        self.config.limits.bearing_hold,
+                    ),
                 },
             }),
             BearingFilter::FiniteDifference => None,
@@ -176,6 +182,16 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
             }
         }
         Ok(in_order)
+    }
+}
+
+/// The larger of `a` and `b` (`a` when they are not ordered).
+#[inline(always)]
+fn larger<T: Real>(a: T, b: T) -> T {
+    if b > a {
+        b
+    } else {
+        a
     }
 }
 
