@@ -650,6 +650,12 @@ typedef struct {
    * sets the agent's `neighbour_timeout`.
    */
   float max_interval;
+  /**
+   * The time constant of the filter on the second-order lead's jerk (s, ≥ 0; 0 for
+   * none; SPEC S21d): `ph_actuator_set_jerk_filter`; `ph_actuator_init` sets 0. With
+   * it, `accel` holds the filtered acceleration.
+   */
+  float jerk_filter;
 } ph_actuator;
 
 /**
@@ -1248,6 +1254,17 @@ ph_status ph_actuator_init(ph_actuator *actuator,
  * `actuator` is NULL or points to a `ph_actuator`.
  */
 ph_status ph_actuator_set_second_lead(ph_actuator *actuator, float second_lead);
+
+/**
+ * Sets the time constant of the filter on the second-order lead's jerk (s, finite,
+ * ≥ 0; SPEC S21d: 0.03 s for the Crazyflie, docs/world.md) and forgets the kept
+ * acceleration. `PH_ERR_ARGUMENT` (nothing written) for a value that is not finite and
+ * non-negative.
+ *
+ * # Safety
+ * `actuator` is NULL or points to a `ph_actuator`.
+ */
+ph_status ph_actuator_set_jerk_filter(ph_actuator *actuator, float jerk_filter);
 
 /**
  * Sets the gap bound of `*actuator` (m/s, > 0; `INFINITY` for none; SPEC S21c): the

@@ -43,6 +43,10 @@ pub struct ph_actuator {
     /// over a longer `dt` starts again from the measured velocity. `ph_actuator_init`
     /// sets the agent's `neighbour_timeout`.
     pub max_interval: f32,
+    /// The time constant of the filter on the second-order lead's jerk (s, ≥ 0; 0 for
+    /// none; SPEC S21d): `ph_actuator_set_jerk_filter`; `ph_actuator_init` sets 0. With
+    /// it, `accel` holds the filtered acceleration.
+    pub jerk_filter: f32,
 }
 
 /// Fills `*actuator` for `agent`: mass `mass`, the friction `D^r` of the agent's
@@ -82,6 +86,7 @@ pub unsafe extern "C" fn ph_actuator_init(
             has_accel: 0,
             max_gap: plant.max_gap(),
             max_interval: plant.max_interval(),
+            jerk_filter: 0.0,
         };
         // SAFETY: per this function's contract.
         unsafe { write(actuator, value) }
@@ -109,6 +114,35 @@ pub unsafe extern "C" fn ph_actuator_set_second_lead(
         let a = unsafe { input(actuator.cast_const()) }?;
         let updated = ph_actuator {
             second_lead,
+            has_accel: 0,
+            ..*a
+        };
+        // SAFETY: per this function's contract.
+        unsafe { write(actuator, updated) }
+    })();
+    status(r)
+}
+
+/// Sets the time constant of the filter on the second-order lead's jerk (s, finite,
+/// ≥ 0; SPEC S21d: 0.03 s for the Crazyflie, docs/world.md) and forgets the kept
+/// acceleration. `PH_ERR_ARGUMENT` (nothing written) for a value that is not finite and
+/// non-negative.
+///
+/// # Safety
+/// `actuator` is NULL or points to a `ph_actuator`.
+#[no_mangle]
+pub unsafe extern "C" fn ph_actuator_set_jerk_filter(
+    actuator: *mut ph_actuator,
+    jerk_filter: f32,
+) -> ph_status {
+    let r = (|| {
+        if !(jerk_filter.is_finite() && jerk_filter >= 0.0) {
+            return Err(ph_status::PH_ERR_ARGUMENT);
+        }
+        // SAFETY: per this function's contract.
+        let a = unsafe { input(actuator.cast_const()) }?;
+        let updated = ph_actuator {
+            jerk_filter,
             has_accel: 0,
             ..*a
         };
@@ -174,6 +208,7 @@ pub unsafe extern "C" fn ph_actuate(
         let plant = VirtualMass::new(a.mass, a.friction, a.max_speed)
             .and_then(|p| p.with_lead(a.lead))
             .and_then(|p| p.with_second_lead(a.second_lead))
+            .and_then(|p| p.with_jerk_filter(a.jerk_filter))
             .and_then(|p| p.with_max_gap(none_if_zero(a.max_gap)))
             .and_then(|p| p.with_max_interval(none_if_zero(a.max_interval)))
             .map_err(|_| ph_status::PH_ERR_ARGUMENT)?;

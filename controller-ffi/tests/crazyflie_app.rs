@@ -199,7 +199,7 @@ fn app_code_converges_four_simulated_crazyflies() {
 /// `rms=` and `max=` of `cfapp-host --position-noise SIGMA --seconds 60`.
 fn shape_error(program: &Path, sigma: &str) -> (f64, f64) {
     let out = Command::new(program)
-        .args(["--position-noise", sigma, "--seconds", "60"])
+        .args(["--position-noise", sigma, "--seconds", "120"])
         .output()
         .expect("run cfapp-host");
     let log = String::from_utf8_lossy(&out.stdout).into_owned();
@@ -219,11 +219,11 @@ fn shape_error(program: &Path, sigma: &str) -> (f64, f64) {
 
 /// docs/crazyflie.md's position-accuracy table, on two independent bases:
 /// * **linearity**: the closed loop is linear about the square, so well above the
-///   noise-free floor (0.17 mm, the table's σ = 0 row) the shape error's RMS is
-///   proportional to σ: RMS(3 cm) / RMS(1 cm) = 3 within 10 % (the floor adds under 1 %
-///   in quadrature; the rest is the spread of an RMS over 1,000 correlated samples of
-///   the last 10 s; measured 3.03). A sensor whose noise did not reach the bearings, or
-///   reached them squared, fails it;
+///   noise-free transient left at 120 s (0.11 mm, the table's σ = 0 row) the shape
+///   error's RMS is proportional to σ: RMS(3 mm) / RMS(1 mm) = 3 within 10 % (the
+///   transient and the spread of an RMS over 1,000 correlated samples of the last 10 s;
+///   measured 2.90). A sensor whose noise did not reach the bearings, or reached them
+///   squared, fails it;
 /// * **the table itself** at the two σ: 2 % (the C program is deterministic; the margin
 ///   covers another host compiler's float contraction).
 #[test]
@@ -247,7 +247,7 @@ fn position_accuracy_table_is_measured() {
             .collect();
         let close = |a: f64, b: f64| (a - b).abs() <= 0.02 * b.abs();
         assert!(
-            cells.len() == 3 && close(cells[1], rms) && close(cells[2], max),
+            cells.len() == 5 && close(cells[1], rms) && close(cells[2], max),
             "docs/crazyflie.md states {row:?}; measured rms {rms}, max {max}: update it"
         );
     }

@@ -27,6 +27,8 @@ ph_status agent_loop_init(agent_loop *loop, uint8_t *memory, size_t size, uint8_
                              FORMATION_LEAD);
     if (s == PH_OK)
         s = ph_actuator_set_second_lead(&loop->actuator, FORMATION_SECOND_LEAD);
+    if (s == PH_OK)
+        s = ph_actuator_set_jerk_filter(&loop->actuator, FORMATION_JERK_FILTER);
     if (s == PH_OK && FORMATION_MAX_GAP > 0.0f)
         s = ph_actuator_set_max_gap(&loop->actuator, FORMATION_MAX_GAP);
     if (s == PH_OK)

@@ -46,6 +46,12 @@
 #ifndef FORMATION_SECOND_LEAD
 #define FORMATION_SECOND_LEAD 0.03895f
 #endif
+/* The filter on the second-order lead's jerk (s, SPEC S21d): keeps the velocity noise,
+ * differenced twice, out of the setpoints the 100 Hz velocity loop samples on its own
+ * clock (docs/world.md measures 0 to 0.1 s). 0 turns it off. */
+#ifndef FORMATION_JERK_FILTER
+#define FORMATION_JERK_FILTER 0.03f
+#endif
 /* Gap bound (m/s, SPEC S21c): the virtual velocity stays within this of the measured
  * one, so that a blocked or saturated Crazyflie does not wind it up. Half the speed
  * limit: a following Crazyflie lags by FORMATION_LEAD times the virtual acceleration
