@@ -62,8 +62,9 @@ pub mod results {
     pub use crate::engine::attack::AttackCounts;
     pub use crate::engine::channel::ChannelStats;
     pub use crate::engine::hil::LinkStats;
-    pub use crate::engine::{ControlStats, FrameCounts, FrameReasons};
+    pub use crate::engine::{ControlStats, FaultReport, FrameCounts, FrameReasons};
     pub use crate::model::EstimateInfo;
+    pub use crate::model::{FaultKind, FaultModel};
     pub use crate::report::PlotError;
     pub use ph_formation_core::policy::PolicyCounts;
 }

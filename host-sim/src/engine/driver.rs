@@ -139,6 +139,7 @@ pub fn drive(
     let policy = engine.policy_counts();
     let frames = engine.frame_counts();
     let loss = engine.loss_by_sender();
+    let faults = engine.fault_reports();
     let (q, v, est) = engine.view();
     let verdict = sim
         .monitor
@@ -178,6 +179,9 @@ pub fn drive(
         warnings.push(note);
     }
     let names: Vec<&str> = model.agents.iter().map(|a| a.name.as_str()).collect();
+    for f in &faults {
+        reason = format!("{reason}; fault: {}", f.note(&names));
+    }
     if let Some(note) = super::channel::lossy_note(&loss, &names) {
         if verdict.outcome != crate::analysis::Outcome::Converged {
             reason = format!("{reason}; {note}");
@@ -221,6 +225,7 @@ pub fn drive(
         channel,
         attacks: engine.attack_counts(),
         policy,
+        faults,
         warnings,
         steps: sim.steps,
         wall_seconds: started.elapsed().as_secs_f64(),

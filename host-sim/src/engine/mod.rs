@@ -41,4 +41,4 @@ pub use result::RunResult;
 pub use sampled::{direct_radio, SampledSim};
 pub use simulator::Engine;
 pub use speed::PARALLEL_MIN_AGENTS;
-pub use stats::{ControlStats, FrameCounts, FrameReasons};
+pub use stats::{ControlStats, FaultReport, FrameCounts, FrameReasons};

@@ -65,6 +65,8 @@ pub struct RunResult {
     /// and the last one's reason, setpoints the separation guard changed (empty
     /// without `[policy]`; `crate::engine::policy`).
     pub policy: Vec<ph_formation_core::policy::PolicyCounts>,
+    /// What the swarm did after each fault (`[[faults]]` order; empty without).
+    pub faults: Vec<super::stats::FaultReport>,
     /// Things the user should know (ignored settings, …).
     pub warnings: Vec<String>,
     /// RK4 steps taken.

@@ -23,6 +23,7 @@
 mod actuation;
 mod delivery;
 mod estimates;
+mod faults;
 mod parallel;
 mod sensing;
 mod statistics;
@@ -71,6 +72,8 @@ pub struct SampledSim<'m> {
     senses: Senses,
     /// The mailboxes and the radio.
     delivery: Delivery,
+    /// Faults of the flight (`[[faults]]`) and what the swarm did about them.
+    faults: faults::Faults,
     /// Statistics: the estimates the diagnostics read, and the controllers' outputs.
     estimates: Estimates,
     stats: ControlStats,
@@ -120,7 +123,11 @@ impl<'m> SampledSim<'m> {
         let senses = Senses::new(model, period);
         // Agents on their own clocks hear frames through the radio's queue, and so do
         // those of a bearing sensor that sends packets of its own.
-        let direct = direct_radio(model) && model.world.clock.is_none() && !senses.uses_radio();
+        // And so do faulty agents' neighbours (a deaf agent's inbox is emptied).
+        let direct = direct_radio(model)
+            && model.world.clock.is_none()
+            && !senses.uses_radio()
+            && model.faults.is_empty();
         let slot_order = SlotOrder::for_model(model, |i| controllers[i].neighbour_order());
         Ok(Self {
             model,
@@ -133,6 +140,7 @@ impl<'m> SampledSim<'m> {
             world: WorldState::new(model),
             senses,
             delivery: Delivery::new(model, direct),
+            faults: faults::Faults::new(model),
             estimates,
             stats: ControlStats::with_window(crate::analysis::steady::Window::of(model).from),
             error: None,
@@ -196,6 +204,7 @@ impl SampledSim<'_> {
             && rayon::current_num_threads() > 1
             && self.world.clocks.is_none()
             && self.actuation.policy.is_none()
+            && !self.faults.any()
     }
 
     /// Every due agent's tick started ([`Walk::start`]), in agent order: every agent at
@@ -225,6 +234,10 @@ impl SampledSim<'_> {
             let Some(at) = self.world.tick_of(i, at) else {
                 continue;
             };
+            if self.faults.down(i, at.time) {
+                inbox.clear();
+                continue;
+            }
             let (a, b) = (est.start[i], est.start[i + 1]);
             let mut slots = AgentSlots {
                 controller,
@@ -285,6 +298,24 @@ impl SampledSim<'_> {
         }
     }
 
+    /// The faults at `t`: a reboot gives its agent a new controller from its
+    /// configuration (the core's state lost) and restarts its actuation; every agent's
+    /// radio is on or off.
+    fn apply_faults(&mut self, t: f64) {
+        for i in self.faults.reboots_due(t) {
+            if let (true, Ok(fresh)) = (self.local, local_core(self.model, i)) {
+                self.controllers[i] = fresh;
+                self.footprints[i] = Footprint::of(&*self.controllers[i]);
+            }
+            self.plant.restart(i);
+        }
+        let n = self.model.n();
+        self.delivery.deaf.resize(n, false);
+        for i in 0..n {
+            self.delivery.deaf[i] = self.faults.deaf(i, t);
+        }
+    }
+
     /// Agent `i`'s output of its tick: the one its tick gave, or a remote controller's
     /// (its estimates copied when viewed); `None` after a failure (kept in `self.error`).
     fn output_of(&mut self, i: usize) -> Option<StepOutput<f64>> {
@@ -321,6 +352,9 @@ impl Engine for SampledSim<'_> {
         let model = self.model;
         // Set again once every agent's tick copied its estimates.
         self.estimates.fresh = false;
+        if self.faults.any() {
+            self.apply_faults(t);
+        }
         let sensor = &mut self.senses.bearing;
         self.delivery
             .receive(model, t, self.ticks, self.plant.q(), sensor);
@@ -351,11 +385,25 @@ impl Engine for SampledSim<'_> {
             let Some(at) = self.world.tick_of(i, at) else {
                 continue;
             };
+            if self.faults.any() && self.faults.down(i, at.time) {
+                // Down: no output, nothing sent; the vehicle holds still.
+                self.delivery.outboxes[i].clear();
+                self.actuation.forces[i] = Vec2::zeros();
+                self.plant.set_velocity_setpoint(i, Vec2::zeros());
+                continue;
+            }
             let Some(out) = self.output_of(i) else {
                 return;
             };
-            let sensor = self.senses.bearing.as_deref_mut();
-            self.delivery.send(model, t, i, self.plant.q(), sensor);
+            if self.faults.any() {
+                self.faults.observe(i, at.time, out.status);
+            }
+            if self.faults.any() && self.faults.deaf(i, at.time) {
+                self.delivery.outboxes[i].clear();
+            } else {
+                let sensor = self.senses.bearing.as_deref_mut();
+                self.delivery.send(model, t, i, self.plant.q(), sensor);
+            }
             let headings = self.world.headings.as_ref();
             self.actuation
                 .apply(model, &mut *self.plant, headings, i, &out, &at);
@@ -422,6 +470,10 @@ impl Engine for SampledSim<'_> {
             .policy
             .as_ref()
             .map_or_else(Vec::new, super::policy::PolicyRun::counts)
+    }
+
+    fn fault_reports(&self) -> Vec<super::stats::FaultReport> {
+        self.faults.reports()
     }
 
     fn loss_by_sender(&self) -> Vec<(u64, u64)> {

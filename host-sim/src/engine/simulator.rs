@@ -56,6 +56,10 @@ pub trait Engine {
     fn loss_by_sender(&self) -> Vec<(u64, u64)> {
         Vec::new()
     }
+    /// What the swarm did after each fault (`[[faults]]` order; none by default).
+    fn fault_reports(&self) -> Vec<super::stats::FaultReport> {
+        Vec::new()
+    }
     /// What the safety policies did, per agent (empty without `[policy]`).
     fn policy_counts(&self) -> Vec<ph_formation_core::policy::PolicyCounts> {
         Vec::new()

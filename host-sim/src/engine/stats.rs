@@ -3,6 +3,7 @@
 use ph_formation_core::FrameStats;
 
 use crate::analysis::control::WindowCounts;
+use crate::model::FaultModel;
 use ph_formation_core::{Fault, Status};
 
 /// Cumulative frame counters of a run (link copies; see `docs/outputs.md`).
@@ -223,5 +224,62 @@ mod tests {
             assert_eq!(named, [1, 2]);
         }
         assert_eq!(direct, merged);
+    }
+}
+
+/// What the swarm did after one fault.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FaultReport {
+    /// The fault.
+    pub fault: FaultModel,
+    /// The agents (indices) that took their safe output after it struck, with the time
+    /// of their first safe tick.
+    pub went_safe: Vec<(usize, f64)>,
+    /// Of those, and of a rebooted agent, the ones whose control law ran again after
+    /// the fault ended, with the time of their first nominal tick since.
+    pub recovered: Vec<(usize, f64)>,
+}
+
+impl FaultReport {
+    /// The fault and what the swarm did, in words, with the agents' scenario ids
+    /// `names`: "reboot of agent 10 at 30 s for 2 s: agents 9, 11 went to their safe
+    /// output (30.01–30.02 s); 9, 10, 11 came back (32.3–33.1 s)".
+    pub fn note(&self, names: &[&str]) -> String {
+        let f = &self.fault;
+        let name = |i: usize| names.get(i).copied().unwrap_or("?").to_owned();
+        let who = f.agent.map_or_else(
+            || "every agent".to_owned(),
+            |a| format!("agent {}", name(a)),
+        );
+        let mut s = format!("{} of {who} at {} s", f.kind.as_str(), f.t);
+        if f.end.is_finite() {
+            s += &format!(" for {} s", f.end - f.t);
+        }
+        let list = |v: &[(usize, f64)]| {
+            let ids: Vec<String> = v.iter().map(|(a, _)| name(*a)).collect();
+            let lo = v.iter().map(|x| x.1).fold(f64::INFINITY, f64::min);
+            let hi = v.iter().map(|x| x.1).fold(f64::NEG_INFINITY, f64::max);
+            let span = if hi > lo {
+                format!("{lo:.2}–{hi:.2} s")
+            } else {
+                format!("{lo:.2} s")
+            };
+            (ids.join(", "), span)
+        };
+        if self.went_safe.is_empty() {
+            s += ": no agent went to its safe output";
+        } else {
+            let (ids, span) = list(&self.went_safe);
+            s += &format!(": agents {ids} went to their safe output ({span})");
+        }
+        if self.recovered.is_empty() {
+            if f.end.is_finite() {
+                s += "; none came back to its control law";
+            }
+        } else {
+            let (ids, span) = list(&self.recovered);
+            s += &format!("; {ids} came back to the control law ({span})");
+        }
+        s
     }
 }

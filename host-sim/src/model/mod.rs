@@ -13,6 +13,7 @@ mod criteria;
 mod devices;
 mod error;
 pub mod estimates;
+pub mod faults;
 mod formation;
 pub mod geometry;
 pub mod graph;
@@ -32,6 +33,7 @@ pub use devices::PositionsModel;
 pub use devices::{CameraModel, RadioDepartures, RadioModel, SensorDepartures, SensorModel};
 pub use error::ModelError;
 pub use estimates::{estimate_layout, resolve_estimates, EstimateInfo};
+pub use faults::{FaultKind, FaultModel, FAULT_KINDS};
 pub use formation::{AgentModel, AngleModel, LeaderModel, TriangleModel};
 pub use graph::Graph;
 pub use options::{BearingRate, Estimator, Mode};
@@ -102,6 +104,8 @@ pub struct Model {
     pub target: Target,
     /// Adversaries on the radio (`[[attacks]]`; empty: none).
     pub attacks: Vec<AttackModel>,
+    /// Faults of the flight (`[[faults]]`; empty: none).
+    pub faults: Vec<FaultModel>,
     /// The robot's world: vehicle, wind, headings, clocks (`docs/world.md`).
     pub world: WorldModel,
     /// The vehicles' safety policies (`[policy]`; `None`: none run).

@@ -7,6 +7,7 @@ mod attack;
 mod channel;
 mod columns;
 mod csv;
+mod faults;
 mod mcap;
 pub mod plot;
 pub mod replay;

@@ -150,6 +150,7 @@ pub fn summary_json(model: &Model, r: &RunResult, estimates: &[EstimateInfo]) ->
         }
         super::channel::add_json(obj, model, r);
         super::attack::add_json(obj, model, r);
+        super::faults::add_json(obj, model, r);
         super::world::add_json(obj, model);
     }
     // Host-in-the-loop runs only (wall-clock figures would make summaries of the same

@@ -7,6 +7,7 @@
 
 mod builtin;
 pub mod error;
+pub mod faults;
 pub mod policy;
 mod schema;
 mod settings;

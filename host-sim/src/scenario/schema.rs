@@ -258,6 +258,9 @@ pub struct ScenarioFile {
     /// `[[attacks]]`: adversaries on the radio (`docs/attacks.md`).
     #[serde(default)]
     pub attacks: Vec<AttackSpec>,
+    /// `[[faults]]`: faults of a real flight (`docs/faults.md`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub faults: Vec<super::faults::FaultSpec>,
     /// `world`: a preset of the robot's world (`ideal`, `crazyflie`; `docs/world.md`),
     /// merged under the file.
     #[serde(default)]

@@ -81,6 +81,7 @@ pub fn strip_model(n: usize, duration: f64) -> Result<Model, ScenarioErrors> {
         criteria: Criteria::default(),
         graph: Graph::new(n, &tri, None),
         attacks: Vec::new(),
+        faults: Vec::new(),
         world: crate::model::WorldModel::ideal(),
         policy: None,
         start_tolerance: 0.3,

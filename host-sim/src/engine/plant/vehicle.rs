@@ -38,6 +38,9 @@ pub trait Plant: Send + Sync {
     fn set_velocity_setpoint(&mut self, _i: usize, _setpoint: Vec2<f64>) -> bool {
         false
     }
+    /// Agent `i`'s actuation starts again from its measured velocity at its next
+    /// command (a rebooted agent's state is lost; nothing for a point mass).
+    fn restart(&mut self, _i: usize) {}
     /// Agent `i`'s tilt from vertical (rad), if the vehicle models one.
     fn tilt(&self, _i: usize) -> Option<f64> {
         None
@@ -99,6 +102,13 @@ impl Setpoints {
         if let (Some(c), Some(v), Some(sp)) = (c, v, sp) {
             let next = c.step([force.x, force.y], [v.x, v.y], period);
             *sp = Vec2::new(next[0], next[1]);
+        }
+    }
+
+    /// Agent `i`'s virtual mass starts again from the measured velocity.
+    pub(crate) fn restart(&mut self, i: usize) {
+        if let Some(c) = self.command.get_mut(i) {
+            c.restart();
         }
     }
 

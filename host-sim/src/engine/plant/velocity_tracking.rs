@@ -82,6 +82,10 @@ impl Plant for VelocityTrackingPlant {
         self.setpoints.command(i, force, &self.v, period);
     }
 
+    fn restart(&mut self, i: usize) {
+        self.setpoints.restart(i);
+    }
+
     fn set_velocity_setpoint(&mut self, i: usize, setpoint: Vec2<f64>) -> bool {
         self.setpoints.set(i, setpoint)
     }

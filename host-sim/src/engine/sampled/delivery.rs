@@ -44,6 +44,9 @@ pub(super) struct Delivery {
     pub(super) sent: Vec<Vec<RadioFrame>>,
     /// Frames bypass [`Radio`]'s queue ([`direct_radio`]).
     pub(super) direct: bool,
+    /// Agents whose radio is off at this tick (`[[faults]]`): what the radio delivers to
+    /// them is dropped before anyone reads it.
+    pub(super) deaf: Vec<bool>,
 }
 
 impl Delivery {
@@ -80,6 +83,7 @@ impl Delivery {
             outboxes: (0..n).map(|_| outbox()).collect(),
             sent: (0..if direct { n } else { 0 }).map(|_| outbox()).collect(),
             direct,
+            deaf: Vec::new(),
         }
     }
 
@@ -106,6 +110,9 @@ impl Delivery {
             self.attacks.tick(t, period, q, model, &mut self.radio);
         }
         self.radio.deliver(t, &mut self.inboxes);
+        for (inbox, _) in self.inboxes.iter_mut().zip(&self.deaf).filter(|(_, d)| **d) {
+            inbox.clear();
+        }
         if let Some(s) = sensor.as_deref_mut() {
             s.hear_radio(t, tick, q, &mut self.inboxes);
         }

@@ -8,6 +8,7 @@ mod attacks;
 mod camera;
 mod checker;
 mod comm;
+mod faults;
 mod graph;
 mod model;
 mod policy;
@@ -74,6 +75,7 @@ fn check(
     let order = graph::check(&mut c, s, &agents, &triangles, ids_ok, margin);
     let leader = references::leader(&mut c, s, &index);
     let attacks = attacks::check(&mut c, s, &index);
+    let faults = faults::check(&mut c, s, &index);
     let velocity_reference = c.schedule("velocity_reference", &s.velocity_reference);
     let tri_idx: Vec<[usize; 3]> = triangles.iter().map(|t| t.vertices).collect();
     let graph = Graph::new(agents.len(), &tri_idx, leader.as_ref().map(|l| [l.a, l.b]));
@@ -150,6 +152,7 @@ fn check(
         criteria: s.criteria.clone(),
         graph,
         attacks,
+        faults,
         target,
         world,
         start_tolerance: s.policy.as_ref().map_or(0.3, |p| p.start_tolerance_m),
