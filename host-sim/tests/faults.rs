@@ -106,6 +106,62 @@ fn a_blackout_of_every_radio_is_ridden_out() {
     assert!(f.recovered.iter().all(|x| x.1 >= 21.0 - 1e-9));
 }
 
+/// Agent 10's clock jumps half a second ahead, or back, at 30 s: it takes its safe
+/// output for the one tick whose interval the jump spoils (the neighbours' data looks
+/// 0.5 s old, or the interval is negative) and runs its law at the next; the strip stays
+/// converged.
+#[test]
+fn a_clock_jump_costs_one_tick() {
+    for jump in ["0.5", "-0.5"] {
+        let r = run(
+            &format!("[[faults]]\nkind = \"clock_jump\"\nagent = 10\nt = 30.0\njump_s = {jump}\n"),
+            60.0,
+        );
+        assert_eq!(r.outcome, Outcome::Converged, "{jump}: {}", r.reason);
+        let f = &r.faults[0];
+        assert_eq!(f.went_safe, vec![(10, 30.0)], "{jump}: {:?}", f.went_safe);
+        assert_eq!(f.recovered.len(), 1, "{jump}: {:?}", f.recovered);
+        assert!((f.recovered[0].1 - 30.01).abs() < 1e-9, "{:?}", f.recovered);
+    }
+}
+
+/// A burst of random bearings at agent 10 for 1 s: the bearing tracker's gate and its
+/// recovery rules (SPEC §11a) ride it out and the strip stays converged. Negative
+/// control: the finite-difference path (the ideal world's default, no gate) turns the
+/// same burst into an estimate collapse (docs/faults.md).
+#[test]
+fn an_outlier_burst_is_ridden_out_by_the_tracker_not_by_finite_differences() {
+    let burst = "[[faults]]\nkind = \"outlier_burst\"\nagent = 10\nt = 30.0\nduration = 1.0\n";
+    let text = format!("{}\n{burst}", strip20());
+    let go = |filter: &str| {
+        let set = [
+            "duration=90".to_owned(),
+            format!("sensors.bearing_filter={filter}"),
+        ];
+        let m = load_toml(&text, "strip20-burst", &set).unwrap_or_else(|e| panic!("{e}"));
+        sim::run(&m, &mut NullRecorder, &mut |_| {}).expect("run")
+    };
+    let tracked = go("tracker");
+    assert_eq!(tracked.outcome, Outcome::Converged, "{}", tracked.reason);
+    let raw = go("none");
+    assert_eq!(raw.outcome, Outcome::EstimateCollapse, "{}", raw.reason);
+}
+
+/// Agent 10's sensors freeze for 5 s at 2 s, while the strip is still forming: it acts on
+/// stale bearings and velocity (its settle time grows from 10.6 s to about 27 s: the
+/// freeze took effect) and the strip converges once its sensors are back.
+#[test]
+fn a_frozen_sensor_delays_the_formation_and_it_recovers() {
+    let clean = run("", 60.0);
+    let frozen = run(
+        "[[faults]]\nkind = \"sensor_freeze\"\nagent = 10\nt = 2.0\nduration = 5.0\n",
+        60.0,
+    );
+    assert_eq!(frozen.outcome, Outcome::Converged, "{}", frozen.reason);
+    let (a, b) = (clean.settle_time.unwrap(), frozen.settle_time.unwrap());
+    assert!(b > a + 10.0, "settled at {b} s, {a} s without the freeze");
+}
+
 /// Mistakes are refused naming the entry and the field.
 #[test]
 fn fault_mistakes_name_the_field() {
@@ -123,11 +179,21 @@ fn fault_mistakes_name_the_field() {
         "{e}"
     );
     let e = refused(
-        "[[faults]]\nkind = \"sensor_freeze\"\nagent = 1\nt = 1.0\nduration = 1.0\n",
+        "[[faults]]\nkind = \"sensor_freeze\"\nagent = 1\nt = 1.0\n",
+        &[],
+    );
+    assert!(e.contains("faults[0].duration"), "{e}");
+    let e = refused(
+        "[[faults]]\nkind = \"clock_jump\"\nagent = 1\nt = 1.0\n",
+        &[],
+    );
+    assert!(e.contains("faults[0].jump_s"), "{e}");
+    let e = refused(
+        "[[faults]]\nkind = \"reboot\"\nagent = 1\nt = 1.0\nduration = 1.0\njump_s = 1.0\n",
         &[],
     );
     assert!(
-        e.contains("faults[0].kind") && e.contains("not simulated yet"),
+        e.contains("faults[0].jump_s") && e.contains("clock_jump"),
         "{e}"
     );
     let e = refused("[[faults]]\nkind = \"reboot\"\nagent = 1\nt = 1.0\n", &[]);

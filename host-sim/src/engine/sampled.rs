@@ -221,6 +221,7 @@ impl SampledSim<'_> {
             sent: &self.delivery.sent,
             footprints: &self.footprints,
             copy_estimates: self.estimates.viewed,
+            faults: self.faults.any().then_some(&self.faults),
         };
         let each = self
             .controllers
@@ -268,6 +269,7 @@ impl SampledSim<'_> {
             sent: &self.delivery.sent,
             footprints: &self.footprints,
             copy_estimates: self.estimates.viewed,
+            faults: self.faults.any().then_some(&self.faults),
         };
         // Each agent's parts (the slices are disjoint fields).
         let sums = tick_all(

@@ -232,8 +232,8 @@ mod tests {
 pub struct FaultReport {
     /// The fault.
     pub fault: FaultModel,
-    /// The agents (indices) that took their safe output after it struck, with the time
-    /// of their first safe tick.
+    /// The agents (indices) that took their safe output while it acted or within 1 s
+    /// after (after it struck, for a loss), with the time of their first safe tick.
     pub went_safe: Vec<(usize, f64)>,
     /// Of those, and of a rebooted agent, the ones whose control law ran again after
     /// the fault ended, with the time of their first nominal tick since.
@@ -252,8 +252,11 @@ impl FaultReport {
             |a| format!("agent {}", name(a)),
         );
         let mut s = format!("{} of {who} at {} s", f.kind.as_str(), f.t);
-        if f.end.is_finite() {
-            s += &format!(" for {} s", f.end - f.t);
+        if f.jump != 0.0 {
+            s += &format!(" by {} s", f.jump);
+        } else if f.end.is_finite() {
+            // The duration as written (the subtraction's last bits dropped).
+            s += &format!(" for {} s", ((f.end - f.t) * 1e9).round() / 1e9);
         }
         let list = |v: &[(usize, f64)]| {
             let ids: Vec<String> = v.iter().map(|(a, _)| name(*a)).collect();
@@ -273,7 +276,7 @@ impl FaultReport {
             s += &format!(": agents {ids} went to their safe output ({span})");
         }
         if self.recovered.is_empty() {
-            if f.end.is_finite() {
+            if f.end.is_finite() && !self.went_safe.is_empty() {
                 s += "; none came back to its control law";
             }
         } else {

@@ -14,10 +14,26 @@ pub enum FaultKind {
     /// From `t` for `duration` the agent's radio (or, without an agent, every radio)
     /// neither sends nor hears: frames and position packets.
     RadioBlackout,
+    /// At `t` the agent's clock jumps by `jump` seconds (forward, or back when
+    /// negative): every time its controller reads from then on is off by that much.
+    ClockJump,
+    /// From `t` for `duration` every bearing the agent measures points in a random
+    /// direction (a detector gone wrong).
+    OutlierBurst,
+    /// From `t` for `duration` the agent's sensors stop updating: it reads, at every
+    /// tick, the bearings, velocity and leader offset of its tick at `t`.
+    SensorFreeze,
 }
 
 /// The `kind` names the schema accepts, in [`FaultKind`] order.
-pub const FAULT_KINDS: &[&str] = &["agent_loss", "reboot", "radio_blackout"];
+pub const FAULT_KINDS: &[&str] = &[
+    "agent_loss",
+    "reboot",
+    "radio_blackout",
+    "clock_jump",
+    "outlier_burst",
+    "sensor_freeze",
+];
 
 impl FaultKind {
     /// The name used in files and `summary.json`.
@@ -26,6 +42,9 @@ impl FaultKind {
             Self::AgentLoss => "agent_loss",
             Self::Reboot => "reboot",
             Self::RadioBlackout => "radio_blackout",
+            Self::ClockJump => "clock_jump",
+            Self::OutlierBurst => "outlier_burst",
+            Self::SensorFreeze => "sensor_freeze",
         }
     }
 }
@@ -39,8 +58,10 @@ pub struct FaultModel {
     pub agent: Option<usize>,
     /// When it strikes (s).
     pub t: f64,
-    /// When it ends (s; infinity for `agent_loss`).
+    /// When it ends (s; infinity for `agent_loss`, `t` for `clock_jump`, an instant).
     pub end: f64,
+    /// `clock_jump`: the jump (s); 0 for the other kinds.
+    pub jump: f64,
 }
 
 impl FaultModel {

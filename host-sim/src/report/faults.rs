@@ -33,6 +33,7 @@ pub(super) fn add_json(obj: &mut Map<String, Value>, m: &Model, r: &RunResult) {
                 "agent": f.fault.agent.map_or(Value::Null, id),
                 "t_s": f.fault.t,
                 "end_s": if f.fault.end.is_finite() { json!(f.fault.end) } else { Value::Null },
+                "jump_s": f.fault.jump,
                 "went_safe": who(&f.went_safe),
                 "recovered": who(&f.recovered),
             })

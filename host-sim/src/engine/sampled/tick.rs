@@ -37,6 +37,9 @@ pub(super) struct Walk<'a> {
     pub(super) footprints: &'a [Footprint],
     /// Each agent copies its estimates after its tick (`SampledSim`'s `viewed`).
     pub(super) copy_estimates: bool,
+    /// The faults that change what an agent measures or reads on its clock
+    /// (`[[faults]]`: clock jumps, outlier bursts); `None` without faults.
+    pub(super) faults: Option<&'a super::faults::Faults>,
 }
 
 /// One agent's part of a tick: its controller, mailboxes, force and estimates.
@@ -81,9 +84,25 @@ impl Walk<'_> {
             partner_offset = partner_offset.map(|p| f.sensed(&p));
         }
         self.slot_order.apply(i, &mut bearings);
+        // A clock jump moves the agent's reading (and, once, its interval); an outlier
+        // burst turns its bearings (docs/faults.md).
+        let (mut time, mut dt) = (at.time, at.dt);
+        if let Some(f) = self.faults {
+            f.freeze(
+                i,
+                at.time,
+                &mut bearings,
+                &mut velocity,
+                &mut partner_offset,
+            );
+            let off = f.clock_offset(i, at.time);
+            time += off;
+            dt += off - f.clock_offset(i, at.time - at.dt);
+            f.corrupt(i, at.time, at.tick, &mut bearings);
+        }
         let m = Measurements {
-            time: at.time,
-            dt: at.dt,
+            time,
+            dt,
             velocity,
             bearings: &bearings,
             partner_offset,

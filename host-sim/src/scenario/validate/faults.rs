@@ -28,18 +28,9 @@ pub(super) fn check(
             "agent_loss" => Some(FaultKind::AgentLoss),
             "reboot" => Some(FaultKind::Reboot),
             "radio_blackout" => Some(FaultKind::RadioBlackout),
-            "sensor_freeze" | "clock_jump" | "outlier_burst" => {
-                c.err(
-                    InvalidValue,
-                    &field("kind"),
-                    format!(
-                        "`{}` is not simulated yet (issue 45); the kinds are {}",
-                        f.kind,
-                        FAULT_KINDS.join(", ")
-                    ),
-                );
-                None
-            }
+            "clock_jump" => Some(FaultKind::ClockJump),
+            "outlier_burst" => Some(FaultKind::OutlierBurst),
+            "sensor_freeze" => Some(FaultKind::SensorFreeze),
             other => {
                 c.err(
                     InvalidValue,
@@ -71,16 +62,45 @@ pub(super) fn check(
                 continue;
             }
         };
+        let jump = match (kind, f.jump_s) {
+            (Some(FaultKind::ClockJump), Some(j)) if j.is_finite() && j != 0.0 => j,
+            (Some(FaultKind::ClockJump), j) => {
+                c.err(
+                    InvalidValue,
+                    &field("jump_s"),
+                    format!(
+                        "a clock_jump needs a finite jump ≠ 0 s, got {}",
+                        j.map_or("none".to_owned(), |j| j.to_string())
+                    ),
+                );
+                continue;
+            }
+            (_, Some(_)) => {
+                c.err(
+                    InvalidValue,
+                    &field("jump_s"),
+                    format!("only a clock_jump has it (this one is `{}`)", f.kind),
+                );
+                continue;
+            }
+            (_, None) => 0.0,
+        };
         let end = match (kind, f.duration) {
-            (Some(FaultKind::AgentLoss), Some(_)) => {
+            (Some(k @ (FaultKind::AgentLoss | FaultKind::ClockJump)), Some(_)) => {
                 c.err(
                     InvalidValue,
                     &field("duration"),
-                    "an agent_loss lasts to the end of the run (use reboot for an agent that comes back)",
+                    if k == FaultKind::AgentLoss {
+                        "an agent_loss lasts to the end of the run (use reboot for an agent that comes back)"
+                    } else {
+                        "a clock_jump is an instant (its size is jump_s)"
+                    },
                 );
                 continue;
             }
             (Some(FaultKind::AgentLoss), None) => f64::INFINITY,
+            // An instant: recovery counts from it on.
+            (Some(FaultKind::ClockJump), None) => f.t,
             (Some(_), Some(d)) if d.is_finite() && d > 0.0 => f.t + d,
             (Some(k), d) => {
                 c.err(
@@ -105,6 +125,7 @@ pub(super) fn check(
                 agent,
                 t: f.t,
                 end,
+                jump,
             });
         }
     }
