@@ -12,6 +12,15 @@ use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
 
+/// A number of the camera's configuration in `summary.json` (`world.sensors.camera.KEY`,
+/// or `world.camera.KEY`), if the run recorded one.
+fn camera(summary: &Value, key: &str) -> Option<f64> {
+    let w = &summary["world"];
+    w["sensors"]["camera"][key]
+        .as_f64()
+        .or_else(|| w["camera"][key].as_f64())
+}
+
 /// Every `stride`-th of `valid` rows and the last one.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct Stride {
@@ -337,6 +346,9 @@ impl ReplayData {
             "n_edges": self.n_edges,
             "leaders": self.leaders.map(|(a, b)| [a, b]),
             "rows": self.rows,
+            "fov": camera(s, "fov_deg").map(|d| d.to_radians() / 2.0),
+            "camera_range": camera(s, "range_m"),
+            "heading_nominal": s["world"]["heading"]["initial_deg"].as_f64().map(f64::to_radians),
         });
         let mut out = head.to_string();
         out.pop(); // the closing brace: the arrays follow
