@@ -65,6 +65,15 @@ where
             Key::Line(OTHERS, 1),
         ));
     }
+    if !many && run.angles.len() > 1 {
+        entries.push(entry(
+            format!(
+                "angles side by side (offset up to ±{} px)",
+                fan_offset(run.angles.len() - 1, run.angles.len())
+            ),
+            Key::None,
+        ));
+    }
     if run.n_angles == 0 {
         entries.push(entry("(no angle columns)", Key::None));
     }
@@ -113,13 +122,16 @@ where
                 bitmap,
             )?;
         }
+        stroke(chart.plotting_area(), &max_series, DARK, 3, false, bitmap)?;
     } else {
+        // The maximum under the angles, and the angles side by side: none hides another.
+        stroke(chart.plotting_area(), &max_series, DARK, 3, false, bitmap)?;
         for (i, pts) in series.iter().enumerate() {
-            stroke(chart.plotting_area(), pts, colour(i), 2, false, bitmap)?;
+            let offset = fan_offset(i, series.len());
+            stroke_offset(chart.plotting_area(), pts, colour(i), 2, offset, bitmap)?;
         }
     }
     let area = chart.plotting_area();
-    stroke(area, &max_series, DARK, 3, false, bitmap)?;
     let from = window.map_or(t0, |w| w.clamp(t0, t1));
     let threshold = [(from, line), (t1, line)];
     stroke(area, &threshold, LEADER, 2, true, bitmap)?;
