@@ -630,6 +630,44 @@ fn replay_layout_scale_and_first_frame_in_headless_chromium() {
     let (_, layout) = probe_layout(&profile, &old_page, "probe=first", (1200, 900));
     assert!(!legend_and_controls_in_view(&layout), "{layout}");
 
+    // Cameras: with a field of view and range in the data (summary.json's
+    // world.sensors.camera) a pale blue wedge per agent, at the world's nominal heading;
+    // without them none.
+    let mut d = page_data(&html);
+    let wedge_pixels = |d: &Value, name: &str| {
+        let page = tmp.path().join(format!("{name}.html"));
+        std::fs::write(
+            &page,
+            ph_formation_sim::report::replay::page(&d.to_string()),
+        )
+        .expect("write");
+        let png = shots.join(format!("replay-{name}-t0.png"));
+        browse(
+            &profile,
+            &page,
+            "t=first&shot",
+            &[
+                "--window-size=960,600",
+                &format!("--screenshot={}", png.display()),
+            ],
+        );
+        let (_, _, pixels) = decode(&png);
+        // rgba(120,120,200,0.12) over white: about (240, 240, 250)
+        pixels
+            .iter()
+            .filter(|p| p[0] == p[1] && p[2] > p[0].saturating_add(5) && p[0] > 225)
+            .count()
+    };
+    let without = wedge_pixels(&d, "no-camera");
+    d["fov"] = serde_json::json!(87f64.to_radians() / 2.0);
+    d["camera_range"] = serde_json::json!(0.8);
+    d["heading_nominal"] = serde_json::json!(0.0);
+    let with = wedge_pixels(&d, "camera");
+    assert!(
+        with > 2_000 && without < 100,
+        "wedge pixels {with} with, {without} without"
+    );
+
     // Negative control of the view: the previous fit (one scale for the widest, final
     // frame) makes the formation at t = 0 a speck.
     let (probes, _) = probe_layout(&profile, &page, "probe=first&view=follow", (1200, 900));

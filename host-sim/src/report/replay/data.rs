@@ -423,4 +423,16 @@ mod tests {
         assert_eq!(split_ids("a_1_b_c_2_x", 3, &known), Some(vec![0, 1, 2]));
         assert_eq!(split_ids("a_1_b_d", 3, &known), None);
     }
+
+    #[test]
+    fn the_camera_is_read_where_summary_json_records_it() {
+        let with = json!({"world": {"sensors": {"camera": {"fov_deg": 87.0, "range_m": 4.0}}}});
+        assert_eq!(camera(&with, "fov_deg"), Some(87.0));
+        assert_eq!(camera(&with, "range_m"), Some(4.0));
+        let flat = json!({"world": {"camera": {"fov_deg": 60.0}}});
+        assert_eq!(camera(&flat, "fov_deg"), Some(60.0));
+        // Today's summary.json (world without sensors): no camera, no wedges.
+        let without = json!({"world": {"heading": {"initial_deg": 0.0}}});
+        assert_eq!(camera(&without, "fov_deg"), None);
+    }
 }
