@@ -105,7 +105,7 @@ fn the_check_fails_for_ten_lines_drawn_on_top_of_each_other() {
         {
             let root = BitMapBackend::new(&path, (400, 300)).into_drawing_area();
             root.fill(&WHITE).unwrap();
-            let mut chart = ChartBuilder::on(&root)
+            let chart = ChartBuilder::on(&root)
                 .build_cartesian_2d(0.0..10.0, 0.0..10.0)
                 .unwrap();
             let pts: Vec<(f64, f64)> = (0..=100)
