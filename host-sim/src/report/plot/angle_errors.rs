@@ -65,11 +65,16 @@ where
             Key::Line(OTHERS, 1),
         ));
     }
-    if !many && run.angles.len() > 1 {
+    let coloured = if many {
+        run.worst_angles.len()
+    } else {
+        run.angles.len()
+    };
+    if coloured > 1 {
         entries.push(entry(
             format!(
-                "angles side by side (offset up to ±{} px)",
-                fan_offset(run.angles.len() - 1, run.angles.len())
+                "coloured lines side by side (offset up to ±{} px)",
+                fan_offset(coloured - 1, coloured)
             ),
             Key::None,
         ));
@@ -112,17 +117,21 @@ where
                 stroke(chart.plotting_area(), pts, OTHERS, 1, false, bitmap)?;
             }
         }
+        // The maximum under the worst (the worst #1 is the maximum at the end), the worst
+        // side by side.
+        stroke(chart.plotting_area(), &max_series, DARK, 3, false, bitmap)?;
+        let named = run.worst_angles.len();
         for (k, &i) in run.worst_angles.iter().enumerate() {
-            stroke(
+            let offset = fan_offset(k, named);
+            stroke_offset(
                 chart.plotting_area(),
                 &series[i],
                 colour(k),
                 2,
-                false,
+                offset,
                 bitmap,
             )?;
         }
-        stroke(chart.plotting_area(), &max_series, DARK, 3, false, bitmap)?;
     } else {
         // The maximum under the angles, and the angles side by side: none hides another.
         stroke(chart.plotting_area(), &max_series, DARK, 3, false, bitmap)?;

@@ -40,14 +40,14 @@ fn all_visible(counts: &[usize], min: usize) -> bool {
 
 /// A run of ten agents that all move along the same line, and ten angle errors that are
 /// all the same: without care, one line hides all others.
-fn write_coincident(dir: &Path) {
+fn write_coincident(dir: &Path, angles: usize) {
     let n = 10;
     // The required columns (t, V and its parts, max_angle_err, …), then the agents.
     let mut header = REQUIRED.join(",");
     for i in 1..=n {
         let _ = write!(header, ",x_{i},y_{i},vx_{i},vy_{i}");
     }
-    for k in 0..n {
+    for k in 0..angles {
         let _ = write!(
             header,
             ",angle_err_{}_{}_{}",
@@ -67,7 +67,7 @@ fn write_coincident(dir: &Path) {
         for _ in 0..n {
             let _ = write!(csv, ",{},{},1,0.5", t, 0.5 * t + (0.3 * t).sin());
         }
-        for _ in 0..n {
+        for _ in 0..angles {
             let _ = write!(csv, ",{e}");
         }
         csv.push('\n');
@@ -85,7 +85,7 @@ fn write_coincident(dir: &Path) {
 #[test]
 fn ten_coincident_paths_and_angles_each_stay_visible() {
     let dir = tempfile::tempdir().unwrap();
-    write_coincident(dir.path());
+    write_coincident(dir.path(), 10);
     plot_run(dir.path()).unwrap();
     for fig in ["trajectories", "angle_errors"] {
         let counts = colour_counts(&pixels(&dir.path().join(format!("{fig}.png"))), 10);
@@ -135,4 +135,14 @@ fn the_check_fails_for_ten_lines_drawn_on_top_of_each_other() {
     let on_top = draw(false);
     assert!(!all_visible(&on_top, 200), "{on_top:?}");
     assert_eq!(on_top[..9], [0; 9], "only the last line shows: {on_top:?}");
+}
+
+#[test]
+fn beyond_ten_angles_the_named_worst_stay_visible_beside_the_maximum() {
+    // Sixteen equal angle errors: five named in colour, all equal to the maximum.
+    let dir = tempfile::tempdir().unwrap();
+    write_coincident(dir.path(), 16);
+    plot_run(dir.path()).unwrap();
+    let counts = colour_counts(&pixels(&dir.path().join("angle_errors.png")), WORST_NAMED);
+    assert!(all_visible(&counts, 200), "angle_errors.png: {counts:?}");
 }
