@@ -315,6 +315,27 @@ fn pre(dom: &str, id: &str) -> String {
         .replace("&amp;", "&")
 }
 
+/// Width, height and RGB pixels of a PNG.
+fn decode(png_path: &Path) -> (usize, usize, Vec<[u8; 3]>) {
+    let mut decoder = png::Decoder::new(std::fs::File::open(png_path).expect("screenshot"));
+    decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
+    let mut reader = decoder.read_info().expect("png");
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).expect("frame");
+    let bpp = info.color_type.samples();
+    let pixels = buf[..info.buffer_size()]
+        .chunks_exact(bpp)
+        .map(|p| {
+            if bpp >= 3 {
+                [p[0], p[1], p[2]]
+            } else {
+                [p[0]; 3]
+            }
+        })
+        .collect();
+    (info.width as usize, info.height as usize, pixels)
+}
+
 /// Non-background pixels and distinct colours of a PNG screenshot.
 fn ink(png_path: &Path) -> (usize, usize, Vec<u8>) {
     let mut decoder = png::Decoder::new(std::fs::File::open(png_path).expect("screenshot"));
@@ -428,4 +449,228 @@ fn replay_in_headless_chromium() {
     let dom = browse(&profile, &sweep.join("sweep.html"), "", &["--dump-dom"]);
     assert_eq!(pre(&dom, "ph-errors"), "[]", "sweep page errors");
     assert!(dom.contains("data-ready=\"1\""));
+}
+
+// ---------------------------------------------------------------------------------------
+// Layout, scale bar and first frame, in a real browser (issue 47 item 3)
+
+/// A box `{left, top, right, bottom}` of the page's `layout()` lies in a `w` × `h`
+/// viewport.
+fn inside(b: &Value, w: f64, h: f64) -> bool {
+    let n = |k: &str| b[k].as_f64().expect("box side");
+    n("left") >= 0.0 && n("top") >= 0.0 && n("right") <= w && n("bottom") <= h
+}
+
+/// The legend and the controls of a page `layout` lie in its viewport.
+fn legend_and_controls_in_view(layout: &Value) -> bool {
+    let w = layout["window"][0].as_f64().expect("width");
+    let h = layout["window"][1].as_f64().expect("height");
+    inside(&layout["legend"], w, h) && inside(&layout["controls"], w, h)
+}
+
+/// The metres of a scale bar's label ("20 cm", "5 m", "2 km").
+fn label_metres(label: &str) -> f64 {
+    let (v, unit) = label.split_once(' ').expect("number and unit");
+    let v: f64 = v.parse().expect("number");
+    match unit {
+        "cm" => v / 100.0,
+        "m" => v,
+        "km" => v * 1000.0,
+        other => panic!("unit {other}"),
+    }
+}
+
+/// The scale bar's label, at `metres_per_pixel`, matches its drawn length to 1 %.
+fn bar_matches(bar: &Value, metres_per_pixel: f64) -> bool {
+    let m = label_metres(bar["label"].as_str().expect("label"));
+    let drawn = bar["pixels"].as_f64().expect("pixels") * metres_per_pixel;
+    (drawn - m).abs() <= 0.01 * m
+}
+
+/// Every agent's drawn position of a probe lies in the canvas, and the drawn extent of the
+/// formation (its bounding box's larger side, pixels) over the canvas's smaller side.
+fn first_frame(probe: &Value) -> (bool, f64) {
+    let (px, py) = (numbers(&probe["px"]), numbers(&probe["py"]));
+    let w = probe["canvas"][0].as_f64().expect("W");
+    let h = probe["canvas"][1].as_f64().expect("H");
+    let all_in = px.iter().zip(&py).all(|(&x, &y)| {
+        x.is_finite() && y.is_finite() && (0.0..=w).contains(&x) && (0.0..=h).contains(&y)
+    });
+    let span = |v: &[f64]| {
+        v.iter().copied().fold(f64::MIN, f64::max) - v.iter().copied().fold(f64::MAX, f64::min)
+    };
+    (all_in, span(&px).max(span(&py)) / w.min(h))
+}
+
+/// Dumps `page#hash` at window `size`: the probes (`#probe=…`) and the layout.
+fn probe_layout(profile: &Path, page: &Path, hash: &str, size: (u32, u32)) -> (Vec<Value>, Value) {
+    let dom = browse(
+        profile,
+        page,
+        &format!("{hash}&layout"),
+        &[
+            &format!("--window-size={},{}", size.0, size.1),
+            "--dump-dom",
+        ],
+    );
+    assert_eq!(pre(&dom, "ph-errors"), "[]", "page errors at {size:?}");
+    let probes: Value = serde_json::from_str(&pre(&dom, "ph-probe")).expect("probe JSON");
+    let layout = serde_json::from_str(&pre(&dom, "ph-layout")).expect("layout JSON");
+    (probes.as_array().expect("probes").clone(), layout)
+}
+
+/// The longest run of `colour` pixels on row `y` of a screenshot.
+fn longest_run(w: usize, pixels: &[[u8; 3]], y: usize, colour: [u8; 3]) -> usize {
+    let (mut best, mut run) = (0, 0);
+    for p in &pixels[y * w..][..w] {
+        run = if *p == colour { run + 1 } else { 0 };
+        best = best.max(run);
+    }
+    best
+}
+
+#[test]
+#[ignore = "needs headless Chromium (scripts/browser-deps.sh); cargo xtask test runs it"]
+fn replay_layout_scale_and_first_frame_in_headless_chromium() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let dir = run_into(tmp.path(), "paper", "paper", &[]);
+    let page = dir.join("replay.html");
+    let profile = tmp.path().join("profile");
+    // The screenshots stay in target/ (CARGO_TARGET_TMPDIR), not committed.
+    let shots = Path::new(env!("CARGO_TARGET_TMPDIR")).join("replay-screenshots");
+    std::fs::create_dir_all(&shots).expect("screenshot dir");
+
+    for size in [(1200, 900), (1366, 768), (1920, 1080)] {
+        let (probes, layout) = probe_layout(&profile, &page, "probe=first,last", size);
+        // The viewport is the window less the browser's own bars.
+        let vw = layout["window"][0].as_u64().expect("width") as u32;
+        let vh = layout["window"][1].as_u64().expect("height") as u32;
+        assert!(vw <= size.0 && vh <= size.1 && vh >= size.1 / 2, "{layout}");
+        assert!(
+            legend_and_controls_in_view(&layout),
+            "legend or controls out of the {size:?} window: {layout}"
+        );
+        // t = 0: every agent on the canvas, the formation at least 20 % of it.
+        let (first, last) = (&probes[0], &probes[1]);
+        assert_eq!(first["t"], 0.0);
+        let (all_in, extent) = first_frame(first);
+        assert!(all_in && extent >= 0.2, "t = 0 at {size:?}: {first}");
+        // The scale bar: its label is its drawn length at the page's scale, to 1 %.
+        for p in [first, last] {
+            let mpp = p["metres_per_pixel"].as_f64().expect("mpp");
+            assert!(bar_matches(&p["scale_bar"], mpp), "{p}");
+            assert_eq!(
+                label_metres(p["scale_bar"]["label"].as_str().expect("label")),
+                p["scale_bar"]["metres"].as_f64().expect("metres")
+            );
+        }
+        // It adapts to the zoom: the formation grows tenfold, so does the bar.
+        assert!(
+            last["scale_bar"]["metres"].as_f64() > first["scale_bar"]["metres"].as_f64(),
+            "{first} {last}"
+        );
+        // Negative control: the first frame's bar read at the last frame's scale.
+        let last_mpp = last["metres_per_pixel"].as_f64().expect("mpp");
+        assert!(!bar_matches(&first["scale_bar"], last_mpp));
+
+        // A screenshot of that viewport at t = 0: the bar drawn at its length, every agent
+        // drawn where the hook says, the legend's swatches present.
+        let png = shots.join(format!("replay-{}x{}-t0.png", size.0, size.1));
+        browse(
+            &profile,
+            &page,
+            "t=first",
+            &[
+                &format!("--window-size={vw},{vh}"),
+                &format!("--screenshot={}", png.display()),
+            ],
+        );
+        let (w, h, pixels) = decode(&png);
+        assert_eq!((w, h), (vw as usize, vh as usize), "screenshot size");
+        let view = &layout["view"];
+        let (left, top) = (
+            view["left"].as_f64().expect("left") + 1.0, // the canvas's 1 px border
+            view["top"].as_f64().expect("top") + 1.0,
+        );
+        let bar = &first["scale_bar"];
+        let bar_row = (top + bar["y"].as_f64().expect("y") + 1.0) as usize;
+        let drawn = longest_run(w, &pixels, bar_row, [10, 11, 12]);
+        let want = bar["pixels"].as_u64().expect("pixels") as usize;
+        assert!(
+            drawn.abs_diff(want) <= 1,
+            "scale bar {drawn} px drawn, {want} px labelled"
+        );
+        for (x, y) in numbers(&first["px"]).iter().zip(numbers(&first["py"])) {
+            let (x, y) = ((left + x) as usize, (top + y) as usize);
+            let p = pixels[y * w + x];
+            // an agent's dot (#222) or a leader's (#1a2a9a)
+            assert!(
+                p == [0x22; 3] || p == [0x1a, 0x2a, 0x9a],
+                "no agent dot at ({x}, {y}): {p:?}"
+            );
+        }
+        let legend_row = (layout["legend"]["top"].as_f64().expect("top") + 8.0) as usize;
+        assert!(
+            pixels[legend_row * w..][..w].contains(&[0x2a, 0x9d, 0x3a]),
+            "no green swatch on the legend's first line"
+        );
+    }
+
+    // Negative control of the layout: the old order (view, controls, chart, then the legend)
+    // puts the legend below the fold at 1200 × 900.
+    let html = std::fs::read_to_string(&page).expect("page");
+    let old = html.replacen("<p id=\"legend\"></p>\n", "", 1).replacen(
+        "<canvas id=\"chart\" width=\"960\" height=\"220\"></canvas>\n",
+        "<canvas id=\"chart\" width=\"960\" height=\"220\"></canvas>\n<p id=\"legend\"></p>\n",
+        1,
+    );
+    assert_ne!(old, html, "the old layout was not rebuilt");
+    let old_page = tmp.path().join("old-layout.html");
+    std::fs::write(&old_page, old).expect("write");
+    let (_, layout) = probe_layout(&profile, &old_page, "probe=first", (1200, 900));
+    assert!(!legend_and_controls_in_view(&layout), "{layout}");
+
+    // Cameras: with a field of view and range in the data (summary.json's
+    // world.sensors.camera) a pale blue wedge per agent, at the world's nominal heading;
+    // without them none.
+    let mut d = page_data(&html);
+    let wedge_pixels = |d: &Value, name: &str| {
+        let page = tmp.path().join(format!("{name}.html"));
+        std::fs::write(
+            &page,
+            ph_formation_sim::report::replay::page(&d.to_string()),
+        )
+        .expect("write");
+        let png = shots.join(format!("replay-{name}-t0.png"));
+        browse(
+            &profile,
+            &page,
+            "t=first&shot",
+            &[
+                "--window-size=960,600",
+                &format!("--screenshot={}", png.display()),
+            ],
+        );
+        let (_, _, pixels) = decode(&png);
+        // rgba(120,120,200,0.12) over white: about (240, 240, 250)
+        pixels
+            .iter()
+            .filter(|p| p[0] == p[1] && p[2] > p[0].saturating_add(5) && p[0] > 225)
+            .count()
+    };
+    let without = wedge_pixels(&d, "no-camera");
+    d["fov"] = serde_json::json!(87f64.to_radians() / 2.0);
+    d["camera_range"] = serde_json::json!(0.8);
+    d["heading_nominal"] = serde_json::json!(0.0);
+    let with = wedge_pixels(&d, "camera");
+    assert!(
+        with > 2_000 && without < 100,
+        "wedge pixels {with} with, {without} without"
+    );
+
+    // Negative control of the view: the previous fit (one scale for the widest, final
+    // frame) makes the formation at t = 0 a speck.
+    let (probes, _) = probe_layout(&profile, &page, "probe=first&view=follow", (1200, 900));
+    let (all_in, extent) = first_frame(&probes[0]);
+    assert!(all_in && extent < 0.2, "{}", probes[0]);
 }

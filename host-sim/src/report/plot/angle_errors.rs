@@ -65,6 +65,20 @@ where
             Key::Line(OTHERS, 1),
         ));
     }
+    let coloured = if many {
+        run.worst_angles.len()
+    } else {
+        run.angles.len()
+    };
+    if coloured > 1 {
+        entries.push(entry(
+            format!(
+                "coloured lines side by side (offset up to ±{} px)",
+                fan_offset(coloured - 1, coloured)
+            ),
+            Key::None,
+        ));
+    }
     if run.n_angles == 0 {
         entries.push(entry("(no angle columns)", Key::None));
     }
@@ -103,23 +117,30 @@ where
                 stroke(chart.plotting_area(), pts, OTHERS, 1, false, bitmap)?;
             }
         }
+        // The maximum under the worst (the worst #1 is the maximum at the end), the worst
+        // side by side.
+        stroke(chart.plotting_area(), &max_series, DARK, 3, false, bitmap)?;
+        let named = run.worst_angles.len();
         for (k, &i) in run.worst_angles.iter().enumerate() {
-            stroke(
+            let offset = fan_offset(k, named);
+            stroke_offset(
                 chart.plotting_area(),
                 &series[i],
                 colour(k),
                 2,
-                false,
+                offset,
                 bitmap,
             )?;
         }
     } else {
+        // The maximum under the angles, and the angles side by side: none hides another.
+        stroke(chart.plotting_area(), &max_series, DARK, 3, false, bitmap)?;
         for (i, pts) in series.iter().enumerate() {
-            stroke(chart.plotting_area(), pts, colour(i), 2, false, bitmap)?;
+            let offset = fan_offset(i, series.len());
+            stroke_offset(chart.plotting_area(), pts, colour(i), 2, offset, bitmap)?;
         }
     }
     let area = chart.plotting_area();
-    stroke(area, &max_series, DARK, 3, false, bitmap)?;
     let from = window.map_or(t0, |w| w.clamp(t0, t1));
     let threshold = [(from, line), (t1, line)];
     stroke(area, &threshold, LEADER, 2, true, bitmap)?;

@@ -39,6 +39,8 @@ mod shape;
 mod style;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_legible;
 mod text;
 mod thinning;
 mod trajectories;

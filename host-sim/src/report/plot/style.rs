@@ -110,6 +110,77 @@ where
     Ok(())
 }
 
+/// The pixel offset of line `i` of `n` that [`stroke_offset`] draws side by side:
+/// `2 i − (n − 1)` pixels (−9 … 9 for ten lines), so that ten 2-pixel lines over the same
+/// data lie next to each other instead of on top of each other.
+pub(super) fn fan_offset(i: usize, n: usize) -> i32 {
+    let i = i32::try_from(i).unwrap_or(0);
+    let n = i32::try_from(n).unwrap_or(1);
+    2 * i - (n - 1)
+}
+
+/// [`stroke`] shifted by `offset` pixels along the line's normal (in pixels, at every
+/// point the normal of the chord between its neighbours): lines over the same data stay
+/// visible side by side (see [`fan_offset`]).
+pub(super) fn stroke_offset<DB, CT>(
+    area: &DrawingArea<DB, CT>,
+    pts: &[CT::From],
+    colour: RGBColor,
+    width: u32,
+    offset: i32,
+    bitmap: bool,
+) -> DrawResult
+where
+    DB: DrawingBackend,
+    DB::ErrorType: 'static,
+    CT: CoordTranslate,
+    CT::From: Clone,
+{
+    if pts.len() < 2 {
+        return Ok(());
+    }
+    let pixels = area.strip_coord_spec();
+    let (bx, by) = pixels.get_base_pixel();
+    let mut base: Vec<(i32, i32)> = pts
+        .iter()
+        .map(|p| {
+            let (x, y) = area.map_coordinate(p);
+            (x - bx, y - by)
+        })
+        .collect();
+    base.dedup();
+    let last = base.len().saturating_sub(1);
+    let mut normal = (0.0, -1.0);
+    let shifted: Vec<(i32, i32)> = (0..base.len())
+        .map(|k| {
+            let (a, b) = (base[k.saturating_sub(1)], base[(k + 1).min(last)]);
+            let (dx, dy) = (f64::from(b.0 - a.0), f64::from(b.1 - a.1));
+            let len = dx.hypot(dy);
+            if len > 0.0 {
+                normal = (-dy / len, dx / len);
+            }
+            let o = f64::from(offset);
+            (
+                base[k].0 + (normal.0 * o).round() as i32,
+                base[k].1 + (normal.1 * o).round() as i32,
+            )
+        })
+        .collect();
+    if !bitmap || width <= 1 {
+        return Ok(pixels.draw(&PathElement::new(shifted, colour.stroke_width(width)))?);
+    }
+    let w = i32::try_from(width).unwrap_or(1);
+    let lo = -(w - 1) / 2;
+    let style = colour.stroke_width(1);
+    for dx in lo..lo + w {
+        for dy in lo..lo + w {
+            let line: Vec<(i32, i32)> = shifted.iter().map(|&(x, y)| (x + dx, y + dy)).collect();
+            pixels.draw(&PathElement::new(line, style))?;
+        }
+    }
+    Ok(())
+}
+
 pub(super) const CHART_MARGIN: u32 = 14;
 pub(super) const X_LABEL_AREA: u32 = 56;
 pub(super) const Y_LABEL_AREA: u32 = 96;

@@ -50,6 +50,15 @@ where
             Key::None,
         ));
     }
+    if label_each && run.paths.len() > 1 {
+        entries.push(entry(
+            format!(
+                "  paths side by side (offset up to ±{} px)",
+                fan_offset(run.paths.len() - 1, run.paths.len())
+            ),
+            Key::None,
+        ));
+    }
     let shades = snapshot_shades(run.snapshots.len());
     for (s, shade) in run.snapshots.iter().zip(&shades) {
         entries.push(entry(
@@ -112,7 +121,13 @@ where
         } else {
             ramp(p.agent as f64 / n.saturating_sub(1).max(1) as f64)
         };
-        stroke(chart.plotting_area(), &pts, c, 2, false, bitmap)?;
+        if label_each {
+            // Side by side: no path hides another (the legend says so).
+            let offset = fan_offset(i, run.paths.len());
+            stroke_offset(chart.plotting_area(), &pts, c, 2, offset, bitmap)?;
+        } else {
+            stroke(chart.plotting_area(), &pts, c, 2, false, bitmap)?;
+        }
     }
     let radius = if n > 100 { 2 } else { 4 };
     for (s, shade) in run.snapshots.iter().zip(&shades) {

@@ -12,6 +12,15 @@ use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
 
+/// A number of the camera's configuration in `summary.json` (`world.sensors.camera.KEY`,
+/// or `world.camera.KEY`), if the run recorded one.
+fn camera(summary: &Value, key: &str) -> Option<f64> {
+    let w = &summary["world"];
+    w["sensors"]["camera"][key]
+        .as_f64()
+        .or_else(|| w["camera"][key].as_f64())
+}
+
 /// Every `stride`-th of `valid` rows and the last one.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct Stride {
@@ -337,6 +346,9 @@ impl ReplayData {
             "n_edges": self.n_edges,
             "leaders": self.leaders.map(|(a, b)| [a, b]),
             "rows": self.rows,
+            "fov": camera(s, "fov_deg").map(|d| d.to_radians() / 2.0),
+            "camera_range": camera(s, "range_m"),
+            "heading_nominal": s["world"]["heading"]["initial_deg"].as_f64().map(f64::to_radians),
         });
         let mut out = head.to_string();
         out.pop(); // the closing brace: the arrays follow
@@ -410,5 +422,17 @@ mod tests {
             .collect();
         assert_eq!(split_ids("a_1_b_c_2_x", 3, &known), Some(vec![0, 1, 2]));
         assert_eq!(split_ids("a_1_b_d", 3, &known), None);
+    }
+
+    #[test]
+    fn the_camera_is_read_where_summary_json_records_it() {
+        let with = json!({"world": {"sensors": {"camera": {"fov_deg": 87.0, "range_m": 4.0}}}});
+        assert_eq!(camera(&with, "fov_deg"), Some(87.0));
+        assert_eq!(camera(&with, "range_m"), Some(4.0));
+        let flat = json!({"world": {"camera": {"fov_deg": 60.0}}});
+        assert_eq!(camera(&flat, "fov_deg"), Some(60.0));
+        // Today's summary.json (world without sensors): no camera, no wedges.
+        let without = json!({"world": {"heading": {"initial_deg": 0.0}}});
+        assert_eq!(camera(&without, "fov_deg"), None);
     }
 }
