@@ -14,17 +14,18 @@ use ph_formation_ffi::{ph_actuator, ph_config, ph_status, PH_AGENT_SIZE};
 
 use fixture::Memory;
 
+const LEAD: f32 = 0.2337;
+const SECOND: f32 = 0.039;
+
 fn config() -> ph_config {
     let mut c = fixture::triangle_config(1);
     c.friction = [0.5, 0.25];
     c
 }
 
-/// The C API's setpoints with lead 0.2337 s and second lead 0.039 s² are the core's,
-/// bit for bit, over steps whose force changes (so the jerk term acts); without the
-/// second lead they differ (negative control).
-#[test]
-fn the_c_api_leads_like_the_core() {
+/// An actuator of mass 1 and speed limit 1 for the triangle agent, with lead
+/// [`LEAD`] (the agent's memory is only read by `ph_actuator_init`).
+fn actuator() -> ph_actuator {
     let mut mem = Memory([0; PH_AGENT_SIZE]);
     let a = mem.0.as_mut_ptr().cast::<ph_agent>();
     // SAFETY: `mem` is PH_AGENT_SIZE bytes, 8-aligned, and outlives the agent's use.
@@ -32,23 +33,34 @@ fn the_c_api_leads_like_the_core() {
         unsafe { ph_agent_init(a, PH_AGENT_SIZE, &config()) },
         ph_status::PH_OK
     );
-    let (lead, second) = (0.2337_f32, 0.039_f32);
     let mut act = ph_actuator::default();
     // SAFETY: valid pointers.
     assert_eq!(
-        unsafe { ph_actuator_init(&mut act, a, 1.0, 1.0, lead) },
+        unsafe { ph_actuator_init(&mut act, a, 1.0, 1.0, LEAD) },
         ph_status::PH_OK
     );
-    // SAFETY: valid pointer.
-    assert_eq!(
-        unsafe { ph_actuator_set_second_lead(&mut act, second) },
-        ph_status::PH_OK
-    );
-    let plant = VirtualMass::new(1.0_f32, [0.5, 0.25], 1.0)
-        .and_then(|p| p.with_lead(lead))
+    act
+}
+
+/// The core's plant of [`actuator`], with the second lead when `second`.
+fn core_plant(second: bool) -> VirtualMass<f32> {
+    let p = VirtualMass::new(1.0_f32, [0.5, 0.25], 1.0)
+        .and_then(|p| p.with_lead(LEAD))
         .unwrap();
-    let mut with = VelocityCommand::new(plant.with_second_lead(second).unwrap());
-    let mut without = VelocityCommand::new(plant);
+    if second {
+        p.with_second_lead(SECOND).unwrap()
+    } else {
+        p
+    }
+}
+
+/// Steps `act` through forces that change (so the jerk term acts): every setpoint must
+/// be `same`'s, bit for bit; returns whether one differed from `other`'s.
+fn steps_match(
+    act: &mut ph_actuator,
+    mut same: VelocityCommand<f32>,
+    mut other: VelocityCommand<f32>,
+) -> bool {
     let measured = [0.1_f32, -0.2];
     let mut differs = false;
     for force in [[0.2_f32, 0.1], [0.4, 0.1], [0.5, -0.3], [0.1, 0.0]] {
@@ -56,7 +68,7 @@ fn the_c_api_leads_like_the_core() {
         // SAFETY: valid pointers, 2 floats each.
         let s = unsafe {
             ph_actuate(
-                &mut act,
+                act,
                 force.as_ptr(),
                 measured.as_ptr(),
                 0.01,
@@ -64,10 +76,28 @@ fn the_c_api_leads_like_the_core() {
             )
         };
         assert_eq!(s, ph_status::PH_OK);
-        assert_eq!(setpoint, with.step(force, measured, 0.01));
-        differs |= setpoint != without.step(force, measured, 0.01);
+        assert_eq!(setpoint, same.step(force, measured, 0.01));
+        differs |= setpoint != other.step(force, measured, 0.01);
     }
-    assert!(differs);
+    differs
+}
+
+/// The C API's setpoints with lead 0.2337 s and second lead 0.039 s² are the core's,
+/// bit for bit, over steps whose force changes (so the jerk term acts); without the
+/// second lead they differ (negative control).
+#[test]
+fn the_c_api_leads_like_the_core() {
+    let mut act = actuator();
+    // SAFETY: valid pointer.
+    assert_eq!(
+        unsafe { ph_actuator_set_second_lead(&mut act, SECOND) },
+        ph_status::PH_OK
+    );
+    assert!(steps_match(
+        &mut act,
+        VelocityCommand::new(core_plant(true)),
+        VelocityCommand::new(core_plant(false)),
+    ));
     // SAFETY: valid pointer.
     assert_eq!(
         unsafe { ph_actuator_set_second_lead(&mut act, f32::NAN) },
@@ -85,23 +115,12 @@ fn the_c_api_leads_like_the_core() {
 /// NaN time constant is refused.
 #[test]
 fn the_c_api_filters_the_jerk_like_the_core() {
-    let mut mem = Memory([0; PH_AGENT_SIZE]);
-    let a = mem.0.as_mut_ptr().cast::<ph_agent>();
-    // SAFETY: `mem` is PH_AGENT_SIZE bytes, 8-aligned, and outlives the agent's use.
-    assert_eq!(
-        unsafe { ph_agent_init(a, PH_AGENT_SIZE, &config()) },
-        ph_status::PH_OK
-    );
-    let (lead, second, filter) = (0.2337_f32, 0.039_f32, 0.03_f32);
-    let mut act = ph_actuator::default();
-    // SAFETY: valid pointers.
+    let filter = 0.03_f32;
+    let mut act = actuator();
+    // SAFETY: valid pointer.
     unsafe {
         assert_eq!(
-            ph_actuator_init(&mut act, a, 1.0, 1.0, lead),
-            ph_status::PH_OK
-        );
-        assert_eq!(
-            ph_actuator_set_second_lead(&mut act, second),
+            ph_actuator_set_second_lead(&mut act, SECOND),
             ph_status::PH_OK
         );
         assert_eq!(
@@ -109,31 +128,12 @@ fn the_c_api_filters_the_jerk_like_the_core() {
             ph_status::PH_OK
         );
     }
-    let plant = VirtualMass::new(1.0_f32, [0.5, 0.25], 1.0)
-        .and_then(|p| p.with_lead(lead))
-        .and_then(|p| p.with_second_lead(second))
-        .unwrap();
-    let mut filtered = VelocityCommand::new(plant.with_jerk_filter(filter).unwrap());
-    let mut plain = VelocityCommand::new(plant);
-    let measured = [0.1_f32, -0.2];
-    let mut differs = false;
-    for force in [[0.2_f32, 0.1], [0.4, 0.1], [0.5, -0.3], [0.1, 0.0]] {
-        let mut setpoint = [0.0_f32; 2];
-        // SAFETY: valid pointers, 2 floats each.
-        let s = unsafe {
-            ph_actuate(
-                &mut act,
-                force.as_ptr(),
-                measured.as_ptr(),
-                0.01,
-                setpoint.as_mut_ptr(),
-            )
-        };
-        assert_eq!(s, ph_status::PH_OK);
-        assert_eq!(setpoint, filtered.step(force, measured, 0.01));
-        differs |= setpoint != plain.step(force, measured, 0.01);
-    }
-    assert!(differs);
+    let filtered = core_plant(true).with_jerk_filter(filter).unwrap();
+    assert!(steps_match(
+        &mut act,
+        VelocityCommand::new(filtered),
+        VelocityCommand::new(core_plant(true)),
+    ));
     for bad in [f32::NAN, -0.01, f32::INFINITY] {
         // SAFETY: valid pointer.
         assert_eq!(
