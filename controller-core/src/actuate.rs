@@ -311,12 +311,20 @@ impl<T: Real> VelocityCommand<T> {
         self.accel
     }
 
-    /// The next step starts again from the measured velocity. Call it on the agent's safe
-    /// output (SPEC S21c): the safe force damps the vehicle's own velocity, not a virtual
-    /// one that may have run ahead of it.
+    /// The next step starts again from the measured velocity, as the first one (no jerk
+    /// term, S21b): after a reboot or a stall.
     pub fn restart(&mut self) {
         self.command = None;
         self.accel = None;
+    }
+
+    /// The next step starts from the measured velocity, keeping the virtual acceleration
+    /// the second-order lead differences (S21b/S21d). Call it when the agent enters its
+    /// safe output (SPEC S21c; once per episode): the safe force damps the vehicle's own
+    /// velocity, not a virtual one that may have run ahead of it, and the setpoint's lead
+    /// goes on without a jump (the C API's `has_command = 0`).
+    pub fn reseed(&mut self) {
+        self.command = None;
     }
 
     /// The current virtual velocity (`None` before the first step): the setpoint

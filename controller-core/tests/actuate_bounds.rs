@@ -82,7 +82,7 @@ fn a_stall_restarts_from_the_measured_velocity() {
     );
 }
 
-/// On the safe output the caller restarts the command (S21c): the next setpoint damps
+/// On the safe output the caller re-seeds the command (S21c): the next setpoint damps
 /// the vehicle's own velocity instead of a virtual one that ran ahead of it.
 #[test]
 fn the_safe_output_restarts_from_the_measured_velocity() {
@@ -90,11 +90,43 @@ fn the_safe_output_restarts_from_the_measured_velocity() {
     for _ in 0..100 {
         c.step([1.0, 0.0], [0.0, 0.0], DT);
     }
-    c.restart();
+    c.reseed();
     let safe_force = [-0.1 * 0.3, 0.0]; // −c v with c = 0.1 at the measured 0.3 m/s
     let v = c.command();
     assert_eq!(v, None);
     c.step(safe_force, [0.3, 0.0], DT);
     let v = c.command().unwrap();
     assert!(v[0] < 0.3 && v[0] > 0.29, "{v:?}");
+}
+
+/// The re-seed keeps the virtual acceleration of the second-order lead (S21b/S21d), so
+/// the setpoint's jerk term goes on from it; a restart (a reboot, a stall) drops it and
+/// the first step has no jerk term. The two differ (negative control).
+#[test]
+fn the_reseed_keeps_the_lead_and_the_restart_drops_it() {
+    let second = plant()
+        .with_second_lead(0.04)
+        .and_then(|p| p.with_jerk_filter(0.03))
+        .unwrap();
+    let run = |reseed: bool| {
+        let mut c = VelocityCommand::new(second);
+        for _ in 0..50 {
+            c.step([1.0, 0.0], [0.0, 0.0], DT);
+        }
+        let accel = c.accel();
+        if reseed {
+            c.reseed();
+            assert_eq!(c.accel(), accel);
+        } else {
+            c.restart();
+            assert_eq!(c.accel(), None);
+        }
+        assert_eq!(c.command(), None);
+        c.step([0.0; 2], [0.3, 0.0], DT)
+    };
+    let (kept, dropped) = (run(true), run(false));
+    // Without force, from 0.3 m/s: friction decelerates; the kept acceleration (about
+    // 1 m/s² before) makes the filtered jerk strongly negative, the restart has none.
+    assert!(dropped[0] > 0.2, "{dropped:?}");
+    assert!(kept[0] < dropped[0] - 0.5, "{kept:?} vs {dropped:?}");
 }

@@ -142,3 +142,55 @@ fn the_c_api_filters_the_jerk_like_the_core() {
         );
     }
 }
+
+/// `has_command = 0` (what the app does on the safe output) is the core's
+/// `VelocityCommand::reseed`, bit for bit: the virtual velocity starts from the measured
+/// one and the jerk filter goes on from the kept acceleration; the core's `restart`
+/// (which drops it) differs (negative control).
+#[test]
+fn a_cleared_command_is_the_cores_reseed() {
+    let mut act = actuator();
+    // SAFETY: valid pointer.
+    unsafe {
+        assert_eq!(
+            ph_actuator_set_second_lead(&mut act, SECOND),
+            ph_status::PH_OK
+        );
+        assert_eq!(
+            ph_actuator_set_jerk_filter(&mut act, 0.03),
+            ph_status::PH_OK
+        );
+    }
+    let plant = core_plant(true).with_jerk_filter(0.03).unwrap();
+    let (mut same, mut other) = (VelocityCommand::new(plant), VelocityCommand::new(plant));
+    let measured = [0.1_f32, -0.2];
+    let mut differs = false;
+    for (k, force) in [[0.2_f32, 0.1], [0.4, 0.1], [0.5, -0.3], [0.1, 0.0]]
+        .iter()
+        .cycle()
+        .take(12)
+        .enumerate()
+    {
+        if k == 6 {
+            act.has_command = 0;
+            same.reseed();
+            other.restart();
+        }
+        let mut setpoint = [0.0_f32; 2];
+        // SAFETY: valid pointers, 2 floats each.
+        let s = unsafe {
+            ph_actuate(
+                &mut act,
+                force.as_ptr(),
+                measured.as_ptr(),
+                0.01,
+                setpoint.as_mut_ptr(),
+            )
+        };
+        assert_eq!(s, ph_status::PH_OK);
+        assert_eq!(setpoint, same.step(*force, measured, 0.01), "step {k}");
+        let o = other.step(*force, measured, 0.01);
+        differs |= k >= 6 && setpoint != o;
+    }
+    assert!(differs, "the restart's setpoints equal the re-seed's");
+}

@@ -30,6 +30,7 @@ typedef struct {
     formation_state formation;
     uint8_t id;
     bool first;           /* no tick yet */
+    bool was_safe;        /* the last tick gave the safe output */
     uint32_t previous_ms; /* the previous tick (ms, the control clock) */
     uint32_t origin_ms;   /* time 0 of the schedules v*, z* (agent_loop_restart) */
     ph_output out;        /* the last tick's controller output */

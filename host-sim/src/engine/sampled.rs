@@ -204,6 +204,7 @@ impl SampledSim<'_> {
             && rayon::current_num_threads() > 1
             && self.world.clocks.is_none()
             && self.actuation.policy.is_none()
+            && !self.plant.takes_commands()
             && !self.faults.any()
     }
 
@@ -291,7 +292,6 @@ impl SampledSim<'_> {
             d.radio.count_direct_sums(sums.broadcasts, sums.copies);
         }
         self.stats.merge(&sums.stats);
-        self.actuation.command_all(&mut *self.plant, at.dt);
         if !d.direct {
             for i in 0..model.n() {
                 let sensor = self.senses.bearing.as_deref_mut();

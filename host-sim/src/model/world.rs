@@ -32,7 +32,16 @@ pub struct CrazyfliePid {
     pub second_lead: Option<f64>,
     /// The time constant of the filter on that lead's jerk (s, ≥ 0; SPEC S21d).
     pub jerk_filter: f64,
+    /// The gap bound between the virtual and the measured velocity (m/s, > 0, infinity
+    /// for none; SPEC S21c): the app's `FORMATION_MAX_GAP`, [`MAX_GAP`] by default.
+    pub max_gap: f64,
 }
+
+/// The default [`CrazyfliePid::max_gap`] (m/s, SPEC S21c): the Crazyflie app's
+/// `FORMATION_MAX_GAP` (crazyflie-app/src/formation.h), well above the lag of a drone that
+/// follows (`τ_lead` 0.23 s times the largest virtual acceleration `max_force / m`,
+/// docs/spec.md S21c).
+pub const MAX_GAP: f64 = 0.5;
 
 /// The default [`CrazyfliePid::jerk_filter`] (s, SPEC S21d): three of the velocity loop's
 /// 10 ms periods, a sixth of the attitude loop's `τ_a` = 1/6 s (docs/world.md measures
@@ -52,6 +61,9 @@ pub struct VelocityTracking {
     /// The lead the agent's actuation gives its setpoints (s, ≥ 0; SPEC S21): what the
     /// agent believes `τ` to be.
     pub lead: f64,
+    /// The gap bound between the virtual and the measured velocity (m/s, > 0; infinity,
+    /// the default, for none; SPEC S21c).
+    pub max_gap: f64,
 }
 
 /// Wind on every agent: a constant part plus gusts, each agent's gust an independent

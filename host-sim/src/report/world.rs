@@ -19,6 +19,7 @@ pub fn add_json(obj: &mut Map<String, Value>, model: &Model) {
             "max_acceleration_m_s2": v.max_acceleration,
             "max_speed_m_s": v.max_speed,
             "lead_s": v.lead,
+            "max_gap_m_s": v.max_gap.is_finite().then_some(v.max_gap),
         }),
         VehicleModel::CrazyfliePid(v) => json!({
             "model": "crazyflie_pid",
@@ -28,6 +29,7 @@ pub fn add_json(obj: &mut Map<String, Value>, model: &Model) {
                 .second_lead
                 .unwrap_or_else(crate::engine::plant::derived_second_lead),
             "jerk_filter_s": v.jerk_filter,
+            "max_gap_m_s": v.max_gap.is_finite().then_some(v.max_gap),
         }),
     };
     let wind = w.wind.map(|x| {

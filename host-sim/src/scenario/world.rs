@@ -30,6 +30,10 @@ pub enum PlantSpec {
         /// The lead of the agents' setpoints (s, SPEC S21); default `time_constant_s`.
         #[serde(default)]
         lead_s: Option<f64>,
+        /// The gap bound between the virtual and the measured velocity (m/s, SPEC S21c);
+        /// default none (`inf`).
+        #[serde(default)]
+        max_gap: Option<f64>,
     },
     /// A Crazyflie 2.x flying its firmware's PID cascade in velocity mode (the gains are
     /// the firmware's, `docs/world.md`).
@@ -50,6 +54,10 @@ pub enum PlantSpec {
         /// S21d); default 0.03 s (docs/world.md).
         #[serde(default)]
         jerk_filter_s: Option<f64>,
+        /// The gap bound between the virtual and the measured velocity (m/s, SPEC S21c;
+        /// `inf` for none); default the app's 0.5 m/s.
+        #[serde(default)]
+        max_gap: Option<f64>,
     },
 }
 
@@ -285,6 +293,7 @@ mod plant_tests {
                 lead_s: None,
                 second_lead_s2: None,
                 jerk_filter_s: None,
+                max_gap: None,
             })
         );
         assert!(matches!(

@@ -19,7 +19,7 @@ pub struct CrazyfliePidPlant {
     q: Vec<Vec2<f64>>,
     v: Vec<Vec2<f64>>,
     /// The velocity setpoints and the virtual masses behind them.
-    setpoints: Setpoints,
+    pub(crate) setpoints: Setpoints,
     drones: Vec<Crazyflie>,
 }
 
@@ -35,6 +35,7 @@ impl CrazyfliePidPlant {
                 vehicle.second_lead.unwrap_or_else(derived_second_lead),
                 vehicle.jerk_filter,
             )),
+            vehicle.max_gap,
         )?;
         let drones: Vec<Crazyflie> = model
             .agents
@@ -47,6 +48,26 @@ impl CrazyfliePidPlant {
             setpoints,
             drones,
         })
+    }
+}
+
+#[cfg(test)]
+impl CrazyfliePidPlant {
+    /// `n` drones hovering at the origin, each with the virtual mass `mass`.
+    pub(crate) fn with_virtual_mass(
+        n: usize,
+        mass: ph_formation_core::actuate::VirtualMass<f64>,
+    ) -> Self {
+        use ph_formation_core::actuate::VelocityCommand;
+        Self {
+            q: vec![Vec2::zeros(); n],
+            v: vec![Vec2::zeros(); n],
+            setpoints: Setpoints {
+                command: vec![VelocityCommand::new(mass); n],
+                setpoint: vec![Vec2::zeros(); n],
+            },
+            drones: vec![Crazyflie::default(); n],
+        }
     }
 }
 
@@ -71,6 +92,10 @@ impl Plant for CrazyfliePidPlant {
 
     fn restart(&mut self, i: usize) {
         self.setpoints.restart(i);
+    }
+
+    fn reseed(&mut self, i: usize) {
+        self.setpoints.reseed(i);
     }
 
     fn set_velocity_setpoint(&mut self, i: usize, setpoint: Vec2<f64>) -> bool {

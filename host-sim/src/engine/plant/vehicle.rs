@@ -41,6 +41,9 @@ pub trait Plant: Send + Sync {
     /// Agent `i`'s actuation starts again from its measured velocity at its next
     /// command (a rebooted agent's state is lost; nothing for a point mass).
     fn restart(&mut self, _i: usize) {}
+    /// Agent `i`'s actuation starts its next command from its measured velocity, its
+    /// setpoint's lead going on (SPEC S21c: the safe output; nothing for a point mass).
+    fn reseed(&mut self, _i: usize) {}
     /// Agent `i`'s tilt from vertical (rad), if the vehicle models one.
     fn tilt(&self, _i: usize) -> Option<f64> {
         None
@@ -64,21 +67,26 @@ pub(crate) struct Setpoints {
 impl Setpoints {
     /// Every agent of `model` with its virtual mass (its mass and friction, the speed
     /// limit `max_speed`, the lead and, if given, the second-order lead with its jerk
-    /// filter's time constant, S21b/S21d), holding its initial velocity as its setpoint
-    /// until its first tick.
+    /// filter's time constant, S21b/S21d; the gap bound `max_gap` and, as the app's
+    /// `ph_actuator_init`, the neighbour timeout as the stall limit, S21c), holding its
+    /// initial velocity as its setpoint until its first tick.
     pub(crate) fn new(
         model: &Model,
         max_speed: f64,
         lead: f64,
         second_lead: Option<(f64, f64)>,
+        max_gap: f64,
     ) -> Result<Self, SetupError> {
         let a = &model.agents;
+        let stall = model.limits.neighbour_timeout;
         let command = a
             .iter()
             .enumerate()
             .map(|(i, x)| {
                 VirtualMass::new(x.mass, x.friction, max_speed)
                     .and_then(|m| m.with_lead(lead))
+                    .and_then(|m| m.with_max_gap(max_gap))
+                    .and_then(|m| m.with_max_interval(stall))
                     .and_then(|m| {
                         second_lead.map_or(Ok(m), |(s, f)| {
                             m.with_second_lead(s).and_then(|m| m.with_jerk_filter(f))
@@ -109,6 +117,14 @@ impl Setpoints {
     pub(crate) fn restart(&mut self, i: usize) {
         if let Some(c) = self.command.get_mut(i) {
             c.restart();
+        }
+    }
+
+    /// Agent `i`'s virtual mass starts from the measured velocity at its next command,
+    /// keeping its virtual acceleration (SPEC S21c, the safe output).
+    pub(crate) fn reseed(&mut self, i: usize) {
+        if let Some(c) = self.command.get_mut(i) {
+            c.reseed();
         }
     }
 

@@ -44,7 +44,13 @@ impl VelocityTrackingPlant {
     /// The model's agents at their initial state, each holding its initial velocity
     /// until its first tick.
     pub fn new(model: &Model, vehicle: &VelocityTracking) -> Result<Self, SetupError> {
-        let setpoints = Setpoints::new(model, vehicle.max_speed, vehicle.lead, None)?;
+        let setpoints = Setpoints::new(
+            model,
+            vehicle.max_speed,
+            vehicle.lead,
+            None,
+            vehicle.max_gap,
+        )?;
         Ok(Self {
             q: model
                 .agents
@@ -84,6 +90,10 @@ impl Plant for VelocityTrackingPlant {
 
     fn restart(&mut self, i: usize) {
         self.setpoints.restart(i);
+    }
+
+    fn reseed(&mut self, i: usize) {
+        self.setpoints.reseed(i);
     }
 
     fn set_velocity_setpoint(&mut self, i: usize, setpoint: Vec2<f64>) -> bool {
@@ -137,6 +147,7 @@ mod tests {
                 max_acceleration: a_max,
                 max_speed: 1.0,
                 lead: 0.0,
+                max_gap: f64::INFINITY,
             },
         }
     }

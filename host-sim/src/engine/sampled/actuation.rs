@@ -7,7 +7,7 @@ use crate::engine::plant::{Held, Plant};
 use crate::engine::policy::PolicyRun;
 use crate::engine::world::{Headings, Wind};
 use crate::model::Model;
-use ph_formation_core::{StepOutput, Vec2};
+use ph_formation_core::{Status, StepOutput, Vec2};
 
 /// Every agent's held force and the safety policies.
 pub(super) struct Actuation {
@@ -15,6 +15,8 @@ pub(super) struct Actuation {
     pub(super) forces: Vec<Vec2<f64>>,
     /// The safety policies (`[policy]`), applied to each force after its tick.
     pub(super) policy: Option<PolicyRun>,
+    /// Whether each agent's last tick was in its safe output.
+    safe: Vec<bool>,
 }
 
 impl Actuation {
@@ -24,12 +26,14 @@ impl Actuation {
         Self {
             forces: vec![Vec2::zeros(); n],
             policy: model.policy.map(|c| PolicyRun::new(c, n, model.battery)),
+            safe: vec![false; n],
         }
     }
 
     /// Agent `i`'s output `out` of its tick `at` acted on: the policies' force (or the
     /// controller's), turned into the world frame, held, and commanded to a vehicle that
-    /// takes commands.
+    /// takes commands, whose actuation starts again from the measured velocity on the
+    /// safe output (SPEC S21c, as the Crazyflie app's `agent_loop.c`).
     #[inline]
     pub(super) fn apply(
         &mut self,
@@ -54,18 +58,8 @@ impl Actuation {
         };
         let force = world_force(headings, i, at, own);
         self.forces[i] = force;
-        if plant.takes_commands() {
-            plant.command(i, force, at.dt);
-        }
-    }
-
-    /// Every agent's held force commanded to a vehicle that takes commands, `dt` after
-    /// the last tick (the parallel tick sets the forces itself).
-    pub(super) fn command_all(&self, plant: &mut dyn Plant, dt: f64) {
-        if plant.takes_commands() {
-            for (i, f) in self.forces.iter().enumerate() {
-                plant.command(i, *f, dt);
-            }
+        if let Some(was_safe) = self.safe.get_mut(i) {
+            command(plant, i, force, out.status, was_safe, at.dt);
         }
     }
 
@@ -86,5 +80,130 @@ impl Actuation {
             wind: wind.map_or(&[], |w| w.now.as_slice()),
         };
         plant.step(&held, dt, steps, chunk);
+    }
+}
+
+/// Agent `i`'s force of a tick of output `status`, `dt` after its last, commanded to a
+/// vehicle that takes commands, whose actuation starts again from the measured velocity
+/// when the agent enters its safe output (SPEC S21c; `was_safe`: whether its last tick
+/// was safe, updated).
+fn command(
+    plant: &mut dyn Plant,
+    i: usize,
+    force: Vec2<f64>,
+    status: Status,
+    was_safe: &mut bool,
+    dt: f64,
+) {
+    if plant.takes_commands() {
+        let safe = matches!(status, Status::Safe(_));
+        if safe && !*was_safe {
+            plant.reseed(i);
+        }
+        *was_safe = safe;
+        plant.command(i, force, dt);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::plant::{derived_lead, derived_second_lead, CrazyfliePidPlant, Held};
+    use ph_formation_core::actuate::VirtualMass;
+    use ph_formation_core::Fault;
+
+    /// A Crazyflie pushed by a steady force for 0.3 s (its virtual velocity runs ahead of
+    /// the drone, which lags by `τ_lead` times the acceleration), then one tick of output
+    /// `status` with no force: its virtual velocity (S20) and the drone's. `gap`: the gap
+    /// bound (S21c).
+    fn setpoint_after(status: Status, gap: f64) -> (Vec2<f64>, Vec2<f64>) {
+        let mass = VirtualMass::new(1.0, [0.0; 2], 1.0)
+            .and_then(|m| m.with_lead(derived_lead()))
+            .and_then(|m| m.with_second_lead(derived_second_lead()))
+            .and_then(|m| m.with_jerk_filter(0.03))
+            .and_then(|m| m.with_max_gap(gap))
+            .unwrap();
+        let mut plant = CrazyfliePidPlant::with_virtual_mass(1, mass);
+        let forces = [Vec2::zeros()];
+        let held = Held {
+            forces: &forces,
+            wind: &[],
+        };
+        let (dt, mut was_safe) = (0.01, false);
+        for _ in 0..30 {
+            let push = Vec2::new(0.5, 0.0);
+            command(&mut plant, 0, push, Status::Nominal, &mut was_safe, dt);
+            plant.step(&held, 1e-3, 10, None);
+        }
+        command(&mut plant, 0, Vec2::zeros(), status, &mut was_safe, dt);
+        let c = plant.setpoints.command[0].command().unwrap();
+        (Vec2::new(c[0], c[1]), plant.v()[0])
+    }
+
+    /// SPEC S21c: on the safe output a vehicle's actuation starts again from its measured
+    /// velocity (the app's `agent_loop.c`), so the safe force damps the drone's own
+    /// velocity; a nominal tick (the negative control) keeps the virtual velocity that ran
+    /// ahead of the drone.
+    #[test]
+    fn the_safe_output_restarts_from_the_measured_velocity() {
+        let safe = Status::Safe(Fault::Stale(2));
+        let (sp, v) = setpoint_after(safe, f64::INFINITY);
+        let (nominal, v_n) = setpoint_after(Status::Nominal, f64::INFINITY);
+        assert!(
+            (nominal - v_n).norm() > 0.03,
+            "the virtual velocity ran ahead: {nominal:?} vs {v_n:?}"
+        );
+        // From the measured velocity, with no force: that velocity less one step of the
+        // friction.
+        assert!((sp - v).norm() < 0.005, "virtual {sp:?}, measured {v:?}");
+    }
+
+    /// SPEC S21c: with the gap bound, the nominal step starts within the bound of the
+    /// measured velocity (negative control: without it, beyond).
+    #[test]
+    fn the_gap_bound_holds_the_virtual_velocity_near_the_drone() {
+        let (free, v_free) = setpoint_after(Status::Nominal, f64::INFINITY);
+        let (held, v_held) = setpoint_after(Status::Nominal, 0.01);
+        assert!((free - v_free).norm() > 0.03);
+        assert!((held - v_held).norm() < 0.015, "{held:?} vs {v_held:?}");
+    }
+
+    /// A vehicle that counts its re-seeds.
+    struct Counting(usize);
+
+    impl Plant for Counting {
+        fn q(&self) -> &[Vec2<f64>] {
+            &[]
+        }
+        fn v(&self) -> &[Vec2<f64>] {
+            &[]
+        }
+        fn takes_commands(&self) -> bool {
+            true
+        }
+        fn reseed(&mut self, _i: usize) {
+            self.0 += 1;
+        }
+        fn step(&mut self, _: &Held<'_>, _: f64, _: usize, _: Option<usize>) {}
+    }
+
+    /// The re-seed is on entering the safe output, once per episode: re-seeding at every
+    /// safe tick would hand the vehicle its own noisy measured velocity as the setpoint
+    /// at every tick, a random walk the safe force barely damps (measured: the 2×5 grid's
+    /// neighbours of a lost drone closed to 0.41 m from 0.86 m). Negative control: a
+    /// nominal-only run re-seeds nothing.
+    #[test]
+    fn the_safe_output_reseeds_once_per_episode() {
+        let safe = Status::Safe(Fault::Stale(2));
+        let count = |statuses: &[Status]| {
+            let (mut p, mut was_safe) = (Counting(0), false);
+            for s in statuses {
+                command(&mut p, 0, Vec2::zeros(), *s, &mut was_safe, 0.01);
+            }
+            p.0
+        };
+        let n = Status::Nominal;
+        assert_eq!(count(&[n, safe, safe, safe, n, safe, safe]), 2);
+        assert_eq!(count(&[n, n, n]), 0);
     }
 }

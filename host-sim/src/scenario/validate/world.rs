@@ -31,6 +31,7 @@ pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile, period: f64) -> World
             max_tilt_deg,
             max_speed,
             lead_s,
+            max_gap,
         }) => {
             c.positive(InvalidValue, "plant.time_constant_s", time_constant_s);
             c.positive(InvalidValue, "plant.max_speed", max_speed);
@@ -48,6 +49,7 @@ pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile, period: f64) -> World
                 max_acceleration: G * max_tilt_deg.to_radians().tan(),
                 max_speed,
                 lead,
+                max_gap: gap(c, max_gap, f64::INFINITY),
             });
         }
         Ok(PlantSpec::CrazyfliePid {
@@ -55,6 +57,7 @@ pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile, period: f64) -> World
             lead_s,
             second_lead_s2,
             jerk_filter_s,
+            max_gap,
         }) => {
             let jerk_filter = jerk_filter_s.unwrap_or(crate::model::world::JERK_FILTER_S);
             c.non_negative(InvalidValue, "plant.jerk_filter_s", jerk_filter);
@@ -70,6 +73,7 @@ pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile, period: f64) -> World
                 lead: lead_s,
                 second_lead: second_lead_s2,
                 jerk_filter,
+                max_gap: gap(c, max_gap, crate::model::world::MAX_GAP),
             });
         }
     }
@@ -166,4 +170,17 @@ pub(super) fn check(c: &mut Checker<'_>, s: &ScenarioFile, period: f64) -> World
         );
     }
     world
+}
+
+/// `plant.max_gap` (m/s, SPEC S21c): above 0, `inf` for none; `default` when absent.
+fn gap(c: &mut Checker<'_>, max_gap: Option<f64>, default: f64) -> f64 {
+    let g = max_gap.unwrap_or(default);
+    if g.is_nan() || g <= 0.0 {
+        c.err(
+            InvalidValue,
+            "plant.max_gap",
+            format!("must be above 0 (inf for none), got {g}"),
+        );
+    }
+    g
 }
