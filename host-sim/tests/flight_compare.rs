@@ -118,10 +118,16 @@ fn a_served_flight_is_held_against_its_run() {
     assert!(window > 3.9, "{window}");
     let e = &j["angle_error_deg"];
     let (run_worst, flight_worst) = (e["run_worst"].as_f64(), e["flight_worst"].as_f64());
-    assert!((run_worst.expect("run") - flight_worst.expect("flight")).abs() < 0.1, "{e}");
+    assert!(
+        (run_worst.expect("run") - flight_worst.expect("flight")).abs() < 0.1,
+        "{e}"
+    );
     let c = &j["convergence_s"];
     let (cr, cf) = (c["run"].as_f64(), c["flight"].as_f64());
-    assert!((cr.expect("run settles") - cf.expect("flight settles")).abs() < 1.0, "{c}");
+    assert!(
+        (cr.expect("run settles") - cf.expect("flight settles")).abs() < 1.0,
+        "{c}"
+    );
     assert_eq!(j["within_tolerance"], true);
     for f in ["compare_positions.png", "compare_angles.png"] {
         assert!(out.join(f).is_file(), "{f}");
@@ -147,11 +153,7 @@ fn first_row(dir: &Path) -> Vec<(String, f64)> {
         .split(',')
         .map(|x| x.parse().expect("number"))
         .collect();
-    header
-        .iter()
-        .map(|h| (*h).to_owned())
-        .zip(row)
-        .collect()
+    header.iter().map(|h| (*h).to_owned()).zip(row).collect()
 }
 
 fn angle_errors(row: &[(String, f64)]) -> Vec<(String, f64)> {
@@ -328,6 +330,14 @@ fn bad_flight_logs_are_named() {
         assert!(said.contains(reason), "{reason}: {said}");
         assert!(said.contains(s(log)), "names the file: {said}");
     }
+    let (code, said) = compare_flight(
+        &run,
+        &tmp.path().join("none.csv"),
+        &tmp.path().join("x"),
+        true,
+    );
+    assert_eq!(code, 2, "{said}");
+    assert!(said.contains("none.csv: cannot read"), "{said}");
     // The control: the intact log passes the same reading.
     let intact = write("intact.csv", text.clone());
     let (code, said) = compare_flight(&run, &intact, &tmp.path().join("x"), true);
@@ -335,7 +345,10 @@ fn bad_flight_logs_are_named() {
     // A reference that is neither a run nor a vehicle step; a step without --speed.
     let (code, _, err) = host_sim(&["compare", s(tmp.path()), s(&intact)]);
     assert_eq!(code, 2);
-    assert!(err.contains("neither host-sim run's output directory"), "{err}");
+    assert!(
+        err.contains("neither host-sim run's output directory"),
+        "{err}"
+    );
     let model = tmp.path().join("vehicle");
     vehicle_step(&model, "0.3");
     let step_log = fixture("step_serve.csv");

@@ -599,7 +599,10 @@ fn compare_flight_with_run(dir: &Path, log: &Path, without_4: &str) {
     assert!(rms.len() == 4 && rms.iter().all(|r| *r < 0.15), "{rms:?}");
     let c = &j["convergence_s"];
     let (cr, cf) = (c["run"].as_f64(), c["flight"].as_f64());
-    assert!((cr.expect("run settles") - cf.expect("flight settles")).abs() < 1.0, "{c}");
+    assert!(
+        (cr.expect("run settles") - cf.expect("flight settles")).abs() < 1.0,
+        "{c}"
+    );
     let missing = dir.join("without-4.csv");
     std::fs::write(&missing, without_4).expect("write");
     let (code, err, _) = compare(&same, &missing, "compare-without-4");

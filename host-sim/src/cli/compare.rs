@@ -5,8 +5,8 @@
 use crate::exit_code;
 use crate::model::Model;
 use crate::report::flight::{
-    compare, compare_step, plot_overlay, plot_step, step_csv, write_flight_dir, Clock,
-    FlightError, FlightLog, FlightSeries, Options, RunSeries,
+    compare, compare_step, plot_overlay, plot_step, step_csv, write_flight_dir, Clock, FlightError,
+    FlightLog, FlightSeries, Options, RunSeries,
 };
 use clap::Args;
 use serde_json::Value;
@@ -118,7 +118,7 @@ fn load_model(scenario: &str, set: &[String]) -> Result<Model, u8> {
 fn fail(e: &FlightError) -> u8 {
     eprintln!("error: {e}");
     match e {
-        FlightError::Io { .. } => exit_code::IO,
+        FlightError::Write { .. } => exit_code::IO,
         _ => exit_code::USAGE,
     }
 }
@@ -233,7 +233,10 @@ fn flight_compare(args: &CompareArgs, quiet: bool) -> Result<u8, u8> {
         eprintln!("error: --settle-deg: must be a finite angle > 0");
         return Err(exit_code::USAGE);
     }
-    if args.tolerance_m.is_some_and(|t| !(t.is_finite() && t >= 0.0)) {
+    if args
+        .tolerance_m
+        .is_some_and(|t| !(t.is_finite() && t >= 0.0))
+    {
         eprintln!("error: --tolerance-m: must be finite and ≥ 0 m");
         return Err(exit_code::USAGE);
     }

@@ -51,7 +51,10 @@ impl RunSeries {
         let (ct, ce) = (need("t")?, need("max_angle_err")?);
         let mut cq = Vec::with_capacity(model.n());
         for a in &model.agents {
-            cq.push((need(&format!("x_{}", a.name))?, need(&format!("y_{}", a.name))?));
+            cq.push((
+                need(&format!("x_{}", a.name))?,
+                need(&format!("y_{}", a.name))?,
+            ));
         }
         let mut s = Self {
             dir: dir.to_path_buf(),
@@ -110,7 +113,10 @@ impl RunSeries {
         if t < self.t[0] || t > last + 1e-9 {
             return None;
         }
-        let j = self.t.partition_point(|&x| x <= t).clamp(1, self.t.len() - 1);
+        let j = self
+            .t
+            .partition_point(|&x| x <= t)
+            .clamp(1, self.t.len() - 1);
         let (a, b) = (j - 1, j);
         let w = if self.t[b] > self.t[a] {
             ((t - self.t[a]) / (self.t[b] - self.t[a])).clamp(0.0, 1.0)

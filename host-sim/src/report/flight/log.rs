@@ -76,6 +76,14 @@ pub enum FlightError {
         /// Why.
         source: std::io::Error,
     },
+    /// An output cannot be written.
+    #[error("{}: cannot write: {source}", path.display())]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
     /// A required column is missing.
     #[error("{}: no column `{column}` ({what})", path.display())]
     MissingColumn {
@@ -123,7 +131,9 @@ pub(super) fn open_csv(
         source,
     };
     let file = std::fs::File::open(path).map_err(io)?;
-    let mut reader = csv::ReaderBuilder::new().has_headers(true).from_reader(file);
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .from_reader(file);
     let header = reader
         .headers()
         .map_err(|e| FlightError::Content {

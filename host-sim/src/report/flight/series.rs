@@ -87,7 +87,10 @@ impl FlightSeries {
         let step = median_interval(&tracks)
             .ok_or_else(|| log.content("no two rows of a drone at different times".to_owned()))?
             .max(1e-3);
-        let first = tracks.iter().map(|k| k.samples[0].t).fold(f64::MIN, f64::max);
+        let first = tracks
+            .iter()
+            .map(|k| k.samples[0].t)
+            .fold(f64::MIN, f64::max);
         let last = tracks
             .iter()
             .map(|k| k.samples[k.samples.len() - 1].t)

@@ -162,7 +162,9 @@ pub fn compare_step(
         .filter(|(t, v)| !v.is_nan() && (-0.2..=2.0).contains(t))
         .collect();
     if logged.is_empty() {
-        return Err(content("no vx sample from -0.2 s to 2 s of the step".to_owned()));
+        return Err(content(
+            "no vx sample from -0.2 s to 2 s of the step".to_owned(),
+        ));
     }
     let model = read_model(vehicle_step)?;
     let at = |t: f64| -> f64 {
@@ -183,7 +185,11 @@ pub fn compare_step(
             .filter(|(t, _)| t + s >= -0.2)
             .collect();
         let model_at: Vec<f64> = kept.iter().map(|(t, _)| at(t + s)).collect();
-        let d: Vec<f64> = kept.iter().zip(&model_at).map(|((_, v), m)| v - m).collect();
+        let d: Vec<f64> = kept
+            .iter()
+            .zip(&model_at)
+            .map(|((_, v), m)| v - m)
+            .collect();
         if d.is_empty() {
             continue;
         }

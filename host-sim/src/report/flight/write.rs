@@ -90,7 +90,7 @@ fn summary(log: &FlightLog, series: &FlightSeries, model: &Model) -> Value {
 ///
 /// # Errors
 ///
-/// [`FlightError::Io`] naming the file that cannot be written.
+/// [`FlightError::Write`] naming the file that cannot be written.
 pub fn write_flight_dir(
     log: &FlightLog,
     series: &FlightSeries,
@@ -100,7 +100,7 @@ pub fn write_flight_dir(
 ) -> Result<Vec<PathBuf>, FlightError> {
     let io = |path: &Path| {
         let path = path.to_path_buf();
-        move |source| FlightError::Io { path, source }
+        move |source| FlightError::Write { path, source }
     };
     std::fs::create_dir_all(dir).map_err(io(dir))?;
     let csv_path = dir.join("timeseries.csv");
