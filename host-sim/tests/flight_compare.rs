@@ -129,6 +129,16 @@ fn a_served_flight_is_held_against_its_run() {
         "{c}"
     );
     assert_eq!(j["within_tolerance"], true);
+    // docs/crazyflie.md quotes these figures.
+    let doc = std::fs::read_to_string(root().join("docs/crazyflie.md")).expect("docs");
+    let quoted = format!(
+        "RMS {:.3}, {:.3}, {:.3}, {:.3} m for agents 1–4",
+        rms[0], rms[1], rms[2], rms[3]
+    );
+    assert!(
+        doc.contains(&quoted),
+        "docs/crazyflie.md should say {quoted}"
+    );
     for f in ["compare_positions.png", "compare_angles.png"] {
         assert!(out.join(f).is_file(), "{f}");
     }

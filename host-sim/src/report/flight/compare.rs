@@ -231,7 +231,7 @@ pub fn compare(
     let err = series.max_angle_err(model);
     let end = formation_end(log).map_or(f64::INFINITY, |e| e - series.start);
     let mut o = Overlay::default();
-    for f in 0..series.frames() {
+    for (f, &flight_err) in err.iter().enumerate() {
         let tau = series.t[f] - series.start;
         if tau < -1e-9 || tau > end + 1e-9 {
             continue;
@@ -243,7 +243,7 @@ pub fn compare(
         o.run_q.extend(rq);
         o.flight_q.extend_from_slice(series.q_at(f));
         o.run_err.push(re);
-        o.flight_err.push(err[f]);
+        o.flight_err.push(flight_err);
         let faulty = (0..n)
             .filter(|&i| {
                 matches!(series.state[f * n + i], Some(2 | 3))
@@ -283,7 +283,7 @@ pub fn compare(
             "rms_common_start_m": common,
             "max_m": d(Vec2::zeros()).fold(0.0, f64::max),
             "start_offset_m": (o.flight_q[i] - o.run_q[i]).norm(),
-            "final_difference_m": d(Vec2::zeros()).last().unwrap_or(f64::NAN),
+            "final_difference_m": d(Vec2::zeros()).next_back().unwrap_or(f64::NAN),
         }));
     }
     let worst = |e: &[f64]| e.iter().copied().fold(0.0, f64::max).to_degrees();
