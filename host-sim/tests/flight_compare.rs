@@ -7,7 +7,8 @@
 //!
 //! * `a_served_flight_is_held_against_its_run`: `host-sim compare` of the flight and a
 //!   run of the same scenario: every agent within 15 cm RMS, the same largest angle error
-//!   and convergence within a second; the negative control, a run with the leader edge
+//!   and convergence within a second, both in one replay page; the negative control, a
+//!   run with the leader edge
 //!   mirrored, is beyond (exit 1, every agent more than 0.5 m RMS).
 //! * `a_flight_converts_like_a_run`: `host-sim flight` writes timeseries.csv, run.mcap and
 //!   replay.html; the flight's angle errors at its first instant are the run's (the same
@@ -142,6 +143,17 @@ fn a_served_flight_is_held_against_its_run() {
     for f in ["compare_positions.png", "compare_angles.png"] {
         assert!(out.join(f).is_file(), "{f}");
     }
+    // Both in one replay page: the run's agents and the flight's, the same instants.
+    let page = std::fs::read_to_string(out.join("overlay/replay.html")).expect("overlay");
+    assert!(
+        page.contains(r#""ids":["1","2","3","4","flight-1","flight-2","flight-3","flight-4"]"#),
+        "the overlay's ids"
+    );
+    let instants = j["alignment"]["instants"].as_u64().expect("instants");
+    assert!(
+        page.contains(&format!(r#""rows":{instants},"#)),
+        "{instants} frames"
+    );
     // The negative control: the run of the mirrored leader edge is another flight.
     let (bad, out_bad) = (tmp.path().join("bad"), tmp.path().join("cmp-bad"));
     run_square(&bad, &["--set", "leader.displacement=[-1.0,1.0]"]);

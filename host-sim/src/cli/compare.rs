@@ -5,8 +5,8 @@
 use crate::exit_code;
 use crate::model::Model;
 use crate::report::flight::{
-    compare, compare_step, plot_overlay, plot_step, step_csv, write_flight_dir, Clock, FlightError,
-    FlightLog, FlightSeries, Options, RunSeries,
+    compare, compare_step, plot_overlay, plot_step, step_csv, write_flight_dir, write_overlay,
+    Clock, FlightError, FlightLog, FlightSeries, Options, RunSeries,
 };
 use clap::Args;
 use serde_json::Value;
@@ -55,7 +55,7 @@ pub struct CompareArgs {
     /// file's directory's compare/).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// Do not draw the figures.
+    /// Do not draw the figures nor write the overlay's replay page (OUT/overlay/).
     #[arg(long)]
     pub no_plots: bool,
 }
@@ -267,6 +267,11 @@ fn flight_compare(args: &CompareArgs, quiet: bool) -> Result<u8, u8> {
             eprintln!("error: {e}");
             exit_code::IO
         })?);
+        let overlay = out.join("overlay");
+        files.push(
+            write_overlay(&overlay, &c.overlay, &model, &args.reference, &args.log)
+                .map_err(|e| fail(&e))?,
+        );
     }
     if !quiet {
         for f in files {

@@ -13,6 +13,7 @@ use super::log::{column, open_csv, Cells, FlightError, FlightLog};
 use super::series::FlightSeries;
 use super::write::{changes, state_name, user_id};
 use crate::model::Model;
+use crate::report::{header as run_header, BASE_COLUMNS};
 use ph_formation_core::Vec2;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
@@ -20,7 +21,7 @@ use std::path::{Path, PathBuf};
 /// What a run directory must hold.
 const RUN_DIR: &str = "the timeseries.csv of host-sim run's output directory";
 
-/// A run's logged positions and largest angle error (`timeseries.csv`) and its
+/// A run's logged positions, velocities, angle errors and V (`timeseries.csv`) and its
 /// `summary.json`.
 #[derive(Clone, Debug)]
 pub struct RunSeries {
@@ -30,16 +31,33 @@ pub struct RunSeries {
     pub t: Vec<f64>,
     /// Positions, `rows × agents` (model order).
     pub q: Vec<Vec2<f64>>,
+    /// Velocities, as [`Self::q`].
+    pub v: Vec<Vec2<f64>>,
     /// `max_angle_err` (rad).
     pub max_angle_err: Vec<f64>,
+    /// Every angle's error, `rows × angles` (model order, columns `angle_err_*`).
+    pub angles: Vec<f64>,
+    /// `V`.
+    pub big_v: Vec<f64>,
     /// `summary.json` (`null` when absent).
     pub summary: Value,
     n: usize,
+    n_angles: usize,
+}
+
+/// A run interpolated at one instant.
+struct RunAt {
+    q: Vec<Vec2<f64>>,
+    v: Vec<Vec2<f64>>,
+    angles: Vec<f64>,
+    err: f64,
+    big_v: f64,
 }
 
 impl RunSeries {
-    /// Reads `dir/timeseries.csv` (columns `t`, `max_angle_err`, `x_<id>`, `y_<id>` of
-    /// every agent of `model`) and `dir/summary.json` if there.
+    /// Reads `dir/timeseries.csv` (columns `t`, `V`, `max_angle_err`, `x_<id>`, `y_<id>`,
+    /// `vx_<id>`, `vy_<id>` of every agent of `model` and its `angle_err_*`) and
+    /// `dir/summary.json` if there.
     ///
     /// # Errors
     ///
@@ -48,21 +66,28 @@ impl RunSeries {
         let path = dir.join("timeseries.csv");
         let (mut reader, header) = open_csv(&path)?;
         let need = |c: &str| column(&path, &header, c, RUN_DIR);
-        let (ct, ce) = (need("t")?, need("max_angle_err")?);
+        let (ct, ce, cv) = (need("t")?, need("max_angle_err")?, need("V")?);
         let mut cq = Vec::with_capacity(model.n());
         for a in &model.agents {
-            cq.push((
-                need(&format!("x_{}", a.name))?,
-                need(&format!("y_{}", a.name))?,
-            ));
+            let [x, y, vx, vy] = ["x", "y", "vx", "vy"].map(|c| need(&format!("{c}_{}", a.name)));
+            cq.push([x?, y?, vx?, vy?]);
         }
+        let n_agent_cols = BASE_COLUMNS.len() + 4 * model.n();
+        let ca = run_header(model, &[])[n_agent_cols..]
+            .iter()
+            .map(|c| need(c))
+            .collect::<Result<Vec<usize>, _>>()?;
         let mut s = Self {
             dir: dir.to_path_buf(),
             t: Vec::new(),
             q: Vec::new(),
+            v: Vec::new(),
             max_angle_err: Vec::new(),
+            angles: Vec::new(),
+            big_v: Vec::new(),
             summary: Value::Null,
             n: model.n(),
+            n_angles: ca.len(),
         };
         let mut record = csv::StringRecord::new();
         let mut line = 1u64;
@@ -86,8 +111,13 @@ impl RunSeries {
             };
             s.t.push(c.number(ct)?);
             s.max_angle_err.push(c.optional(Some(ce))?);
-            for &(x, y) in &cq {
+            s.big_v.push(c.optional(Some(cv))?);
+            for &[x, y, vx, vy] in &cq {
                 s.q.push(Vec2::new(c.optional(Some(x))?, c.optional(Some(y))?));
+                s.v.push(Vec2::new(c.optional(Some(vx))?, c.optional(Some(vy))?));
+            }
+            for &a in &ca {
+                s.angles.push(c.optional(Some(a))?);
             }
         }
         if s.t.len() < 2 {
@@ -106,9 +136,8 @@ impl RunSeries {
         Ok(s)
     }
 
-    /// Positions and largest angle error at `t` (linear between rows), `None` outside
-    /// the run.
-    fn at(&self, t: f64) -> Option<(Vec<Vec2<f64>>, f64)> {
+    /// The run at `t` (linear between rows), `None` outside it.
+    fn at(&self, t: f64) -> Option<RunAt> {
         let last = *self.t.last()?;
         if t < self.t[0] || t > last + 1e-9 {
             return None;
@@ -123,12 +152,23 @@ impl RunSeries {
         } else {
             0.0
         };
-        let n = self.n;
-        let q = (0..n)
-            .map(|i| self.q[a * n + i] + (self.q[b * n + i] - self.q[a * n + i]) * w)
-            .collect();
-        let e = self.max_angle_err[a] + (self.max_angle_err[b] - self.max_angle_err[a]) * w;
-        Some((q, e))
+        let lerp = |x: &[f64], m: usize| -> Vec<f64> {
+            (0..m)
+                .map(|i| x[a * m + i] + (x[b * m + i] - x[a * m + i]) * w)
+                .collect()
+        };
+        let lerp2 = |x: &[Vec2<f64>], m: usize| -> Vec<Vec2<f64>> {
+            (0..m)
+                .map(|i| x[a * m + i] + (x[b * m + i] - x[a * m + i]) * w)
+                .collect()
+        };
+        Some(RunAt {
+            q: lerp2(&self.q, self.n),
+            v: lerp2(&self.v, self.n),
+            angles: lerp(&self.angles, self.n_angles),
+            err: lerp(&self.max_angle_err, 1)[0],
+            big_v: lerp(&self.big_v, 1)[0],
+        })
     }
 }
 
@@ -151,6 +191,16 @@ pub struct Overlay {
     pub run_q: Vec<Vec2<f64>>,
     /// The flight's positions, as [`Self::run_q`].
     pub flight_q: Vec<Vec2<f64>>,
+    /// The run's velocities, as [`Self::run_q`].
+    pub run_v: Vec<Vec2<f64>>,
+    /// The flight's velocities, as [`Self::run_q`].
+    pub flight_v: Vec<Vec2<f64>>,
+    /// The run's angle errors (rad), `instants × angles` (model order).
+    pub run_angles: Vec<f64>,
+    /// The flight's, as [`Self::run_angles`].
+    pub flight_angles: Vec<f64>,
+    /// The run's V.
+    pub run_big_v: Vec<f64>,
     /// Largest angle errors (rad).
     pub run_err: Vec<f64>,
     /// See [`Self::run_err`].
@@ -228,7 +278,8 @@ pub fn compare(
     options: Options,
 ) -> Result<Comparison, FlightError> {
     let n = model.n();
-    let err = series.max_angle_err(model);
+    let (err, angles) = series.angle_errors(model);
+    let n_angles = 2 * model.triangles.len();
     let end = formation_end(log).map_or(f64::INFINITY, |e| e - series.start);
     let mut o = Overlay::default();
     for (f, &flight_err) in err.iter().enumerate() {
@@ -236,13 +287,19 @@ pub fn compare(
         if tau < -1e-9 || tau > end + 1e-9 {
             continue;
         }
-        let Some((rq, re)) = run.at(tau.max(0.0)) else {
+        let Some(r) = run.at(tau.max(0.0)) else {
             continue;
         };
         o.t.push(tau.max(0.0));
-        o.run_q.extend(rq);
+        o.run_q.extend(r.q);
+        o.run_v.extend(r.v);
+        o.run_angles.extend(r.angles);
+        o.run_err.push(r.err);
+        o.run_big_v.push(r.big_v);
         o.flight_q.extend_from_slice(series.q_at(f));
-        o.run_err.push(re);
+        o.flight_v.extend_from_slice(series.v_at(f));
+        o.flight_angles
+            .extend_from_slice(&angles[f * n_angles..(f + 1) * n_angles]);
         o.flight_err.push(flight_err);
         let faulty = (0..n)
             .filter(|&i| {

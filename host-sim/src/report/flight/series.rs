@@ -184,13 +184,21 @@ impl FlightSeries {
         Ok(())
     }
 
-    /// The largest angle error (rad) at each instant, from [`Diagnostics`].
-    pub fn max_angle_err(&self, model: &Model) -> Vec<f64> {
-        let mut out = Vec::with_capacity(self.frames());
+    /// The largest angle error (rad) at each instant, and every angle's signed error
+    /// (`instants × angles`, model order), from [`Diagnostics`].
+    pub fn angle_errors(&self, model: &Model) -> (Vec<f64>, Vec<f64>) {
+        let mut max = Vec::with_capacity(self.frames());
+        let mut all = Vec::with_capacity(self.frames() * 2 * model.triangles.len());
         let _ = self.for_each_row(model, |r| {
-            out.push(r.snap.max_angle_err);
+            max.push(r.snap.max_angle_err);
+            all.extend_from_slice(&r.snap.angle_err);
             Ok::<(), ()>(())
         });
-        out
+        (max, all)
+    }
+
+    /// Velocities at instant `f`.
+    pub fn v_at(&self, f: usize) -> &[Vec2<f64>] {
+        &self.v[f * self.n..(f + 1) * self.n]
     }
 }
