@@ -28,6 +28,10 @@ against `host-sim vehicle step --speed V --out DIR`'s DIR/step.csv (`v_along`),
 aligned by the shift within +-200 ms (four log periods: the setpoint column is the
 second block's latest value) that fits best; prints the RMS
 and largest difference and exits 0 when the RMS is within --tolerance m/s.
+`host-sim compare DIR STEP_LOG --speed V` is the same check in Rust (and
+`host-sim compare RUN_DIR FLIGHT_LOG` holds a `fly` log against a run:
+docs/crazyflie.md "Flights beside simulations"); this one stays for a ground station
+without host-sim.
 """
 import argparse
 import csv

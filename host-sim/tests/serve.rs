@@ -20,7 +20,10 @@
 //!   the ground (negative control: the check fails on the log without agent 4); then
 //!   `swarm.py step` flies agent 1 through a 0.3 m/s velocity step and `compare-step`
 //!   holds its log against `host-sim vehicle step` (negative control: the 0.6 m/s step
-//!   does not match).
+//!   does not match); `host-sim compare` gives the same verdicts, and holds the flight
+//!   log against `host-sim run` of the square (within 15 cm RMS per agent; negative
+//!   controls: the log without agent 4 is refused, a run with the leader edge mirrored
+//!   is beyond the tolerance).
 
 use std::net::UdpSocket;
 use std::path::{Path, PathBuf};
@@ -513,6 +516,17 @@ fn the_swarm_tool_flies_the_square_and_writes_its_flight_log() {
         let model = model.to_str().expect("utf-8 path");
         let (ok, text) = swarm(&["compare-step", "step.csv", model, "--speed", "0.3"]);
         assert_eq!(ok, matches, "against the {speed} m/s step: {text}");
+        // host-sim compare: the same check in Rust, the same verdict.
+        let step_log = dir.join("step.csv");
+        let (code, err) = host_sim(&[
+            "compare",
+            model,
+            step_log.to_str().expect("utf-8 path"),
+            "--speed",
+            "0.3",
+            "--no-plots",
+        ]);
+        assert_eq!(code, if matches { 0 } else { 1 }, "{speed} m/s: {err}");
     }
     assert!(said.contains("swarm: pre-flight passed"), "{said}");
     assert!(said.contains("swarm: worst angle error"), "{said}");
@@ -533,4 +547,68 @@ fn the_swarm_tool_flies_the_square_and_writes_its_flight_log() {
         .map(|l| format!("{l}\n"))
         .collect();
     assert!(check_flight(&without_4).is_err());
+    compare_flight_with_run(&dir, &log, &without_4);
+}
+
+/// `host-sim compare` of the served square's flight log against `host-sim run` of the
+/// same scenario: every agent within 15 cm RMS (common start), both converge (largest
+/// angle error within 5°) within a second of each other. Negative controls: the log
+/// without agent 4 is refused naming it; the run with the leader edge mirrored is beyond
+/// the tolerance.
+fn compare_flight_with_run(dir: &Path, log: &Path, without_4: &str) {
+    let compare = |run: &Path, flight: &Path, out: &str| {
+        let out = dir.join(out);
+        let (code, err) = host_sim(&[
+            "compare",
+            run.to_str().expect("utf-8 path"),
+            flight.to_str().expect("utf-8 path"),
+            "--clock",
+            "drone_ms",
+            "--set",
+            "world=crazyflie",
+            "--settle-deg",
+            "5",
+            "--tolerance-m",
+            "0.15",
+            "--out",
+            out.to_str().expect("utf-8 path"),
+        ]);
+        let json = std::fs::read_to_string(out.join("compare.json")).unwrap_or_default();
+        (code, err, serde_json::from_str(&json).unwrap_or_default())
+    };
+    let run = |name: &str, extra: &[&str]| {
+        let out = dir.join(name);
+        let mut args = vec!["-q", "run", "crazyflie-app/formation.toml"];
+        args.extend(["--set", "world=crazyflie", "--duration", "15", "--no-plots"]);
+        args.extend_from_slice(extra);
+        args.extend(["--out", out.to_str().expect("utf-8 path")]);
+        let (code, err) = host_sim(&args);
+        assert!(code == 0 || code == 10, "{err}");
+        out
+    };
+    let same = run("run", &[]);
+    let (code, err, j): (i32, String, serde_json::Value) = compare(&same, log, "compare");
+    println!("{j:#}");
+    assert_eq!(code, 0, "{err}");
+    let rms: Vec<f64> = j["agents"]
+        .as_array()
+        .expect("agents")
+        .iter()
+        .map(|a| a["rms_common_start_m"].as_f64().expect("rms"))
+        .collect();
+    assert!(rms.len() == 4 && rms.iter().all(|r| *r < 0.15), "{rms:?}");
+    let c = &j["convergence_s"];
+    let (cr, cf) = (c["run"].as_f64(), c["flight"].as_f64());
+    assert!(
+        (cr.expect("run settles") - cf.expect("flight settles")).abs() < 1.0,
+        "{c}"
+    );
+    let missing = dir.join("without-4.csv");
+    std::fs::write(&missing, without_4).expect("write");
+    let (code, err, _) = compare(&same, &missing, "compare-without-4");
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("agent 4"), "{err}");
+    let mirrored = run("run-mirrored", &["--set", "leader.displacement=[-1.0,1.0]"]);
+    let (code, err, _) = compare(&mirrored, log, "compare-mirrored");
+    assert_eq!(code, 1, "{err}");
 }

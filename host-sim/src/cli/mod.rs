@@ -1,7 +1,8 @@
-//! The command line: `host-sim [run|validate|list|plot|design|export|sweep|vehicle]` (exit codes
+//! The command line: `host-sim [run|validate|list|plot|design|export|sweep|vehicle|compare|flight]` (exit codes
 //! in [`crate::exit_code`] and `docs/outputs.md`): a thin client of the library API
 //! ([`crate::Simulation`]).
 
+mod compare;
 mod design;
 mod export;
 mod run;
@@ -11,6 +12,7 @@ mod sweep;
 mod vehicle;
 mod view;
 
+pub use compare::{CompareArgs, FlightArgs};
 pub use design::{DesignArgs, Shape};
 pub use serve::ServeArgs;
 
@@ -83,6 +85,13 @@ pub enum Command {
         #[arg(long)]
         no_open: bool,
     },
+    /// Hold a run against a flight of the swarm tool (positions, angle errors, faults on
+    /// one time axis), or a step-test log against `host-sim vehicle step`; prints the
+    /// differences, writes compare.json and figures (docs/crazyflie.md).
+    Compare(CompareArgs),
+    /// A flight log of the swarm tool as a run directory: timeseries.csv, summary.json,
+    /// replay.html (`host-sim view DIR`) and, with --mcap, run.mcap.
+    Flight(FlightArgs),
 }
 
 /// Arguments of `host-sim export`.
@@ -226,6 +235,8 @@ pub fn execute(cli: Cli) -> u8 {
         }
         Some(Command::Sweep(args)) => sweep::command(&args, quiet),
         Some(Command::View { dir, no_open }) => view::view_command(&dir, no_open),
+        Some(Command::Compare(args)) => compare::compare_command(&args, quiet),
+        Some(Command::Flight(args)) => compare::flight_command(&args, quiet),
         Some(Command::Plot { dir }) => match crate::report::plot_run(&dir) {
             Ok(files) => {
                 if !quiet {

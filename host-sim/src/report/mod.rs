@@ -8,6 +8,7 @@ mod channel;
 mod columns;
 mod csv;
 mod faults;
+pub mod flight;
 mod mcap;
 pub mod plot;
 pub mod replay;

@@ -187,9 +187,15 @@ where
     }
     mesh.draw()?;
     // A small horizontal offset per series keeps overlapping error bars apart (all
-    // offsets within 6 % of the x span).
+    // offsets within 6 % of the x span); none in a panel without error bars, whose x
+    // is exact (time series held side by side, `host-sim compare`).
     let nl = panel.lines.len().max(1) as f64;
-    let step = (x1 - x0) * (0.06 / nl).min(0.006);
+    let bars = all().any(|p| sane(p.lo) && sane(p.hi) && p.hi > p.lo);
+    let step = if bars {
+        (x1 - x0) * (0.06 / nl).min(0.006)
+    } else {
+        0.0
+    };
     for (i, l) in panel.lines.iter().enumerate() {
         let col = colour(i);
         let dx = step * (i as f64 - (nl - 1.0) / 2.0);
