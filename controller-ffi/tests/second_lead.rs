@@ -42,6 +42,40 @@ fn actuator() -> ph_actuator {
     act
 }
 
+/// [`actuator`] with the second lead and the jerk filter `filter` (s).
+fn filtered_actuator(filter: f32) -> ph_actuator {
+    let mut act = actuator();
+    // SAFETY: valid pointer.
+    unsafe {
+        assert_eq!(
+            ph_actuator_set_second_lead(&mut act, SECOND),
+            ph_status::PH_OK
+        );
+        assert_eq!(
+            ph_actuator_set_jerk_filter(&mut act, filter),
+            ph_status::PH_OK
+        );
+    }
+    act
+}
+
+/// One `ph_actuate` of `act` over 10 ms: its setpoint (the call must succeed).
+fn actuate(act: &mut ph_actuator, force: [f32; 2], measured: [f32; 2]) -> [f32; 2] {
+    let mut setpoint = [0.0_f32; 2];
+    // SAFETY: valid pointers, 2 floats each.
+    let s = unsafe {
+        ph_actuate(
+            act,
+            force.as_ptr(),
+            measured.as_ptr(),
+            0.01,
+            setpoint.as_mut_ptr(),
+        )
+    };
+    assert_eq!(s, ph_status::PH_OK);
+    setpoint
+}
+
 /// The core's plant of [`actuator`], with the second lead when `second`.
 fn core_plant(second: bool) -> VirtualMass<f32> {
     let p = VirtualMass::new(1.0_f32, [0.5, 0.25], 1.0)
@@ -64,18 +98,7 @@ fn steps_match(
     let measured = [0.1_f32, -0.2];
     let mut differs = false;
     for force in [[0.2_f32, 0.1], [0.4, 0.1], [0.5, -0.3], [0.1, 0.0]] {
-        let mut setpoint = [0.0_f32; 2];
-        // SAFETY: valid pointers, 2 floats each.
-        let s = unsafe {
-            ph_actuate(
-                act,
-                force.as_ptr(),
-                measured.as_ptr(),
-                0.01,
-                setpoint.as_mut_ptr(),
-            )
-        };
-        assert_eq!(s, ph_status::PH_OK);
+        let setpoint = actuate(act, force, measured);
         assert_eq!(setpoint, same.step(force, measured, 0.01));
         differs |= setpoint != other.step(force, measured, 0.01);
     }
@@ -116,18 +139,7 @@ fn the_c_api_leads_like_the_core() {
 #[test]
 fn the_c_api_filters_the_jerk_like_the_core() {
     let filter = 0.03_f32;
-    let mut act = actuator();
-    // SAFETY: valid pointer.
-    unsafe {
-        assert_eq!(
-            ph_actuator_set_second_lead(&mut act, SECOND),
-            ph_status::PH_OK
-        );
-        assert_eq!(
-            ph_actuator_set_jerk_filter(&mut act, filter),
-            ph_status::PH_OK
-        );
-    }
+    let mut act = filtered_actuator(filter);
     let filtered = core_plant(true).with_jerk_filter(filter).unwrap();
     assert!(steps_match(
         &mut act,
@@ -149,18 +161,7 @@ fn the_c_api_filters_the_jerk_like_the_core() {
 /// (which drops it) differs (negative control).
 #[test]
 fn a_cleared_command_is_the_cores_reseed() {
-    let mut act = actuator();
-    // SAFETY: valid pointer.
-    unsafe {
-        assert_eq!(
-            ph_actuator_set_second_lead(&mut act, SECOND),
-            ph_status::PH_OK
-        );
-        assert_eq!(
-            ph_actuator_set_jerk_filter(&mut act, 0.03),
-            ph_status::PH_OK
-        );
-    }
+    let mut act = filtered_actuator(0.03);
     let plant = core_plant(true).with_jerk_filter(0.03).unwrap();
     let (mut same, mut other) = (VelocityCommand::new(plant), VelocityCommand::new(plant));
     let measured = [0.1_f32, -0.2];
@@ -176,18 +177,7 @@ fn a_cleared_command_is_the_cores_reseed() {
             same.reseed();
             other.restart();
         }
-        let mut setpoint = [0.0_f32; 2];
-        // SAFETY: valid pointers, 2 floats each.
-        let s = unsafe {
-            ph_actuate(
-                &mut act,
-                force.as_ptr(),
-                measured.as_ptr(),
-                0.01,
-                setpoint.as_mut_ptr(),
-            )
-        };
-        assert_eq!(s, ph_status::PH_OK);
+        let setpoint = actuate(&mut act, *force, measured);
         assert_eq!(setpoint, same.step(*force, measured, 0.01), "step {k}");
         let o = other.step(*force, measured, 0.01);
         differs |= k >= 6 && setpoint != o;

@@ -9,7 +9,7 @@
 //! the last row in which every drone is still in formation, hold or landing (after it,
 //! the tool lands them by the high-level commander).
 
-use super::log::{column, open_csv, Cells, FlightError, FlightLog};
+use super::log::{column, for_each_row, open_csv, FlightError, FlightLog};
 use super::series::FlightSeries;
 use super::write::{changes, state_name, user_id};
 use crate::model::Model;
@@ -89,26 +89,7 @@ impl RunSeries {
             n: model.n(),
             n_angles: ca.len(),
         };
-        let mut record = csv::StringRecord::new();
-        let mut line = 1u64;
-        loop {
-            line += 1;
-            match reader.read_record(&mut record) {
-                Ok(false) => break,
-                Ok(true) => {}
-                Err(e) => {
-                    return Err(FlightError::Content {
-                        path,
-                        reason: format!("line {line}: malformed CSV: {e}"),
-                    })
-                }
-            }
-            let c = Cells {
-                path: &path,
-                header: &header,
-                record: &record,
-                line,
-            };
+        for_each_row(&path, &mut reader, &header, |c| {
             s.t.push(c.number(ct)?);
             s.max_angle_err.push(c.optional(Some(ce))?);
             s.big_v.push(c.optional(Some(cv))?);
@@ -119,7 +100,8 @@ impl RunSeries {
             for &a in &ca {
                 s.angles.push(c.optional(Some(a))?);
             }
-        }
+            Ok(())
+        })?;
         if s.t.len() < 2 {
             return Err(FlightError::Content {
                 path,

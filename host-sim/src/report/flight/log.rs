@@ -163,6 +163,38 @@ pub(super) fn column(
         })
 }
 
+/// Every record of `reader` (opened by [`open_csv`] on `path`, with `header`) as
+/// [`Cells`] numbered by its line, in order, to `each`; the first error ends it (a
+/// malformed record is one, naming its line).
+pub(super) fn for_each_row(
+    path: &Path,
+    reader: &mut csv::Reader<std::fs::File>,
+    header: &[String],
+    mut each: impl FnMut(&Cells<'_>) -> Result<(), FlightError>,
+) -> Result<(), FlightError> {
+    let mut record = csv::StringRecord::new();
+    let mut line = 1u64;
+    loop {
+        line += 1;
+        match reader.read_record(&mut record) {
+            Ok(false) => return Ok(()),
+            Ok(true) => {}
+            Err(e) => {
+                return Err(FlightError::Content {
+                    path: path.to_path_buf(),
+                    reason: format!("line {line}: malformed CSV: {e}"),
+                })
+            }
+        }
+        each(&Cells {
+            path,
+            header,
+            record: &record,
+            line,
+        })?;
+    }
+}
+
 /// Reads the cells of one CSV record by column, naming line and column on error.
 pub(super) struct Cells<'a> {
     pub(super) path: &'a Path,
@@ -245,26 +277,7 @@ impl FlightLog {
         let (state, fault) = (opt("state"), opt("fault"));
         let (hold, landings) = (opt("hold_ticks"), opt("landings"));
         let mut tracks: Vec<Track> = Vec::new();
-        let mut record = csv::StringRecord::new();
-        let mut line = 1u64;
-        loop {
-            line += 1;
-            match reader.read_record(&mut record) {
-                Ok(false) => break,
-                Ok(true) => {}
-                Err(e) => {
-                    return Err(FlightError::Content {
-                        path: path.to_path_buf(),
-                        reason: format!("line {line}: malformed CSV: {e}"),
-                    })
-                }
-            }
-            let c = Cells {
-                path,
-                header: &header,
-                record: &record,
-                line,
-            };
+        for_each_row(path, &mut reader, &header, |c| {
             let id = c.text(agent).to_owned();
             if id.is_empty() {
                 return Err(c.bad(agent, "no agent id"));
@@ -293,7 +306,8 @@ impl FlightLog {
                     samples: vec![s],
                 }),
             }
-        }
+            Ok(())
+        })?;
         if tracks.is_empty() {
             return Err(FlightError::Content {
                 path: path.to_path_buf(),

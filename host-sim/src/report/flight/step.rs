@@ -7,7 +7,7 @@
 //! latest value: up to four log periods late); within when that RMS is at most the
 //! tolerance.
 
-use super::log::{column, open_csv, Cells, FlightError, FLIGHT_LOG};
+use super::log::{column, for_each_row, open_csv, FlightError, FLIGHT_LOG};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 
@@ -66,24 +66,10 @@ fn read_model(path: &Path) -> Result<Vec<(f64, f64)>, FlightError> {
         column(path, &header, "v_along", STEP_CSV)?,
     );
     let mut out = Vec::new();
-    let mut record = csv::StringRecord::new();
-    let mut line = 1u64;
-    while reader
-        .read_record(&mut record)
-        .map_err(|e| FlightError::Content {
-            path: path.to_path_buf(),
-            reason: format!("line {}: malformed CSV: {e}", line + 1),
-        })?
-    {
-        line += 1;
-        let c = Cells {
-            path,
-            header: &header,
-            record: &record,
-            line,
-        };
+    for_each_row(path, &mut reader, &header, |c| {
         out.push((c.number(ct)?, c.number(cv)?));
-    }
+        Ok(())
+    })?;
     if out.len() < 2 {
         return Err(FlightError::Content {
             path: path.to_path_buf(),
@@ -105,31 +91,17 @@ fn read_log(path: &Path, agent: Option<&str>) -> Result<Vec<(f64, f64, f64)>, Fl
         need("agent")?,
     );
     let mut out = Vec::new();
-    let mut record = csv::StringRecord::new();
-    let mut line = 1u64;
-    while reader
-        .read_record(&mut record)
-        .map_err(|e| FlightError::Content {
-            path: path.to_path_buf(),
-            reason: format!("line {}: malformed CSV: {e}", line + 1),
-        })?
-    {
-        line += 1;
-        if agent.is_some_and(|a| record.get(cag).map(str::trim) != Some(a)) {
-            continue;
+    for_each_row(path, &mut reader, &header, |c| {
+        if agent.is_some_and(|a| c.record.get(cag).map(str::trim) != Some(a)) {
+            return Ok(());
         }
-        let c = Cells {
-            path,
-            header: &header,
-            record: &record,
-            line,
-        };
         out.push((
             c.number(cms)?,
             c.optional(Some(csp))?,
             c.optional(Some(cvx))?,
         ));
-    }
+        Ok(())
+    })?;
     Ok(out)
 }
 
