@@ -319,10 +319,10 @@ impl<T: Real> VelocityCommand<T> {
     }
 
     /// The next step starts from the measured velocity, keeping the virtual acceleration
-    /// the second-order lead differences (S21b/S21d). Call it when the agent enters its
-    /// safe output (SPEC S21c; once per episode): the safe force damps the vehicle's own
-    /// velocity, not a virtual one that may have run ahead of it, and the setpoint's lead
-    /// goes on without a jump (the C API's `has_command = 0`).
+    /// the second-order lead differences (S21b/S21d). Call it once the agent's safe
+    /// output has lasted the stall limit (SPEC S21c; once per episode): the safe force
+    /// damps the vehicle's own velocity, not a virtual one that may have run ahead of it,
+    /// and the setpoint's lead goes on without a jump (the C API's `has_command = 0`).
     pub fn reseed(&mut self) {
         self.command = None;
     }

@@ -1284,8 +1284,9 @@ ph_status ph_actuator_set_max_gap(ph_actuator *actuator, float max_gap);
  * velocity in `actuator->command`, and writes the setpoint (S21: led by
  * `actuator->lead`) to `setpoint[0..2]`. S21c: the previous virtual velocity is kept
  * within `actuator->max_gap` of `velocity`, and a `dt` above `actuator->max_interval`
- * starts again from `velocity`; set `has_command = 0` on entering the safe output (SPEC S21c). `PH_ERR_ARGUMENT` (nothing written) for
- * an actuator whose parameters `ph_actuator_init` would refuse.
+ * starts again from `velocity`; set `has_command = 0` once a safe output has lasted
+ * `max_interval` (SPEC S21c). `PH_ERR_ARGUMENT` (nothing written) for an actuator
+ * whose parameters `ph_actuator_init` would refuse.
  *
  * # Safety
  * `actuator` is NULL or points to a `ph_actuator`; `force` and `velocity` are NULL or

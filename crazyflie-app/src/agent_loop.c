@@ -10,7 +10,6 @@ ph_status agent_loop_init(agent_loop *loop, uint8_t *memory, size_t size, uint8_
     loop->agent = (ph_agent *)memory;
     loop->id = id;
     loop->first = true;
-    loop->was_safe = false;
 #ifdef FORMATION_USE_STRUCT
     ph_status s = formation_config(id, scratch);
     if (s == PH_OK)
@@ -98,15 +97,24 @@ ph_status agent_loop_tick(agent_loop *loop, uint32_t now_ms, agent_loop_send_fn 
     if (loop->out.status != PH_OUTPUT_NOMINAL && !loop->first)
         loop->safe_ticks++;
 
-    /* The velocity setpoint: S1 integrated by the core (ph_actuate); the first tick
-     * and the entry into the safe output start from the measured velocity (SPEC S21c:
-     * the safe force damps the vehicle's own velocity, not a virtual one that ran
-     * ahead; once per episode, or the setpoint would be the noisy measured velocity at
-     * every safe tick, a random walk). */
-    bool safe = loop->out.status == PH_OUTPUT_SAFE;
-    if (loop->first || (safe && !loop->was_safe))
+    /* The velocity setpoint: S1 integrated by the core (ph_actuate); the first tick,
+     * and a safe output that has lasted the neighbour timeout (the actuator's stall
+     * limit), start from the measured velocity (SPEC S21c: the safe force damps the
+     * vehicle's own velocity, not a virtual one that ran ahead). Once per episode: at
+     * every safe tick the setpoint would be the noisy measured velocity, a random walk;
+     * on every isolated safe tick of a lossy channel, that noise too. */
+    if (loop->out.status != PH_OUTPUT_SAFE) {
+        loop->safe_s = 0.0f;
+        loop->reseeded = false;
+    } else {
+        loop->safe_s += m.dt;
+        if (!loop->reseeded && loop->safe_s >= loop->actuator.max_interval) {
+            loop->actuator.has_command = 0;
+            loop->reseeded = true;
+        }
+    }
+    if (loop->first)
         loop->actuator.has_command = 0;
-    loop->was_safe = safe;
     if (ph_actuate(&loop->actuator, loop->out.force, m.velocity, m.dt, loop->setpoint) != PH_OK)
         loop->setpoint[0] = loop->setpoint[1] = 0.0f;
 

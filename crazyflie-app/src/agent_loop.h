@@ -30,7 +30,6 @@ typedef struct {
     formation_state formation;
     uint8_t id;
     bool first;           /* no tick yet */
-    bool was_safe;        /* the last tick gave the safe output */
     uint32_t previous_ms; /* the previous tick (ms, the control clock) */
     uint32_t origin_ms;   /* time 0 of the schedules v*, z* (agent_loop_restart) */
     ph_output out;        /* the last tick's controller output */
@@ -38,6 +37,8 @@ typedef struct {
     float setpoint[2];    /* the last velocity setpoint (m/s, world frame) */
     uint32_t ticks;
     uint32_t safe_ticks;  /* ticks with the safe output, after the first */
+    float safe_s;         /* how long the current safe output has lasted (s) */
+    bool reseeded;        /* its actuator started again from the velocity (S21c) */
     uint64_t position_counter; /* auth: the next position packet's counter */
 } agent_loop;
 
