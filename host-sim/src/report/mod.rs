@@ -14,6 +14,7 @@ pub mod replay;
 mod series;
 mod summary;
 mod table;
+mod thin;
 mod verdict;
 mod world;
 
@@ -25,3 +26,4 @@ pub use replay::write_replay;
 pub use series::TimeSeries;
 pub use summary::{summary_json, write_summary};
 pub use table::summary_table;
+pub use thin::{expected_rows, SeriesBudget, Thinned};
