@@ -120,6 +120,7 @@ pub struct Simulation<'a> {
     csv: bool,
     mcap: bool,
     budget: SeriesBudget,
+    stride: Option<u64>,
 }
 
 impl<'a> Simulation<'a> {
@@ -135,6 +136,7 @@ impl<'a> Simulation<'a> {
             csv: true,
             mcap: false,
             budget: SeriesBudget::DEFAULT,
+            stride: None,
         }
     }
 
@@ -161,6 +163,13 @@ impl<'a> Simulation<'a> {
     /// The run, its verdict and the in-memory [`Run::series`] are the same either way.
     pub fn series_budget(mut self, budget: SeriesBudget) -> Self {
         self.budget = budget;
+        self
+    }
+
+    /// Keep every `stride`-th row in the row files whatever the budget (for measuring a
+    /// short run at the stride of a long one: `cargo xtask bench-counts`).
+    pub fn row_stride(mut self, stride: u64) -> Self {
+        self.stride = Some(stride.max(1));
         self
     }
 
@@ -223,7 +232,9 @@ impl<'a> Simulation<'a> {
         // One stride for both row files, so that they hold the same rows.
         let columns = report::header(model, &estimates).len() as u64;
         let rows = expected_rows(model);
-        let stride = self.budget.stride(rows, columns);
+        let stride = self
+            .stride
+            .unwrap_or_else(|| self.budget.stride(rows, columns));
         let csv = match &csv_path {
             Some(p) => Some(Thinned::new(
                 CsvRecorder::create(p, model, &estimates)

@@ -425,7 +425,7 @@ fn pose(out: &mut String, (x, y): (f64, f64)) {
 /// `null` for NaN and infinities (which JSON lacks).
 fn number(out: &mut String, x: f64) {
     if x.is_finite() {
-        let _ = write!(out, "{x:?}");
+        super::number::push_f64(out, x);
     } else {
         out.push_str("null");
     }

@@ -9,6 +9,7 @@ mod columns;
 mod csv;
 mod faults;
 mod mcap;
+mod number;
 pub mod plot;
 pub mod replay;
 mod series;

@@ -192,11 +192,8 @@ fn render(
     };
 
     let png = dir.join(format!("{}.png", figure.stem()));
-    {
-        let root = BitMapBackend::new(&png, IMAGE_SIZE).into_drawing_area();
-        draw_figure(figure, &root, run, true).map_err(|e| draw_err(&png, &e))?;
-        root.present().map_err(|e| draw_err(&png, &e))?;
-    }
+    write_png(&png, IMAGE_SIZE, |root| draw_figure(figure, root, run, true))
+        .map_err(|e| draw_err(&png, &e))?;
     written.push(png);
 
     let svg = dir.join(format!("{}.svg", figure.stem()));
@@ -206,6 +203,36 @@ fn render(
         root.present().map_err(|e| draw_err(&svg, &e))?;
     }
     written.push(svg);
+    Ok(())
+}
+
+/// Draws a `size` image with `draw` into memory and writes it to `path` as an 8-bit RGB
+/// PNG with one fixed filter (`Up`) and fast compression. The `image` crate's encoder,
+/// which plotters' `BitMapBackend::new` uses, tries all five filters on every row
+/// (adaptive): that was 57 % of the instructions of `host-sim run paper` with its
+/// default outputs (callgrind, dev build; docs/outputs.md, "What the outputs cost").
+/// The pixels are the same.
+pub(crate) fn write_png(
+    path: &Path,
+    (w, h): (u32, u32),
+    draw: impl FnOnce(&DrawingArea<BitMapBackend<'_>, Shift>) -> DrawResult,
+) -> DrawResult {
+    let mut pixels = vec![0u8; w as usize * h as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut pixels, (w, h)).into_drawing_area();
+        draw(&root)?;
+        root.present()?;
+    }
+    let file = std::io::BufWriter::new(std::fs::File::create(path)?);
+    let mut encoder = png::Encoder::new(file, w, h);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_compression(png::Compression::Fast);
+    encoder.set_filter(png::FilterType::Up);
+    encoder.set_adaptive_filter(png::AdaptiveFilterType::NonAdaptive);
+    let mut writer = encoder.write_header()?;
+    writer.write_image_data(&pixels)?;
+    writer.finish()?;
     Ok(())
 }
 
