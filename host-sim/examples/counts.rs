@@ -147,7 +147,10 @@ fn case(args: &[String]) -> Result<u64, String> {
             .map_err(|e| e.to_string())?;
             match ph_formation_sim::cli::execute(cli) {
                 0 => Ok(0),
-                code => Err(format!("host-sim {} exited with {code}", args[1..].join(" "))),
+                code => Err(format!(
+                    "host-sim {} exited with {code}",
+                    args[1..].join(" ")
+                )),
             }
         }
         Some("draw") => {

@@ -58,7 +58,13 @@ fn a_100_agent_100_s_run_writes_under_50_mb_with_the_verdict_of_the_whole_run() 
     let tmp = tempfile::tempdir().expect("temp dir");
     let scenario = lattice(tmp.path());
     let out = tmp.path().join("run");
-    let o = host_sim(&["run", &scenario, "-q", "--out", out.to_str().expect("utf-8")]);
+    let o = host_sim(&[
+        "run",
+        &scenario,
+        "-q",
+        "--out",
+        out.to_str().expect("utf-8"),
+    ]);
     assert_eq!(o.status.code(), Some(0), "converges");
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(stderr.contains("keep every 20th logged row"), "{stderr}");
@@ -119,7 +125,12 @@ fn full_rate_writes_every_row_of_a_run_over_the_budget() {
         ];
         args.extend(flag);
         let o = host_sim(&args);
-        assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
     }
     let (thin_rows, full_rows) = (
         lines(&thin.join("timeseries.csv")),

@@ -122,7 +122,10 @@ impl Budgets {
         }
         for case in b.outputs.keys() {
             if !crate::bench_outputs::OUTPUTS.iter().any(|c| c.name == case) {
-                let known: Vec<&str> = crate::bench_outputs::OUTPUTS.iter().map(|c| c.name).collect();
+                let known: Vec<&str> = crate::bench_outputs::OUTPUTS
+                    .iter()
+                    .map(|c| c.name)
+                    .collect();
                 return Err(format!(
                     "{name}: [outputs.{case}]: unknown case (cases: {})",
                     known.join(", ")

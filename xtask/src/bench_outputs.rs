@@ -151,7 +151,10 @@ fn parse_ir(text: &str) -> Result<(u64, ()), String> {
         .ok_or("no `totals:` line")?
         .split_whitespace()
         .collect();
-    let i = events.iter().position(|e| *e == "Ir").ok_or("no Ir event")?;
+    let i = events
+        .iter()
+        .position(|e| *e == "Ir")
+        .ok_or("no Ir event")?;
     let ir = totals
         .get(i)
         .and_then(|v| v.parse().ok())
@@ -222,13 +225,17 @@ pub fn run(
         let (writers, engine) = measure(exe, case)?;
         match (no_check, limits.get(case.name)) {
             (false, Some(l)) => {
-                let (pass, line) = check_writer(case.name, writers, engine, l.max_writer_over_engine);
+                let (pass, line) =
+                    check_writer(case.name, writers, engine, l.max_writer_over_engine);
                 ok &= pass;
                 println!("{line}");
             }
             (false, None) => {
                 ok = false;
-                println!("   outputs.{} (no budget: add [outputs.{}])", case.name, case.name);
+                println!(
+                    "   outputs.{} (no budget: add [outputs.{}])",
+                    case.name, case.name
+                );
             }
             (true, _) => println!("{}", check_writer(case.name, writers, engine, f64::MAX).1),
         }

@@ -192,8 +192,10 @@ fn render(
     };
 
     let png = dir.join(format!("{}.png", figure.stem()));
-    write_png(&png, IMAGE_SIZE, |root| draw_figure(figure, root, run, true))
-        .map_err(|e| draw_err(&png, &e))?;
+    write_png(&png, IMAGE_SIZE, |root| {
+        draw_figure(figure, root, run, true)
+    })
+    .map_err(|e| draw_err(&png, &e))?;
     written.push(png);
 
     let svg = dir.join(format!("{}.svg", figure.stem()));
