@@ -258,7 +258,15 @@ impl<'a> Simulation<'a> {
         };
         let thinned = stride > 1 && (csv.is_some() || mcap.is_some());
         let series = self.keep_series.then(|| TimeSeries::new(model, &estimates));
-        let mut recorder = (csv, (series, mcap));
+        // The rows written to timeseries.csv, kept for the figures and the replay page
+        // (drawn from memory instead of reading the file back).
+        let drawn = match &self.out {
+            Some((_, true)) if csv.is_some() => {
+                Some(Thinned::new(TimeSeries::new(model, &estimates), stride))
+            }
+            _ => None,
+        };
+        let mut recorder = (csv, (series, (mcap, drawn)));
         let mut silent = |_: f64| {};
         let progress: &mut dyn Progress = match self.progress {
             Some(p) => p,
@@ -277,7 +285,8 @@ impl<'a> Simulation<'a> {
         };
         progress.finish();
         let mut result = result?;
-        let (series, mcap) = recorder.1;
+        let (series, (mcap, drawn)) = recorder.1;
+        let drawn = drawn.map(Thinned::into_inner);
         let thinning = thinned.then(|| {
             let t = Thinning {
                 stride,
@@ -305,7 +314,7 @@ impl<'a> Simulation<'a> {
             replay_error: None,
         };
         if let Some((dir, plots)) = &self.out {
-            run.write_outputs(model, dir, csv_path, *plots)?;
+            run.write_outputs(model, dir, csv_path, *plots, drawn.as_ref())?;
             run.files.extend(mcap_path);
         }
         Ok(run)
@@ -383,6 +392,7 @@ impl Run {
         dir: &Path,
         csv_path: Option<PathBuf>,
         plots: bool,
+        rows: Option<&TimeSeries>,
     ) -> Result<(), Error> {
         let summary_path = dir.join("summary.json");
         report::write_summary(&summary_path, &self.summary_json(model))
@@ -390,11 +400,11 @@ impl Run {
         let has_csv = csv_path.is_some();
         self.files = csv_path.into_iter().chain([summary_path]).collect();
         if plots && has_csv {
-            match report::plot_run(dir) {
+            match report::plot_run_from(dir, rows) {
                 Ok(p) => self.files.extend(p),
                 Err(e) => self.plot_error = Some(e),
             }
-            match report::write_replay(dir) {
+            match report::write_replay_from(dir, rows) {
                 Ok(p) => self.files.push(p),
                 Err(e) => self.replay_error = Some(e),
             }

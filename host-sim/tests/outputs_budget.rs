@@ -190,3 +190,52 @@ fn a_thinned_series_keeps_the_first_every_stride_th_and_the_last_row() {
         assert!(summary.get("series").is_none());
     }
 }
+
+/// The figures and the replay page a run draws from the rows it kept in memory are the
+/// files `host-sim plot` and `host-sim view` draw from `timeseries.csv` afterwards, byte
+/// for byte (a run that ends early included); a run without figures draws none.
+#[test]
+fn figures_drawn_from_memory_are_those_drawn_from_the_csv() {
+    let tmp = tempfile::tempdir().expect("temp dir");
+    for scenario in ["paper", "paper-printed"] {
+        let (run, redrawn) = (
+            tmp.path().join(format!("{scenario}-run")),
+            tmp.path().join(format!("{scenario}-redrawn")),
+        );
+        let o = host_sim(&[
+            "run",
+            scenario,
+            "-q",
+            "--duration",
+            "20",
+            "--out",
+            run.to_str().expect("utf-8"),
+        ]);
+        assert!(o.status.code().is_some());
+        let o = host_sim(&[
+            "run",
+            scenario,
+            "-q",
+            "--duration",
+            "20",
+            "--no-plots",
+            "--out",
+            redrawn.to_str().expect("utf-8"),
+        ]);
+        assert!(o.status.code().is_some());
+        assert!(!redrawn.join("energy.png").exists() && !redrawn.join("replay.html").exists());
+        let r = redrawn.to_str().expect("utf-8");
+        assert!(host_sim(&["plot", r, "-q"]).status.success());
+        assert!(host_sim(&["view", r, "--no-open"]).status.success());
+        let mut names: Vec<String> = std::fs::read_dir(&run)
+            .expect("dir")
+            .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        assert!(names.len() >= 14, "{names:?}");
+        for f in &names {
+            let (a, b) = (std::fs::read(run.join(f)), std::fs::read(redrawn.join(f)));
+            assert!(a.expect("read") == b.expect(f), "{scenario}: {f} differs");
+        }
+    }
+}

@@ -51,6 +51,7 @@ pub use formation::{plot_formation, MAX_LABELLED_AGENTS};
 pub(crate) use thinning::spread;
 pub use xy::{plot_xy, XyChart, XyLine, XyPanel, XyPoint};
 
+use crate::report::TimeSeries;
 use input::{load_run, Run};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -116,8 +117,14 @@ const REQUIRED: [&str; 10] = {
 /// malformed, lacks a needed column or has no data row, or when an output
 /// image cannot be drawn or written. Figures written before the error stay.
 pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
+    plot_run_from(dir, None)
+}
+
+/// [`plot_run`] with the rows of `dir/timeseries.csv` given in memory (`series`, the
+/// rows the run wrote there): the same figures without reading the file back.
+pub fn plot_run_from(dir: &Path, series: Option<&TimeSeries>) -> Result<Vec<PathBuf>, PlotError> {
     ensure_font()?;
-    let run = load_run(dir)?;
+    let run = load_run(dir, series)?;
     let mut written = Vec::with_capacity(2 * Figure::ALL.len());
     for figure in Figure::ALL {
         // Runs written before `shape` existed have no target to draw.
