@@ -20,6 +20,7 @@
 use ph_formation_sim::engine::{run, NullRecorder, SampledSim};
 use ph_formation_sim::model::Model;
 use ph_formation_sim::scenario::strip_model;
+use ph_formation_sim::TimeSeries;
 use std::process::ExitCode;
 
 /// The counted part: `ticks` control periods of `sim` from `start` (or, with no
@@ -40,7 +41,9 @@ fn counted(model: &Model, sim: Option<&mut SampledSim<'_>>, start: f64, ticks: u
 /// into `dir` at `stride`.
 #[inline(never)]
 fn counted_outputs(model: &Model, dir: Option<&std::path::Path>, stride: Option<u64>) {
-    let mut sim = ph_formation_sim::Simulation::new(model).keep_series(false);
+    // With rows, every row is also kept in memory: at least the cost of the rows a run
+    // keeps for its figures (those it writes).
+    let mut sim = ph_formation_sim::Simulation::new(model).keep_series(dir.is_some());
     if let Some(dir) = dir {
         sim = sim.write_to(dir, ph_formation_sim::WriteOptions::without_plots());
     }
@@ -50,11 +53,14 @@ fn counted_outputs(model: &Model, dir: Option<&std::path::Path>, stride: Option<
     std::hint::black_box(sim.run().ok());
 }
 
-/// The counted part of `draw`: the figures and the replay page of a run directory.
+/// The counted part of `draw`: the figures and the replay page of a run directory,
+/// drawn from its rows in memory, as the run draws them.
 #[inline(never)]
-fn counted_draw(dir: &std::path::Path) -> Result<(), String> {
-    let plots = ph_formation_sim::report::plot_run(dir).map_err(|e| e.to_string())?;
-    let replay = ph_formation_sim::report::write_replay(dir).map_err(|e| e.to_string())?;
+fn counted_draw(dir: &std::path::Path, rows: &TimeSeries) -> Result<(), String> {
+    let plots =
+        ph_formation_sim::report::plot_run_from(dir, Some(rows)).map_err(|e| e.to_string())?;
+    let replay =
+        ph_formation_sim::report::write_replay_from(dir, Some(rows)).map_err(|e| e.to_string())?;
     std::hint::black_box((plots, replay));
     Ok(())
 }
@@ -155,7 +161,10 @@ fn case(args: &[String]) -> Result<u64, String> {
         }
         Some("draw") => {
             let dir = std::path::PathBuf::from(args.get(1).ok_or("missing DIR")?);
-            counted_draw(&dir)?;
+            // The rows the run kept in memory: read back, not counted.
+            let rows =
+                TimeSeries::read_csv(&dir.join("timeseries.csv")).map_err(|e| e.to_string())?;
+            counted_draw(&dir, &rows)?;
             Ok(0)
         }
         _ => Err(

@@ -11,8 +11,11 @@
 //! 2. `counts engine SCENARIO SHORT` under callgrind: a short run through the library
 //!    writing nothing — the engine (ticks, diagnostics, monitor, verdict) per agent-step;
 //! 3. `counts rows SCENARIO SHORT STRIDE`: the same run writing its rows at the whole
-//!    run's stride and its summary: minus (2), the row writers per agent-step;
-//! 4. `counts draw DIR`: the figures (PNG and SVG) and `replay.html` of the whole run.
+//!    run's stride and its summary, and keeping every row in memory (at least what a run
+//!    keeps for its figures): minus (2), the row writers per agent-step;
+//! 4. `counts draw DIR`: the figures (PNG and SVG) and `replay.html` of the whole run,
+//!    drawn from its rows in memory as the run draws them (read back from `DIR`'s CSV
+//!    first, not counted).
 //!
 //! engine = (2) per agent-step × the whole run's agent-steps; writers = (3) − (2) per
 //! agent-step × agent-steps + (4). The check: writers ≤ `max_writer_over_engine` ×
