@@ -239,3 +239,23 @@ fn figures_drawn_from_memory_are_those_drawn_from_the_csv() {
         }
     }
 }
+
+/// `TimeSeries::read_csv` reads a run's `timeseries.csv` back as the rows the run kept
+/// (the figures' rows in `cargo xtask bench-counts`); a changed value differs.
+#[test]
+fn a_series_read_back_from_the_csv_is_the_series_of_the_run() {
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let model = ph_formation_sim::load("paper", &["duration=3".to_owned()]).expect("load");
+    let run = Simulation::new(&model)
+        .write_to(tmp.path(), WriteOptions::without_plots())
+        .run()
+        .expect("run");
+    let csv = tmp.path().join("timeseries.csv");
+    let back = ph_formation_sim::TimeSeries::read_csv(&csv).expect("read");
+    assert_eq!(Some(&back), run.series.as_ref());
+    assert_eq!(back.len(), 301);
+    let text = std::fs::read_to_string(&csv).expect("csv");
+    std::fs::write(&csv, text.replacen("\n0.01,", "\n0.02,", 1)).expect("write");
+    let changed = ph_formation_sim::TimeSeries::read_csv(&csv).expect("read");
+    assert_ne!(Some(&changed), run.series.as_ref());
+}

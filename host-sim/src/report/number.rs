@@ -28,13 +28,8 @@ fn may_tie(a: f64) -> bool {
     }
     // a ≥ 2^(e2 + 52 − leading bits) ≥ 2^p with p = e2 + 63 − leading_zeros(m).
     let p = e2 + 63 - m.leading_zeros() as i32;
-    // ⌊p · log10 2⌋ ≤ ⌊log10 a⌋ (a lower bound: log10 2 nudged towards zero).
-    let log2 = if p >= 0 {
-        std::f64::consts::LOG10_2 - 1e-9
-    } else {
-        std::f64::consts::LOG10_2 + 1e-9
-    };
-    let lower = (f64::from(p) * log2).floor() as i32;
+    // ⌊p · log10 2⌋ ≤ ⌊log10 a⌋, in integers (exact for |p| ≤ 1650, as in Ryu).
+    let lower = (p * 78_913) >> 18;
     lower + 1 - e <= 18
 }
 
@@ -75,6 +70,11 @@ pub fn write_f64(out: &mut Vec<u8>, x: f64) {
     }
     let mut buffer = zmij::Buffer::new();
     let printed = buffer.format_finite(a).as_bytes();
+    if (1e-4..1e15).contains(&a) {
+        // Both write these in decimals, the same digits (most of a run's numbers).
+        out.extend_from_slice(printed);
+        return;
+    }
     // `{:?}` writes 1e-4 ≤ |x| < 1e16 in decimals, others in exponent form; where
     // `zmij` chose the same form the text is the same but for its `e+`.
     let decimal = (1e-4..1e16).contains(&a);
@@ -260,6 +260,14 @@ mod tests {
 
     /// Negative control: `zmij`'s own layout (`1e+16`) is not Debug's (`1e16`), and the
     /// comparison sees it.
+    #[test]
+    fn the_integer_floor_of_p_log10_2_is_exact() {
+        for p in -1100..1100 {
+            let exact = (f64::from(p) * std::f64::consts::LOG10_2).floor() as i32;
+            assert_eq!((p * 78_913) >> 18, exact, "p = {p}");
+        }
+    }
+
     /// Negative control of the ties: there `zmij`'s digits are not Debug's, and
     /// [`super::may_tie`] sends them to `{:?}`.
     #[test]
