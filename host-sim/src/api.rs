@@ -19,7 +19,9 @@ use crate::engine::hil::{self, HilOptions};
 use crate::engine::{self, RunError, RunResult};
 use crate::exit_code;
 use crate::model::{estimate_layout, EstimateInfo, Model};
-use crate::report::{self, CsvRecorder, McapRecorder, PlotError, TimeSeries};
+use crate::report::{
+    self, expected_rows, CsvRecorder, McapRecorder, PlotError, SeriesBudget, Thinned, TimeSeries,
+};
 use crate::scenario::{self, ScenarioErrors, Source};
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -117,6 +119,8 @@ pub struct Simulation<'a> {
     threads: Option<usize>,
     csv: bool,
     mcap: bool,
+    budget: SeriesBudget,
+    stride: Option<u64>,
 }
 
 impl<'a> Simulation<'a> {
@@ -131,6 +135,8 @@ impl<'a> Simulation<'a> {
             threads: None,
             csv: true,
             mcap: false,
+            budget: SeriesBudget::DEFAULT,
+            stride: None,
         }
     }
 
@@ -147,6 +153,23 @@ impl<'a> Simulation<'a> {
     /// MCAP for Foxglove and PlotJuggler, and the run's events (`docs/outputs.md`).
     pub fn mcap(mut self, mcap: bool) -> Self {
         self.mcap = mcap;
+        self
+    }
+
+    /// The size budget of `timeseries.csv` and `run.mcap` (default
+    /// [`SeriesBudget::DEFAULT`]): a series larger than it keeps every `stride`-th logged
+    /// row (the first and the last always), named in `summary.json`'s `series` and in a
+    /// warning; [`SeriesBudget::FULL_RATE`] writes every row (`host-sim run --full-rate`).
+    /// The run, its verdict and the in-memory [`Run::series`] are the same either way.
+    pub fn series_budget(mut self, budget: SeriesBudget) -> Self {
+        self.budget = budget;
+        self
+    }
+
+    /// Keep every `stride`-th row in the row files whatever the budget (for measuring a
+    /// short run at the stride of a long one: `cargo xtask bench-counts`).
+    pub fn row_stride(mut self, stride: u64) -> Self {
+        self.stride = Some(stride.max(1));
         self
     }
 
@@ -206,11 +229,18 @@ impl<'a> Simulation<'a> {
             .as_ref()
             .filter(|_| self.csv)
             .map(|(d, _)| d.join("timeseries.csv"));
+        // One stride for both row files, so that they hold the same rows.
+        let columns = report::header(model, &estimates).len() as u64;
+        let rows = expected_rows(model);
+        let stride = self
+            .stride
+            .unwrap_or_else(|| self.budget.stride(rows, columns));
         let csv = match &csv_path {
-            Some(p) => Some(
+            Some(p) => Some(Thinned::new(
                 CsvRecorder::create(p, model, &estimates)
                     .map_err(|e| Error::Output(format!("cannot create {}: {e}", p.display())))?,
-            ),
+                stride,
+            )),
             None => None,
         };
         let mcap_path = self
@@ -219,14 +249,24 @@ impl<'a> Simulation<'a> {
             .filter(|_| self.mcap)
             .map(|(d, _)| d.join("run.mcap"));
         let mcap = match &mcap_path {
-            Some(p) => Some(
+            Some(p) => Some(Thinned::new(
                 McapRecorder::create(p, model, &estimates)
                     .map_err(|e| Error::Output(format!("cannot create {}: {e}", p.display())))?,
-            ),
+                stride,
+            )),
             None => None,
         };
+        let thinned = stride > 1 && (csv.is_some() || mcap.is_some());
         let series = self.keep_series.then(|| TimeSeries::new(model, &estimates));
-        let mut recorder = (csv, (series, mcap));
+        // The rows written to timeseries.csv, kept for the figures and the replay page
+        // (drawn from memory instead of reading the file back).
+        let drawn = match &self.out {
+            Some((_, true)) if csv.is_some() => {
+                Some(Thinned::new(TimeSeries::new(model, &estimates), stride))
+            }
+            _ => None,
+        };
+        let mut recorder = (csv, (series, (mcap, drawn)));
         let mut silent = |_: f64| {};
         let progress: &mut dyn Progress = match self.progress {
             Some(p) => p,
@@ -244,14 +284,29 @@ impl<'a> Simulation<'a> {
             }
         };
         progress.finish();
-        let result = result?;
-        let (series, mcap) = recorder.1;
+        let mut result = result?;
+        let (series, (mcap, drawn)) = recorder.1;
+        let drawn = drawn.map(Thinned::into_inner);
+        let thinning = thinned.then(|| {
+            let t = Thinning {
+                stride,
+                columns,
+                rows_expected: rows,
+                log_interval: model.log_every as f64 * model.dt,
+                row_interval: (stride * model.log_every as u64) as f64 * model.dt,
+                max_full_cells: self.budget.max_full_cells,
+            };
+            result.warnings.push(t.warning());
+            t
+        });
         if let (Some(m), Some(p)) = (mcap, &mcap_path) {
-            m.close(&result.events)
+            m.into_inner()
+                .close(&result.events)
                 .map_err(|e| Error::Output(format!("cannot write {}: {e}", p.display())))?;
         }
         let mut run = Run {
             series,
+            thinning,
             result,
             estimates,
             files: Vec::new(),
@@ -259,7 +314,7 @@ impl<'a> Simulation<'a> {
             replay_error: None,
         };
         if let Some((dir, plots)) = &self.out {
-            run.write_outputs(model, dir, csv_path, *plots)?;
+            run.write_outputs(model, dir, csv_path, *plots, drawn.as_ref())?;
             run.files.extend(mcap_path);
         }
         Ok(run)
@@ -294,8 +349,11 @@ pub struct Run {
     pub result: RunResult,
     /// The owned estimates, in the order of their columns.
     pub estimates: Vec<EstimateInfo>,
-    /// Every logged row (when kept, see [`Simulation::keep_series`]).
+    /// Every logged row (when kept, see [`Simulation::keep_series`]; never thinned).
     pub series: Option<TimeSeries>,
+    /// How `timeseries.csv` and `run.mcap` were thinned (`None`: every logged row
+    /// written; see [`Simulation::series_budget`]).
+    pub thinning: Option<Thinning>,
     /// The files written (see [`Simulation::write_to`]): `timeseries.csv`,
     /// `summary.json`, then the figures and `replay.html`, then `run.mcap`.
     pub files: Vec<PathBuf>,
@@ -317,9 +375,14 @@ impl Run {
         self.result.outcome.exit_code()
     }
 
-    /// `summary.json` of this run of `model`.
+    /// `summary.json` of this run of `model` (with `series` when its row files were
+    /// thinned).
     pub fn summary_json(&self, model: &Model) -> serde_json::Value {
-        report::summary_json(model, &self.result, &self.estimates)
+        let mut v = report::summary_json(model, &self.result, &self.estimates);
+        if let (Some(t), Some(obj)) = (&self.thinning, v.as_object_mut()) {
+            obj.insert("series".to_owned(), t.json());
+        }
+        v
     }
 
     /// Writes `summary.json` next to the finished `timeseries.csv`, then the figures.
@@ -329,6 +392,7 @@ impl Run {
         dir: &Path,
         csv_path: Option<PathBuf>,
         plots: bool,
+        rows: Option<&TimeSeries>,
     ) -> Result<(), Error> {
         let summary_path = dir.join("summary.json");
         report::write_summary(&summary_path, &self.summary_json(model))
@@ -336,15 +400,63 @@ impl Run {
         let has_csv = csv_path.is_some();
         self.files = csv_path.into_iter().chain([summary_path]).collect();
         if plots && has_csv {
-            match report::plot_run(dir) {
+            match report::plot_run_from(dir, rows) {
                 Ok(p) => self.files.extend(p),
                 Err(e) => self.plot_error = Some(e),
             }
-            match report::write_replay(dir) {
+            match report::write_replay_from(dir, rows) {
                 Ok(p) => self.files.push(p),
                 Err(e) => self.replay_error = Some(e),
             }
         }
         Ok(())
+    }
+}
+
+/// How a run's row files were thinned ([`Simulation::series_budget`]; `summary.json`'s
+/// `series`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Thinning {
+    /// Every `stride`-th logged row was written (and the last).
+    pub stride: u64,
+    /// Columns of a row.
+    pub columns: u64,
+    /// Rows a whole run logs.
+    pub rows_expected: u64,
+    /// The scenario's `integration.log_interval` (s).
+    pub log_interval: f64,
+    /// Simulated time between two written rows (s): `stride` log intervals.
+    pub row_interval: f64,
+    /// The budget's [`SeriesBudget::max_full_cells`].
+    pub max_full_cells: u64,
+}
+
+impl Thinning {
+    /// The warning of a thinned run.
+    pub fn warning(&self) -> String {
+        let cells = self.rows_expected.saturating_mul(self.columns);
+        format!(
+            "timeseries.csv (and run.mcap) keep every {}th logged row (every {:?} s, and the last): \
+             the full-rate series would be {:.1} M cells ({} rows × {} columns), over the \
+             budget of {:.1} M; `--full-rate` writes every row (docs/outputs.md)",
+            self.stride,
+            self.row_interval,
+            cells as f64 / 1e6,
+            self.rows_expected,
+            self.columns,
+            self.max_full_cells as f64 / 1e6,
+        )
+    }
+
+    /// `summary.json`'s `series`.
+    pub fn json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "stride": self.stride,
+            "row_interval_s": self.row_interval,
+            "log_interval_s": self.log_interval,
+            "full_rate_rows": self.rows_expected,
+            "columns": self.columns,
+            "max_full_cells": self.max_full_cells,
+        })
     }
 }

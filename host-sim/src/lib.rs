@@ -50,10 +50,10 @@
 #![deny(missing_docs)]
 
 pub use analysis::Outcome;
-pub use api::{load, load_toml, Error, Progress, Run, Simulation, WriteOptions};
+pub use api::{load, load_toml, Error, Progress, Run, Simulation, Thinning, WriteOptions};
 pub use engine::{RunError, RunResult};
 pub use model::Model;
-pub use report::TimeSeries;
+pub use report::{SeriesBudget, TimeSeries};
 pub use scenario::{ScenarioErrors, BUILTINS};
 
 /// What a run found, besides [`RunResult`] and [`TimeSeries`]: the types of their fields.

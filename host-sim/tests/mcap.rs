@@ -112,3 +112,35 @@ fn pypi_mcap_reader_finds_every_agent_pose_of_every_row() {
         "changed value: {text}"
     );
 }
+
+/// A run over the size budget (docs/outputs.md, "Size budget"): `run.mcap` holds the
+/// rows of its thinned `timeseries.csv` (every 10th of a 100-agent lattice's 5,801), in
+/// zstd chunks, and the PyPI reader finds every pose of every row in it.
+#[test]
+#[ignore = "needs the venv of scripts/python-deps.sh: run by cargo xtask test"]
+fn pypi_mcap_reader_reads_a_thinned_run() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scenario = dir.path().join("lat100.toml");
+    let status = Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args([
+            "design",
+            "--shape",
+            "tri-lattice",
+            "-n",
+            "100",
+            "--duration",
+            "58",
+            "-q",
+            "-o",
+        ])
+        .arg(&scenario)
+        .status()
+        .expect("host-sim design");
+    assert!(status.success());
+    let out = dir.path().join("run");
+    run(scenario.to_str().expect("utf-8"), &out, &["--mcap"]);
+    let summary = String::from_utf8(read(out.join("summary.json"))).expect("utf-8");
+    assert!(summary.contains("\"stride\": 10"), "{summary}");
+    let (ok, text) = check(&out);
+    assert!(ok && text.contains("mcap_check: ok: 581 rows"), "{text}");
+}

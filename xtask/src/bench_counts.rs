@@ -89,6 +89,10 @@ pub struct Budgets {
     /// `[release.<case>]`: the release build (the figures of `docs/performance.md`).
     #[serde(default)]
     pub release: BTreeMap<String, Limits>,
+    /// `[outputs.<case>]`: the outputs against the engine (dev build;
+    /// [`crate::bench_outputs`]).
+    #[serde(default)]
+    pub outputs: BTreeMap<String, crate::bench_outputs::OutputLimits>,
 }
 
 /// The limits of one case, per agent-step.
@@ -114,6 +118,18 @@ impl Budgets {
                         known.join(", ")
                     ));
                 }
+            }
+        }
+        for case in b.outputs.keys() {
+            if !crate::bench_outputs::OUTPUTS.iter().any(|c| c.name == case) {
+                let known: Vec<&str> = crate::bench_outputs::OUTPUTS
+                    .iter()
+                    .map(|c| c.name)
+                    .collect();
+                return Err(format!(
+                    "{name}: [outputs.{case}]: unknown case (cases: {})",
+                    known.join(", ")
+                ));
             }
         }
         Ok(b)
@@ -254,6 +270,10 @@ pub fn run(o: &Options) -> Result<bool, String> {
             }
         }
     }
+    // The outputs against the engine: measured on the dev build (what CI checks).
+    if o.profile == "dev" {
+        ok &= crate::bench_outputs::run(&exe, &budgets.outputs, o.no_check)?;
+    }
     Ok(ok)
 }
 
@@ -345,6 +365,11 @@ mod tests {
         }
         let e = Budgets::parse("[dev.strip_10]\ninstructions = 1\nll_misses = 1\n", "f");
         assert!(e.unwrap_err().contains("[dev.strip_10]"));
+        for case in &crate::bench_outputs::OUTPUTS {
+            assert!(b.outputs.contains_key(case.name), "outputs.{}", case.name);
+        }
+        let e = Budgets::parse("[outputs.x]\nmax_writer_over_engine = 1\n", "f");
+        assert!(e.unwrap_err().contains("[outputs.x]"));
         let e = Budgets::parse("[dev.paper]\ninstructions = 1\n", "f").unwrap_err();
         assert!(e.contains("ll_misses"), "{e}");
     }

@@ -18,6 +18,7 @@
 //!   live defmt log).
 
 mod bench_counts;
+mod bench_outputs;
 mod budgets;
 mod check;
 mod cluster;

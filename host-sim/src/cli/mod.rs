@@ -154,6 +154,11 @@ pub struct RunArgs {
     /// and PlotJuggler (docs/outputs.md). Changes no other output.
     #[arg(long)]
     pub mcap: bool,
+    /// Write every logged row into timeseries.csv (and run.mcap) whatever the size. By
+    /// default a series over 8 M cells (rows × columns, ~160 MB) keeps every 2nd, 5th,
+    /// 10th, 20th, … row, to at most 1 M cells, and says so (docs/outputs.md).
+    #[arg(long)]
+    pub full_rate: bool,
     /// Worker threads of a large run (at least 2,048 agents; default one per core). The
     /// results are the same for any number.
     #[arg(short = 'j', long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
@@ -209,6 +214,7 @@ pub fn execute(cli: Cli) -> u8 {
                 no_plots: false,
                 summary_only: false,
                 mcap: false,
+                full_rate: false,
                 jobs: None,
                 hil: Vec::new(),
                 firmware: None,

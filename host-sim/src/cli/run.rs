@@ -5,7 +5,7 @@ use super::{report, RunArgs};
 use crate::api::{self, Simulation};
 use crate::engine::hil::{self, HilOptions};
 use crate::model::Model;
-use crate::report::summary_table;
+use crate::report::{summary_table, SeriesBudget};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -90,6 +90,11 @@ pub(super) fn run_command(args: &RunArgs, quiet: bool) -> u8 {
         )
         .csv(!args.summary_only)
         .mcap(args.mcap)
+        .series_budget(if args.full_rate {
+            SeriesBudget::FULL_RATE
+        } else {
+            SeriesBudget::DEFAULT
+        })
         .progress(&mut progress);
     if let Some(n) = args.jobs {
         // One run per process: size rayon's global pool, so that the run stays on this

@@ -3,7 +3,8 @@
 //! comes from [`for_each_cell`] under the column names of [`header`], the one
 //! implementation of the time series; the run's events are added when it is over.
 //!
-//! Messages are JSON (`message_encoding = "json"`) with `jsonschema` schemas. The
+//! Messages are JSON (`message_encoding = "json"`) with `jsonschema` schemas, in
+//! zstd-compressed chunks. The
 //! visual channels carry Foxglove's schema names (`foxglove.PosesInFrame`,
 //! `foxglove.SceneUpdate`, `foxglove.Log`) and their field layout; each embedded schema
 //! describes the fields written. No ROS 2 message schemas are written.
@@ -85,7 +86,12 @@ impl McapRecorder {
     /// Creates the file and writes its header, schemas and channels.
     pub fn create(path: &Path, model: &Model, estimates: &[EstimateInfo]) -> io::Result<Self> {
         let file = BufWriter::new(File::create(path)?);
+        // zstd chunks (MCAP's default compression, which Foxglove, PlotJuggler and the
+        // PyPI reader read): the JSON messages shrink about 4× (`paper`: 26.6 → 6.6 MB). One
+        // thread: the same bytes and counts on any machine.
         let options = mcap::WriteOptions::new()
+            .compression(Some(mcap::Compression::Zstd))
+            .compression_threads(0)
             .profile("")
             .library(concat!("ph-formation-sim ", env!("CARGO_PKG_VERSION")));
         let mut w = options.create(file).map_err(io_err)?;
@@ -419,7 +425,7 @@ fn pose(out: &mut String, (x, y): (f64, f64)) {
 /// `null` for NaN and infinities (which JSON lacks).
 fn number(out: &mut String, x: f64) {
     if x.is_finite() {
-        let _ = write!(out, "{x:?}");
+        super::number::push_f64(out, x);
     } else {
         out.push_str("null");
     }

@@ -23,6 +23,27 @@ impl TimeSeries {
         }
     }
 
+    /// Reads a run's `timeseries.csv` back (an empty or non-numeric field is NaN).
+    pub fn read_csv(path: &std::path::Path) -> io::Result<Self> {
+        let mut reader = csv::Reader::from_path(path).map_err(io::Error::other)?;
+        let columns: Vec<String> = reader
+            .headers()
+            .map_err(io::Error::other)?
+            .iter()
+            .map(|s| s.trim().to_owned())
+            .collect();
+        let mut values = Vec::new();
+        for rec in reader.records() {
+            let rec = rec.map_err(io::Error::other)?;
+            values.extend((0..columns.len()).map(|k| {
+                rec.get(k)
+                    .and_then(|v| v.trim().parse().ok())
+                    .unwrap_or(f64::NAN)
+            }));
+        }
+        Ok(Self { columns, values })
+    }
+
     /// The column names (the header of `timeseries.csv`).
     pub fn columns(&self) -> &[String] {
         &self.columns

@@ -44,9 +44,7 @@ pub fn plot_formation(model: &Model, path: &Path) -> Result<(), PlotError> {
         draw(&root, model, false).map_err(|e| err(&e))?;
         root.present().map_err(|e| err(&e))
     } else {
-        let root = BitMapBackend::new(path, IMAGE_SIZE).into_drawing_area();
-        draw(&root, model, true).map_err(|e| err(&e))?;
-        root.present().map_err(|e| err(&e))
+        super::write_png(path, IMAGE_SIZE, |root| draw(root, model, true)).map_err(|e| err(&e))
     }
 }
 

@@ -4,6 +4,8 @@
 
 use super::thinning::{spread, Thinning};
 use super::{PlotError, MAX_AGENT_PATHS, MAX_ANGLES, MAX_ESTIMATES, REQUIRED, WORST_NAMED};
+use crate::report::rows::{Field, Rows};
+use crate::report::TimeSeries;
 use serde::Deserialize;
 use std::collections::HashMap;
 use std::fs::File;
@@ -208,24 +210,13 @@ impl Columns {
     }
 }
 
-pub(super) fn open_csv(path: &Path) -> Result<csv::Reader<File>, PlotError> {
-    let file = File::open(path).map_err(|source| PlotError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    Ok(csv::ReaderBuilder::new()
-        .has_headers(true)
-        .from_reader(file))
-}
-
 /// Parses one field: empty → NaN; a number (including `NaN`/`inf`) → it;
-/// anything else → [`PlotError::BadValue`].
-pub(super) fn field(
-    rec: &csv::ByteRecord,
-    col: usize,
-    header: &Header<'_>,
-) -> Result<f64, PlotError> {
-    let raw = rec.get(col).unwrap_or(b"");
+/// anything else → [`PlotError::BadValue`]. A value kept in memory is itself.
+pub(super) fn field(f: Field<'_>, col: usize, header: &Header<'_>) -> Result<f64, PlotError> {
+    let (raw, line) = match f {
+        Field::Value(x) => return Ok(x),
+        Field::Text(raw, line) => (raw, line),
+    };
     let text = String::from_utf8_lossy(raw);
     let text = text.trim();
     if text.is_empty() {
@@ -233,7 +224,7 @@ pub(super) fn field(
     }
     text.parse::<f64>().map_err(|_| PlotError::BadValue {
         path: header.path.to_path_buf(),
-        line: rec.position().map_or(0, |p| p.line()),
+        line,
         column: header.names.get(col).cloned().unwrap_or_default(),
         value: text.chars().take(40).collect(),
     })
@@ -250,22 +241,18 @@ pub(super) fn load_summary(path: &Path) -> Result<Summary, PlotError> {
     })
 }
 
-pub(super) fn load_run(dir: &Path) -> Result<Run, PlotError> {
+/// Reads `dir/summary.json` and the rows of `dir/timeseries.csv`, or `series` (the same
+/// rows, kept in memory by the run) when given.
+pub(super) fn load_run(dir: &Path, series: Option<&TimeSeries>) -> Result<Run, PlotError> {
     let summary = load_summary(&dir.join("summary.json"))?;
     let csv_path = dir.join("timeseries.csv");
-    let csv_err = |source| PlotError::Csv {
-        path: csv_path.clone(),
-        source,
+    let mut reader = match series {
+        Some(s) => Rows::memory(s, &csv_path),
+        None => Rows::csv(&csv_path)?,
     };
 
     // Header.
-    let mut reader = open_csv(&csv_path)?;
-    let names: Vec<String> = reader
-        .headers()
-        .map_err(csv_err)?
-        .iter()
-        .map(|s| s.trim().to_string())
-        .collect();
+    let names: Vec<String> = reader.names()?;
     if names.iter().all(String::is_empty) {
         return Err(PlotError::Empty {
             path: csv_path,
@@ -334,17 +321,16 @@ pub(super) fn load_run(dir: &Path) -> Result<Run, PlotError> {
         .collect();
 
     // Pass 1: count the rows with a finite t, and keep the last one (swapped, not copied).
-    let mut rec = csv::ByteRecord::new();
-    let mut last = csv::ByteRecord::new();
     let mut valid = 0usize;
-    while reader.read_byte_record(&mut rec).map_err(csv_err)? {
-        if field(&rec, t_col, &header)?.is_finite() {
+    while reader.next()? {
+        if field(reader.get(t_col), t_col, &header)?.is_finite() {
             valid += 1;
-            std::mem::swap(&mut rec, &mut last);
+            reader.keep_as_last();
         }
     }
+    let reader = reader;
     // |value| at the end, for ranking (non-finite ranks first: the worst).
-    let at_end = |c: usize| field(&last, c, &header).map_or(f64::INFINITY, |x| x.abs());
+    let at_end = |c: usize| field(reader.last(c), c, &header).map_or(f64::INFINITY, |x| x.abs());
 
     // Angles: an evenly spaced subset and the WORST_NAMED largest at the end (named in
     // the legend).
@@ -379,7 +365,8 @@ pub(super) fn load_run(dir: &Path) -> Result<Run, PlotError> {
     let mut pairs = Vec::with_capacity(n_estimates);
     for (c, suffix) in &est_cols {
         let r = header.require(&format!("r_{suffix}"))?;
-        let gap = field(&last, *c, &header).and_then(|h| Ok((h - field(&last, r, &header)?).abs()));
+        let gap = field(reader.last(*c), *c, &header)
+            .and_then(|h| Ok((h - field(reader.last(r), r, &header)?).abs()));
         let gap = gap.ok().filter(|g| !g.is_nan()).unwrap_or(f64::INFINITY);
         pairs.push((gap, *c, r, suffix.as_str()));
     }
@@ -401,23 +388,29 @@ pub(super) fn load_run(dir: &Path) -> Result<Run, PlotError> {
     let snapshot_at = thin.snapshots();
 
     // Pass 2: keep the thinned rows.
-    let mut reader = open_csv(&csv_path)?;
+    let mut reader = reader;
+    reader.restart()?;
     let mut snapshots = Vec::with_capacity(snapshot_at.len());
     let (mut v, mut kept) = (0usize, 0usize);
-    while reader.read_byte_record(&mut rec).map_err(csv_err)? {
-        let t = field(&rec, t_col, &header)?;
+    while reader.next()? {
+        let t = field(reader.get(t_col), t_col, &header)?;
         if !t.is_finite() {
             continue;
         }
         if thin.keeps(v) {
             for (slot, &c) in cols.src.iter().enumerate() {
-                let x = field(&rec, c, &header)?;
+                let x = field(reader.get(c), c, &header)?;
                 cols.data[slot].push(x);
             }
             if snapshot_at.contains(&kept) {
                 let pos = agent_xy
                     .iter()
-                    .map(|&(cx, cy)| Ok((field(&rec, cx, &header)?, field(&rec, cy, &header)?)))
+                    .map(|&(cx, cy)| {
+                        Ok((
+                            field(reader.get(cx), cx, &header)?,
+                            field(reader.get(cy), cy, &header)?,
+                        ))
+                    })
                     .collect::<Result<_, PlotError>>()?;
                 snapshots.push(Snapshot { t, pos });
             }

@@ -51,6 +51,7 @@ pub use formation::{plot_formation, MAX_LABELLED_AGENTS};
 pub(crate) use thinning::spread;
 pub use xy::{plot_xy, XyChart, XyLine, XyPanel, XyPoint};
 
+use crate::report::TimeSeries;
 use input::{load_run, Run};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -116,8 +117,14 @@ const REQUIRED: [&str; 10] = {
 /// malformed, lacks a needed column or has no data row, or when an output
 /// image cannot be drawn or written. Figures written before the error stay.
 pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
+    plot_run_from(dir, None)
+}
+
+/// [`plot_run`] with the rows of `dir/timeseries.csv` given in memory (`series`, the
+/// rows the run wrote there): the same figures without reading the file back.
+pub fn plot_run_from(dir: &Path, series: Option<&TimeSeries>) -> Result<Vec<PathBuf>, PlotError> {
     ensure_font()?;
-    let run = load_run(dir)?;
+    let run = load_run(dir, series)?;
     let mut written = Vec::with_capacity(2 * Figure::ALL.len());
     for figure in Figure::ALL {
         // Runs written before `shape` existed have no target to draw.
@@ -192,11 +199,10 @@ fn render(
     };
 
     let png = dir.join(format!("{}.png", figure.stem()));
-    {
-        let root = BitMapBackend::new(&png, IMAGE_SIZE).into_drawing_area();
-        draw_figure(figure, &root, run, true).map_err(|e| draw_err(&png, &e))?;
-        root.present().map_err(|e| draw_err(&png, &e))?;
-    }
+    write_png(&png, IMAGE_SIZE, |root| {
+        draw_figure(figure, root, run, true)
+    })
+    .map_err(|e| draw_err(&png, &e))?;
     written.push(png);
 
     let svg = dir.join(format!("{}.svg", figure.stem()));
@@ -206,6 +212,36 @@ fn render(
         root.present().map_err(|e| draw_err(&svg, &e))?;
     }
     written.push(svg);
+    Ok(())
+}
+
+/// Draws a `size` image with `draw` into memory and writes it to `path` as an 8-bit RGB
+/// PNG with one fixed filter (`Up`) and fast compression. The `image` crate's encoder,
+/// which plotters' `BitMapBackend::new` uses, tries all five filters on every row
+/// (adaptive): that was 57 % of the instructions of `host-sim run paper` with its
+/// default outputs (callgrind, dev build; docs/outputs.md, "What the outputs cost").
+/// The pixels are the same.
+pub(crate) fn write_png(
+    path: &Path,
+    (w, h): (u32, u32),
+    draw: impl FnOnce(&DrawingArea<BitMapBackend<'_>, Shift>) -> DrawResult,
+) -> DrawResult {
+    let mut pixels = vec![0u8; w as usize * h as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut pixels, (w, h)).into_drawing_area();
+        draw(&root)?;
+        root.present()?;
+    }
+    let file = std::io::BufWriter::new(std::fs::File::create(path)?);
+    let mut encoder = png::Encoder::new(file, w, h);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_compression(png::Compression::Fast);
+    encoder.set_filter(png::FilterType::Up);
+    encoder.set_adaptive_filter(png::AdaptiveFilterType::NonAdaptive);
+    let mut writer = encoder.write_header()?;
+    writer.write_image_data(&pixels)?;
+    writer.finish()?;
     Ok(())
 }
 

@@ -182,7 +182,7 @@ fn a_large_run_is_thinned_and_says_so() {
         estimates: 20,
     };
     write_run(dir.path(), &s);
-    let run = load_run(dir.path()).unwrap();
+    let run = load_run(dir.path(), None).unwrap();
     assert!(run.t.len() <= MAX_POINTS + 1, "{} rows kept", run.t.len());
     assert_eq!(run.t.first(), Some(&0.0));
     assert_eq!(run.t.last(), Some(&(0.01 * 4320.0)));

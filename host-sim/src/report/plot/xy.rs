@@ -72,11 +72,8 @@ pub fn plot_xy(dir: &Path, stem: &str, chart: &XyChart) -> Result<Vec<PathBuf>, 
         reason: e.to_string(),
     };
     let png = dir.join(format!("{stem}.png"));
-    {
-        let root = BitMapBackend::new(&png, IMAGE_SIZE).into_drawing_area();
-        draw(&root, chart, true).map_err(|e| draw_err(&png, &e))?;
-        root.present().map_err(|e| draw_err(&png, &e))?;
-    }
+    super::write_png(&png, IMAGE_SIZE, |root| draw(root, chart, true))
+        .map_err(|e| draw_err(&png, &e))?;
     let svg = dir.join(format!("{stem}.svg"));
     {
         let root = SVGBackend::new(&svg, IMAGE_SIZE).into_drawing_area();

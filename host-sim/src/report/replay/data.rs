@@ -4,7 +4,8 @@
 
 use super::{MAX_AGENTS, MAX_CELLS, MAX_CHART_POINTS, MAX_FRAMES};
 use crate::report::plot::spread;
-use crate::report::PlotError;
+use crate::report::rows::{Field, Rows};
+use crate::report::{PlotError, TimeSeries};
 use serde_json::{json, Value};
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -104,24 +105,27 @@ fn io_err(path: &Path) -> impl Fn(std::io::Error) -> PlotError + '_ {
     }
 }
 
-fn open(path: &Path) -> Result<csv::Reader<File>, PlotError> {
-    let file = File::open(path).map_err(io_err(path))?;
-    Ok(csv::ReaderBuilder::new()
-        .has_headers(true)
-        .from_reader(file))
-}
-
-fn number(rec: &csv::ByteRecord, col: usize) -> f64 {
-    std::str::from_utf8(rec.get(col).unwrap_or(b""))
-        .ok()
-        .and_then(|s| s.trim().parse().ok())
-        .unwrap_or(f64::NAN)
+/// A field as a number (NaN when empty or not a number).
+fn number(rows: &Rows<'_>, col: usize) -> f64 {
+    match rows.get(col) {
+        Field::Value(x) => x,
+        Field::Text(raw, _) => std::str::from_utf8(raw)
+            .ok()
+            .and_then(|s| s.trim().parse().ok())
+            .unwrap_or(f64::NAN),
+    }
 }
 
 impl ReplayData {
     /// Reads `dir/summary.json` and `dir/timeseries.csv` (twice: to count the rows, then
     /// to keep the thinned ones).
     pub fn load(dir: &Path) -> Result<Self, PlotError> {
+        Self::load_from(dir, None)
+    }
+
+    /// [`Self::load`] with the rows of `dir/timeseries.csv` given in memory (`series`,
+    /// the rows the run wrote there).
+    pub fn load_from(dir: &Path, series: Option<&TimeSeries>) -> Result<Self, PlotError> {
         let summary_path = dir.join("summary.json");
         let file = File::open(&summary_path).map_err(io_err(&summary_path))?;
         let summary: Value =
@@ -130,21 +134,15 @@ impl ReplayData {
                 source,
             })?;
         let csv_path = dir.join("timeseries.csv");
-        let csv_err = |source| PlotError::Csv {
-            path: csv_path.clone(),
-            source,
-        };
         let missing = |column: &str| PlotError::MissingColumn {
             path: csv_path.clone(),
             column: column.to_owned(),
         };
-        let mut reader = open(&csv_path)?;
-        let names: Vec<String> = reader
-            .headers()
-            .map_err(csv_err)?
-            .iter()
-            .map(|s| s.trim().to_owned())
-            .collect();
+        let mut reader = match series {
+            Some(s) => Rows::memory(s, &csv_path),
+            None => Rows::csv(&csv_path)?,
+        };
+        let names: Vec<String> = reader.names()?;
         let col: HashMap<&str, usize> = names
             .iter()
             .enumerate()
@@ -229,10 +227,9 @@ impl ReplayData {
         }
 
         // Pass 1: count the rows with a finite t.
-        let mut rec = csv::ByteRecord::new();
         let mut valid = 0usize;
-        while reader.read_byte_record(&mut rec).map_err(csv_err)? {
-            if number(&rec, c_t).is_finite() {
+        while reader.next()? {
+            if number(&reader, c_t).is_finite() {
                 valid += 1;
             }
         }
@@ -265,30 +262,30 @@ impl ReplayData {
             chart_v: Vec::new(),
             chart_err: Vec::new(),
         };
-        let mut reader = open(&csv_path)?;
+        reader.restart()?;
         let mut v = 0usize;
         let mut errs = vec![0.0f64; d.edges.len()];
-        while reader.read_byte_record(&mut rec).map_err(csv_err)? {
-            let t = number(&rec, c_t);
+        while reader.next()? {
+            let t = number(&reader, c_t);
             if !t.is_finite() {
                 continue;
             }
             if chart.keeps(v) {
                 d.chart_t.push(t);
-                d.chart_v.push(number(&rec, c_v));
-                d.chart_err.push(number(&rec, c_err));
+                d.chart_v.push(number(&reader, c_v));
+                d.chart_err.push(number(&reader, c_err));
             }
             if frames.keeps(v) {
                 d.t.push(t);
                 for q in state_cols.chunks_exact(4) {
-                    d.x.push(number(&rec, q[0]));
-                    d.y.push(number(&rec, q[1]));
-                    d.vx.push(number(&rec, q[2]));
-                    d.vy.push(number(&rec, q[3]));
+                    d.x.push(number(&reader, q[0]));
+                    d.y.push(number(&reader, q[1]));
+                    d.vx.push(number(&reader, q[2]));
+                    d.vy.push(number(&reader, q[3]));
                 }
                 errs.fill(0.0);
                 for &(c, s) in &angle_edges {
-                    errs[s] = errs[s].max(number(&rec, c).abs());
+                    errs[s] = errs[s].max(number(&reader, c).abs());
                 }
                 d.edge_err.extend_from_slice(&errs);
             }

@@ -14,7 +14,7 @@
 mod data;
 mod sweep;
 
-use super::PlotError;
+use super::{PlotError, TimeSeries};
 use std::path::{Path, PathBuf};
 
 pub use data::ReplayData;
@@ -48,7 +48,13 @@ const DATA_MARKER: &str = "/*PH_REPLAY_DATA*/null";
 ///
 /// A [`PlotError`] naming the file and the reason, as for the figures.
 pub fn write_replay(dir: &Path) -> Result<PathBuf, PlotError> {
-    let data = ReplayData::load(dir)?;
+    write_replay_from(dir, None)
+}
+
+/// [`write_replay`] with the rows of `dir/timeseries.csv` given in memory (`series`, the
+/// rows the run wrote there): the same page without reading the file back.
+pub fn write_replay_from(dir: &Path, series: Option<&TimeSeries>) -> Result<PathBuf, PlotError> {
+    let data = ReplayData::load_from(dir, series)?;
     let path = dir.join("replay.html");
     std::fs::write(&path, page(&data.to_json())).map_err(|e| PlotError::Draw {
         path: path.clone(),
