@@ -577,6 +577,42 @@ fn an_overloaded_aloha_channel_names_the_rate_that_fits() {
 /// then stays under 10 %, without the overload warning, and in control. The app's
 /// square (9.5 %) keeps every tick and its timeouts. Negative control: the strip at the
 /// file's rate is overloaded. A word other than "auto" is refused naming the field.
+/// `"auto"` under TDMA counts the frames the access drops (an agent's packets of one
+/// broadcast wait for its own slot, a superframe each): the 20-strip in the Crazyflie
+/// world on a TDMA channel offers 39 % of the air time at every tick, which the air time
+/// alone would take, but drops frames there; auto broadcasts at 50 Hz, where none is
+/// dropped (negative control: at every tick the run drops more than 1 %). With a queue
+/// limit no rate fits, and the note says so.
+#[test]
+fn comm_rate_auto_under_tdma_counts_the_dropped_frames() {
+    let set = ["world=crazyflie", "duration=2", "radio.channel.access=tdma"];
+    let m = model(&strip20(), &set);
+    let auto = m.comm_auto.as_ref().expect("the preset asks for auto");
+    assert_eq!(m.comm_every, 2, "{auto:?}");
+    assert!(auto.dropped.unwrap() <= 0.01, "{auto:?}");
+    let dropped = |m: &Model| {
+        let r = run(m);
+        let c = r.channel.expect("channel");
+        c.access_dropped as f64 / (c.access_dropped + c.transmissions) as f64
+    };
+    assert!(dropped(&m) <= 0.01);
+    let every = model(
+        &strip20(),
+        &[&set[..], &["controller.comm_rate_hz=100"]].concat(),
+    );
+    assert!(dropped(&every) > 0.01, "every tick drops nothing");
+    let tight = model(
+        &strip20(),
+        &[&set[..], &["radio.queue_limit=0.012"]].concat(),
+    );
+    let note = ph_formation_sim::engine::load::auto_note(tight.comm_auto.as_ref().unwrap());
+    assert!(note.contains("even so the access drops"), "{note}");
+    assert!(
+        !ph_formation_sim::engine::load::auto_note(auto).contains("even so"),
+        "{auto:?}"
+    );
+}
+
 #[test]
 fn comm_rate_auto_picks_the_highest_rate_the_channel_carries() {
     let set = ["world=crazyflie", "duration=10"];

@@ -22,6 +22,9 @@ pub struct AutoRate {
     pub load_every_tick: Option<f64>,
     /// The offered load at the chosen rate.
     pub load: Option<f64>,
+    /// The share of frames the access dropped at the chosen rate (they would have
+    /// waited longer than `radio.queue_limit`).
+    pub dropped: Option<f64>,
     /// The chosen rate (Hz).
     pub rate_hz: f64,
     /// Timeouts raised to span the broadcasts they need: `(key, from s, to s)`.
