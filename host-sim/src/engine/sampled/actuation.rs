@@ -62,6 +62,9 @@ impl Actuation {
         };
         let force = world_force(headings, i, at, own);
         self.forces[i] = force;
+        if !plant.takes_commands() {
+            return;
+        }
         if let Some(episode) = self.safe.get_mut(i) {
             let reseed = episode.tick(out.status, at.dt, self.reseed_after);
             command(plant, i, force, reseed, at.dt);
@@ -116,12 +119,10 @@ impl SafeEpisode {
 /// commands, its actuation first started again from the measured velocity when
 /// `reseed` (SPEC S21c).
 fn command(plant: &mut dyn Plant, i: usize, force: Vec2<f64>, reseed: bool, dt: f64) {
-    if plant.takes_commands() {
-        if reseed {
-            plant.reseed(i);
-        }
-        plant.command(i, force, dt);
+    if reseed {
+        plant.reseed(i);
     }
+    plant.command(i, force, dt);
 }
 
 #[cfg(test)]
