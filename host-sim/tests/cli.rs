@@ -427,3 +427,31 @@ fn jobs_do_not_change_the_outputs_and_summary_only_skips_the_series() {
     assert_eq!(summaries[0]["V_final"], summaries[2]["V_final"]);
     assert!(!d.join("so").join("timeseries.csv").exists());
 }
+
+/// `validate` warns when a camera's field of view leaves an agent without one of its
+/// triangles' neighbours, at the start and in the target shape (the 2×5 grid in the
+/// camera world: its forward 87° camera cannot see a neighbour behind); an all-round
+/// camera gets no such warning (negative control).
+#[test]
+fn validate_warns_when_a_camera_cannot_see_a_neighbour() {
+    let grid = concat!(env!("CARGO_MANIFEST_DIR"), "/sweeps/world/grid2x5.toml");
+    let warnings = |extra: &[&str]| {
+        let o = bin()
+            .args(["validate", grid, "--set", "world=crazyflie-camera"])
+            .args(extra)
+            .output()
+            .expect("spawn host-sim");
+        no_panic(&o);
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        text(&o.stderr)
+            .lines()
+            .filter(|l| l.contains("out of view of its camera"))
+            .map(str::to_owned)
+            .collect::<Vec<_>>()
+    };
+    let seen = warnings(&[]);
+    assert_eq!(seen.len(), 2, "{seen:?}");
+    assert!(seen[0].starts_with("warning: at the initial positions, agent "));
+    assert!(seen[1].starts_with("warning: in the target shape, agent "));
+    assert!(warnings(&["--set", "sensors.camera.fov_deg=360"]).is_empty());
+}

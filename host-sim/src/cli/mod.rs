@@ -330,8 +330,25 @@ fn validate_command(
             if let Some(w) = crate::engine::load::overload_warning(&m) {
                 eprintln!("warning: {w}");
             }
+            for w in view_warnings(&m) {
+                eprintln!("warning: {w}");
+            }
             exit_code::CONVERGED
         }
         Err(e) => report(&e),
     }
+}
+
+/// `validate`'s warnings when a camera (`[sensors.camera]`) leaves an agent without one of
+/// its triangles' neighbours: at the initial positions, and in the target shape as it
+/// starts (its first triangle's base edge where it is; the leader edge may turn it).
+fn view_warnings(m: &crate::model::Model) -> Vec<String> {
+    let start: Vec<[f64; 2]> = m.agents.iter().map(|a| a.position).collect();
+    [
+        ("at the initial positions", start.as_slice()),
+        ("in the target shape", m.target.positions.as_slice()),
+    ]
+    .into_iter()
+    .filter_map(|(when, q)| crate::engine::view_note(m, q).map(|w| format!("{when}, {w}")))
+    .collect()
 }
