@@ -71,7 +71,6 @@ where
     CT: CoordTranslate,
     CT::From: Clone,
 {
-    const DASH: (i32, i32) = (9, 6);
     if pts.len() < 2 {
         return Ok(());
     }
@@ -84,22 +83,55 @@ where
         }
         return Ok(());
     }
+    let (pixels, base) = pixel_path(area, pts);
+    draw_wide(&pixels, &base, colour, width, dashed)
+}
+
+/// Dash and gap lengths (pixels) of a dashed stroke.
+const DASH: (i32, i32) = (9, 6);
+
+/// `pts` in the pixels of `area`'s backend (relative to its base pixel, repeats in a row
+/// dropped), and that backend's area.
+fn pixel_path<DB, CT>(
+    area: &DrawingArea<DB, CT>,
+    pts: &[CT::From],
+) -> (DrawingArea<DB, Shift>, Vec<(i32, i32)>)
+where
+    DB: DrawingBackend,
+    CT: CoordTranslate,
+{
     let pixels = area.strip_coord_spec();
     let (bx, by) = pixels.get_base_pixel();
-    let mut base: Vec<(i32, i32)> = pts
+    let mut path: Vec<(i32, i32)> = pts
         .iter()
         .map(|p| {
             let (x, y) = area.map_coordinate(p);
             (x - bx, y - by)
         })
         .collect();
-    base.dedup();
+    path.dedup();
+    (pixels, path)
+}
+
+/// The pixel polyline `path` drawn as `width × width` one-pixel lines offset by a pixel
+/// each (see [`stroke`]), solid or dashed.
+fn draw_wide<DB>(
+    pixels: &DrawingArea<DB, Shift>,
+    path: &[(i32, i32)],
+    colour: RGBColor,
+    width: u32,
+    dashed: bool,
+) -> DrawResult
+where
+    DB: DrawingBackend,
+    DB::ErrorType: 'static,
+{
     let w = i32::try_from(width).unwrap_or(1);
     let lo = -(w - 1) / 2;
     let style = colour.stroke_width(1);
     for dx in lo..lo + w {
         for dy in lo..lo + w {
-            let shifted: Vec<(i32, i32)> = base.iter().map(|&(x, y)| (x + dx, y + dy)).collect();
+            let shifted: Vec<(i32, i32)> = path.iter().map(|&(x, y)| (x + dx, y + dy)).collect();
             if dashed {
                 pixels.draw(&DashedPathElement::new(shifted, DASH.0, DASH.1, style))?;
             } else {
@@ -139,16 +171,7 @@ where
     if pts.len() < 2 {
         return Ok(());
     }
-    let pixels = area.strip_coord_spec();
-    let (bx, by) = pixels.get_base_pixel();
-    let mut base: Vec<(i32, i32)> = pts
-        .iter()
-        .map(|p| {
-            let (x, y) = area.map_coordinate(p);
-            (x - bx, y - by)
-        })
-        .collect();
-    base.dedup();
+    let (pixels, base) = pixel_path(area, pts);
     let last = base.len().saturating_sub(1);
     let mut normal = (0.0, -1.0);
     let shifted: Vec<(i32, i32)> = (0..base.len())
@@ -169,16 +192,7 @@ where
     if !bitmap || width <= 1 {
         return Ok(pixels.draw(&PathElement::new(shifted, colour.stroke_width(width)))?);
     }
-    let w = i32::try_from(width).unwrap_or(1);
-    let lo = -(w - 1) / 2;
-    let style = colour.stroke_width(1);
-    for dx in lo..lo + w {
-        for dy in lo..lo + w {
-            let line: Vec<(i32, i32)> = shifted.iter().map(|&(x, y)| (x + dx, y + dy)).collect();
-            pixels.draw(&PathElement::new(line, style))?;
-        }
-    }
-    Ok(())
+    draw_wide(&pixels, &shifted, colour, width, false)
 }
 
 pub(super) const CHART_MARGIN: u32 = 14;
