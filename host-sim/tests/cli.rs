@@ -455,3 +455,40 @@ fn validate_warns_when_a_camera_cannot_see_a_neighbour() {
     assert!(seen[1].starts_with("warning: in the target shape, agent "));
     assert!(warnings(&["--set", "sensors.camera.fov_deg=360"]).is_empty());
 }
+
+/// `validate` warns when the force limit lets a virtual mass accelerate faster than the
+/// vehicle can (the ideal world's 1000 N under `world = "crazyflie"`, issue 42), naming
+/// the key and what `design --vehicle crazyflie` chooses; the app's square (2 N per kg)
+/// and the same scenario on the point mass are not warned (negative controls).
+#[test]
+fn validate_warns_when_the_force_limit_is_above_what_the_vehicle_flies() {
+    let app = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../crazyflie-app/formation.toml"
+    );
+    let warned = |args: &[&str]| {
+        let o = bin()
+            .arg("validate")
+            .args(args)
+            .output()
+            .expect("spawn host-sim");
+        no_panic(&o);
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        text(&o.stderr)
+            .lines()
+            .filter(|l| l.contains("controller.max_force"))
+            .map(str::to_owned)
+            .collect::<Vec<_>>()
+    };
+    let seen = warned(&["formation-only", "--set", "world=crazyflie"]);
+    assert_eq!(seen.len(), 1, "{seen:?}");
+    assert!(
+        seen[0].contains("controller.max_force = 1000 N")
+            && seen[0].contains("above the 3.57 m/s²")
+            && seen[0].contains("--vehicle crazyflie"),
+        "{}",
+        seen[0]
+    );
+    assert!(warned(&["formation-only"]).is_empty());
+    assert!(warned(&[app, "--set", "world=crazyflie"]).is_empty());
+}

@@ -94,10 +94,14 @@ pub struct DesignArgs {
     #[arg(long, value_name = "S")]
     pub duration: Option<f64>,
     /// The vehicle the formation is designed for: `crazyflie` writes `world =
-    /// "crazyflie"`, a 2 N/kg force limit and a velocity damping of 1 /s over the
-    /// template's (docs/design.md).
+    /// "crazyflie"`, a 2 N/kg force limit and a velocity damping of 6 N s/m per kg over
+    /// the template's, and for more than 20 agents a slotted channel (docs/design.md).
     #[arg(long, value_enum)]
     pub vehicle: Option<Vehicle>,
+    /// With `--vehicle crazyflie`: how the team shares the radio channel [default:
+    /// `aloha` up to 20 agents, `tdma` above] (docs/design.md).
+    #[arg(long, value_enum, requires = "vehicle")]
+    pub channel: Option<Channel>,
     /// Write the scenario here instead of stdout.
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
@@ -115,6 +119,20 @@ pub enum Vehicle {
     /// A Crazyflie team (`world = "crazyflie"`, docs/design.md).
     Crazyflie,
 }
+
+/// `--channel`: how a Crazyflie team shares its radio channel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Channel {
+    /// Unslotted broadcasts, as the Crazyflie app sends them (the preset's).
+    Aloha,
+    /// One slot per agent (docs/radio.md), sized for a frame and a position packet.
+    Tdma,
+}
+
+/// Above this many agents `--vehicle crazyflie` slots the channel: one unslotted
+/// Crazyflie channel carries 20 agents at 16.7 Hz, and the designed formations of 30 and
+/// more hold on slots, not on it (docs/design.md).
+pub const ALOHA_TEAM: usize = 20;
 
 /// Parses `A,B`.
 fn pair<T: std::str::FromStr>(s: &str) -> Result<[T; 2], PairError> {
@@ -263,8 +281,19 @@ fn design(args: &DesignArgs) -> Result<(String, String), DesignError> {
         reason: e.to_string(),
     })?;
     let template = Template::parse(&src.text, &src.label)?;
+    let n = points.len();
+    if args.channel.is_some() && args.vehicle != Some(Vehicle::Crazyflie) {
+        return Err(option(
+            "channel",
+            "only with --vehicle crazyflie (the channel of a Crazyflie team)".to_owned(),
+        ));
+    }
+    let slotted = match args.channel {
+        Some(c) => c == Channel::Tdma,
+        None => n > ALOHA_TEAM,
+    };
     let template = Some(match args.vehicle {
-        Some(Vehicle::Crazyflie) => template.crazyflie(),
+        Some(Vehicle::Crazyflie) => template.crazyflie(n, slotted),
         Some(Vehicle::Template) | None => template,
     });
     let margin_deg = args.margin.unwrap_or_else(|| {
@@ -274,7 +303,6 @@ fn design(args: &DesignArgs) -> Result<(String, String), DesignError> {
                 t.angle_margin_deg()
             })
     });
-    let n = points.len();
     let leader = match args.leader {
         Some(ids) => {
             let id = |k: usize| -> Result<usize, DesignError> {

@@ -324,7 +324,11 @@ fn validate_command(
                 }
             }
             // Printed even with --quiet, as warnings are.
-            if let Some(w) = crate::engine::speed_limit_note(&m) {
+            let limits = [
+                crate::engine::speed_limit_note(&m),
+                crate::engine::force_limit_note(&m),
+            ];
+            for w in limits.into_iter().flatten() {
                 eprintln!("warning: {w}");
             }
             if let Some(w) = crate::engine::load::overload_warning(&m) {

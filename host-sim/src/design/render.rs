@@ -30,6 +30,12 @@ pub struct Template {
     table: toml::Table,
 }
 
+/// `D^v` per kg of virtual mass that `host-sim design --vehicle crazyflie` writes (N s/m
+/// per kg, SPEC S12): the smallest of the measured 1, 2, 3, 4, 6 and 8 with which the
+/// designed strips and lattices of 16 to 30 agents converge under `world = "crazyflie"`
+/// (docs/design.md, "Designing for the Crazyflie").
+pub const CRAZYFLIE_VELOCITY_DAMPING: f64 = 6.0;
+
 impl Template {
     /// Parses a template's TOML text; `label` names it in errors and in the header.
     pub fn parse(text: &str, label: &str) -> Result<Self, DesignError> {
@@ -50,42 +56,76 @@ impl Template {
         })
     }
 
-    /// The template for a Crazyflie team (`host-sim design --vehicle crazyflie`,
+    /// The template for a Crazyflie team of `n` (`host-sim design --vehicle crazyflie`,
     /// docs/design.md "Designing for the Crazyflie"): `world = "crazyflie"` (the
     /// firmware's cascade, shared positions, the radio channel with the broadcast rate
     /// it carries), the force limited to 2 N per kg of virtual mass (2 m/s², under the
     /// 3.57 m/s² of the firmware's 20° tilt limit, as the app's square), and a velocity
-    /// damping `D^v` = 1 N s/m (SPEC S12) that damps the estimator's velocity noise
-    /// (the 2×5 grid converges over 300 s with it, not without). The rest is the
-    /// template's.
-    pub fn crazyflie(mut self) -> Self {
+    /// damping `D^v` = [`CRAZYFLIE_VELOCITY_DAMPING`] N s/m per kg (SPEC S12) that damps
+    /// the modes the estimator's velocity noise excites (docs/design.md measures 1 to 8
+    /// on formations of 4 to 50). With `slotted` the team shares the channel in slots
+    /// ([`Template::slotted`]). The rest is the template's.
+    pub fn crazyflie(mut self, n: usize, slotted: bool) -> Self {
         let mass = self
             .table
             .get("agent_defaults")
             .and_then(|a| a.get("mass"))
             .and_then(|m| m.as_float().or_else(|| m.as_integer().map(|i| i as f64)))
             .unwrap_or(1.0);
-        let mut set = |section: &str, key: &str, value: toml::Value| {
-            let t = self
-                .table
-                .entry(section.to_owned())
-                .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-            if let Some(t) = t.as_table_mut() {
-                t.insert(key.to_owned(), value);
-            }
-        };
-        set("controller", "max_force", toml::Value::Float(2.0 * mass));
-        set(
+        self.set("controller", "max_force", toml::Value::Float(2.0 * mass));
+        self.set(
             "agent_defaults",
             "velocity_damping",
-            toml::Value::Float(mass),
+            toml::Value::Float(CRAZYFLIE_VELOCITY_DAMPING * mass),
         );
         self.table.insert(
             "world".to_owned(),
             toml::Value::String("crazyflie".to_owned()),
         );
         self.label = format!("{} for the Crazyflie (--vehicle crazyflie)", self.label);
+        if slotted {
+            self.slotted(n)
+        } else {
+            self
+        }
+    }
+
+    /// The Crazyflie channel shared in slots (TDMA, docs/radio.md) by a team of `n`:
+    /// each agent owns one slot per superframe, long enough for what it sends at one
+    /// broadcast (a frame of at most `MAX_FRAME_LEN` bytes and its position packet of at
+    /// most `MAX_POSITION_LEN`, each after the radio's turnaround), and a frame may wait
+    /// one superframe for its slot (`radio.queue_limit`, at least the default 0.05 s).
+    /// The simulator's slots are perfectly synchronised; the Crazyflie app broadcasts
+    /// unslotted today (docs/design.md).
+    pub fn slotted(mut self, n: usize) -> Self {
+        use crate::model::channel::{
+            CRAZYFLIE_BIT_RATE, CRAZYFLIE_OVERHEAD_BYTES, CRAZYFLIE_TURNAROUND,
+        };
+        use ph_formation_core::wire::position::MAX_POSITION_LEN;
+        let bytes = (ph_formation_core::MAX_FRAME_LEN + MAX_POSITION_LEN) as f64
+            + 2.0 * CRAZYFLIE_OVERHEAD_BYTES;
+        // To the nanosecond, so that the file reads 0.000697.
+        let slot =
+            ((2.0 * CRAZYFLIE_TURNAROUND + bytes * 8.0 / CRAZYFLIE_BIT_RATE) * 1e9).round() / 1e9;
+        let mut channel = toml::Table::new();
+        channel.insert("access".to_owned(), toml::Value::String("tdma".to_owned()));
+        channel.insert("slot".to_owned(), toml::Value::Float(slot));
+        self.set("radio", "channel", toml::Value::Table(channel));
+        let wait = ((slot * n as f64).max(0.05) * 1e9).round() / 1e9;
+        self.set("radio", "queue_limit", toml::Value::Float(wait));
+        self.label = format!("{}, slotted channel", self.label);
         self
+    }
+
+    /// Sets `[section] key = value`, making the section if needed.
+    fn set(&mut self, section: &str, key: &str, value: toml::Value) {
+        let t = self
+            .table
+            .entry(section.to_owned())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        if let Some(t) = t.as_table_mut() {
+            t.insert(key.to_owned(), value);
+        }
     }
 
     /// The built-in `paper` scenario (SPEC §9) as template: the default.

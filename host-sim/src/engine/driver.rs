@@ -30,6 +30,31 @@ pub fn speed_limit_note(model: &Model) -> Option<String> {
     ))
 }
 
+/// Why the setpoints run ahead of the vehicle, if the force limit lets an agent's
+/// virtual mass (SPEC S20) accelerate faster than the vehicle's tilt limit lets it
+/// (`controller.max_force / mass` above
+/// [`crate::model::world::WorldModel::max_acceleration`]): the
+/// ideal world's `max_force = 1000` N under `world = "crazyflie"` (docs/design.md): a
+/// warning, and part of the outcome's reason.
+pub fn force_limit_note(model: &Model) -> Option<String> {
+    let a_max = model.world.max_acceleration()?;
+    let f = model.limits.max_force;
+    let (i, x) = model
+        .agents
+        .iter()
+        .enumerate()
+        .find(|(_, x)| f / x.mass > a_max)?;
+    Some(format!(
+        "controller.max_force = {f} N lets agent {}'s virtual mass ({} kg) accelerate at up \
+         to {:.2} m/s², above the {a_max:.2} m/s² the vehicle gives itself (its tilt \
+         limit): its setpoints run ahead of what it flies; `host-sim design --vehicle \
+         crazyflie` chooses 2 N per kg (docs/design.md)",
+        model.agents.get(i).map_or("?", |a| a.name.as_str()),
+        x.mass,
+        f / x.mass
+    ))
+}
+
 /// Why some bearings are missing at the end, if a camera with a limited field of view
 /// or range leaves an agent without one of its triangles' neighbours at positions `q`
 /// (headings taken as the preset's `heading.initial`, spread ignored): part of the
@@ -84,9 +109,8 @@ pub fn run(
     if let Some(auto) = &model.comm_auto {
         warnings.push(super::load::auto_note(auto));
     }
-    if let Some(w) = speed_limit_note(model) {
-        warnings.push(w);
-    }
+    warnings.extend(speed_limit_note(model));
+    warnings.extend(force_limit_note(model));
     match model.mode {
         Mode::Sampled => {
             let mut e = SampledSim::new(model)?;
@@ -157,7 +181,10 @@ pub fn drive(
         }
     }
     if verdict.outcome != crate::analysis::Outcome::Converged {
-        if let Some(note) = speed_limit_note(model) {
+        for note in speed_limit_note(model)
+            .into_iter()
+            .chain(force_limit_note(model))
+        {
             reason = format!("{reason}; {note}");
         }
         let at: Vec<[f64; 2]> = q.iter().map(|p| [p.x, p.y]).collect();

@@ -174,4 +174,18 @@ impl WorldModel {
             VehicleModel::CrazyfliePid(v) => Some(v.max_speed),
         }
     }
+
+    /// The largest horizontal acceleration the vehicle gives itself per axis, if it has a
+    /// tilt limit (m/s²): `velocity_tracking`'s `g tan θ_max`; the Crazyflie cascade's
+    /// `g tan 20°` = 3.57 m/s² (`PID_VEL_ROLL_MAX`, docs/world.md).
+    pub fn max_acceleration(&self) -> Option<f64> {
+        match &self.vehicle {
+            VehicleModel::PointMass => None,
+            VehicleModel::VelocityTracking(v) => Some(v.max_acceleration),
+            VehicleModel::CrazyfliePid(_) => {
+                use ph_formation_vehicle::crazyflie::{firmware, G};
+                Some(G * firmware::TILT_MAX_DEG.to_radians().tan())
+            }
+        }
+    }
 }
