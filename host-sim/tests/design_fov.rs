@@ -261,11 +261,11 @@ fn an_impossible_field_of_view_is_refused_with_the_reason() {
     for (args, want) in [
         (vec!["--fov-deg", "400"], "must be in (0, 360]"),
         (
-            vec!["--fov-deg", "120", "--clearance", "-1"],
+            vec!["--fov-deg", "120", "--clearance=-1"],
             "option `clearance`",
         ),
         (
-            vec!["--fov-deg", "120", "--heading-margin-deg", "-2"],
+            vec!["--fov-deg", "120", "--heading-margin-deg=-2"],
             "heading margin must be",
         ),
     ] {
