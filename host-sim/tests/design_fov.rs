@@ -260,6 +260,7 @@ fn an_impossible_field_of_view_is_refused_with_the_reason() {
     assert!(!err.contains("panicked"), "{err}");
     for (args, want) in [
         (vec!["--fov-deg", "400"], "must be in (0, 360]"),
+        (vec!["--clearance", "0"], "give --fov-deg or --smallest-fov"),
         (
             vec!["--fov-deg", "120", "--clearance=-1"],
             "option `clearance`",

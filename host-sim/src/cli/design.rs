@@ -359,6 +359,19 @@ fn design(args: &DesignArgs) -> Result<(String, String), DesignError> {
             seed: args.seed,
         })
     };
+    if args.fov_deg.is_none() && !args.smallest_fov {
+        for (given, name) in [
+            (args.heading_margin_deg.is_some(), "heading-margin-deg"),
+            (args.clearance.is_some(), "clearance"),
+        ] {
+            if given {
+                return Err(option(
+                    name,
+                    "applies to a camera design: give --fov-deg or --smallest-fov".to_owned(),
+                ));
+            }
+        }
+    }
     let mut smallest = None;
     let fov = if args.smallest_fov {
         let f = smallest_fov(&points, &opts, &camera_options(360.0)?)?;
