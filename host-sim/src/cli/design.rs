@@ -100,7 +100,8 @@ pub struct DesignArgs {
     pub vehicle: Option<Vehicle>,
     /// Design for a camera of this field of view (degrees, in (0, 360]): choose the
     /// triangles and every agent's heading so that each triangle neighbour stays at least
-    /// the heading margin inside its view at the target and at the initial positions; write
+    /// the heading margin inside its view at the target and at the initial positions, and
+    /// no line of sight passes another agent (`--clearance`), within the camera's range; write
     /// `heading_deg` per agent and `[sensors.camera] fov_deg` (docs/design.md, "Designing
     /// for a camera"). 360: the plain design, byte for byte. Not with `--rotate`.
     #[arg(long = "fov-deg", value_name = "F", conflicts_with = "rotate")]

@@ -524,7 +524,7 @@ impl Growth<'_> {
                     }
                 }
                 if let Some((score, [a, b])) = best {
-                    // Each edge is seen from both ends: `count` is twice the candidates.
+                    // An edge with both ends near `v` counts twice: urgency is approximate.
                     let urgency = 4.0 / count as f64;
                     let jitter = noise * (2.0 * rng.random::<f64>() - 1.0);
                     let key = score + urgency + jitter;
@@ -589,7 +589,7 @@ impl Growth<'_> {
         if let Some((width, agent, [a, b])) = arc {
             msg.push_str(&format!(
                 ", and the best of the rest, with agents {} and {}, needs agent {}'s \
-                 neighbours (with their motion allowance) to span {:.1}° > F − 2·margin = \
+                 neighbours (their bearings from start to target) to span {:.1}° > F − 2·margin = \
                  {:.1}°",
                 a + 1,
                 b + 1,
@@ -683,5 +683,43 @@ mod tests {
         // Three directions 120° apart need 240°.
         let (w, _) = cover(&[(0.0, 0.0), (d(120.0), 0.0), (d(240.0), 0.0)]);
         assert!((w - d(240.0)).abs() < 1e-9);
+    }
+
+    /// The neighbour interval holds the bearing for every shortening of the two
+    /// displacements and every point of straight paths to the target; a negative control:
+    /// an interval of the target bearing alone does not.
+    #[test]
+    fn the_neighbour_interval_holds_every_bearing_on_the_way() {
+        let pts = [[0.0, 0.0], [1.0, 0.0], [0.5, 0.8]];
+        let disp = [[0.08, -0.05], [-0.03, 0.09], [0.0, 0.0]];
+        let tree = point_tree(&pts);
+        let near = vec![vec![1, 2], vec![0, 2], vec![0, 1]];
+        let g = Growth {
+            pts: &pts,
+            near: &near,
+            w: PI,
+            margin: 0.1,
+            disp: &disp,
+            range: 10.0,
+            clearance: 0.0,
+            tree: &tree,
+            mt: 8,
+            nb: 12,
+        };
+        let (c, h) = g.interval(0, 1);
+        let mut missed_by_target_only = false;
+        for k in 0..=20 {
+            for l in 0..=20 {
+                let (a, b) = (k as f64 / 20.0, l as f64 / 20.0);
+                let e = [
+                    pts[1][0] - pts[0][0] + b * disp[1][0] - a * disp[0][0],
+                    pts[1][1] - pts[0][1] + b * disp[1][1] - a * disp[0][1],
+                ];
+                let off = wrap(e[1].atan2(e[0]) - c).abs();
+                assert!(off <= h + 1e-12, "{a} {b}: {off} > {h}");
+                missed_by_target_only |= e[1].atan2(e[0]).abs() > 1e-3;
+            }
+        }
+        assert!(h > 0.05 && missed_by_target_only);
     }
 }
