@@ -380,3 +380,66 @@ fn the_smallest_fields_of_view_are_measured() {
         );
     }
 }
+
+/// Under a heading model (`world = "crazyflie-camera"`: headings spread ±5°) a given
+/// `heading_deg` wins: the designed grid's cameras see their neighbours; without the
+/// headings (every agent facing +x, spread ±5°) they do not. Heading error and drift off
+/// and bodies that hide nothing, to isolate the field of view.
+#[test]
+fn under_a_heading_model_the_given_headings_turn_the_cameras() {
+    let dir = tempfile::tempdir().unwrap();
+    let g = grid();
+    let o = design(&[
+        g.to_str().unwrap(),
+        "--fov-deg",
+        "120",
+        "--duration",
+        "300",
+        "--perturbation",
+        "0.05",
+        "--clearance",
+        "0",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let designed = text(&o.stdout);
+    let headless: String = designed
+        .lines()
+        .filter(|l| !l.starts_with("heading_deg"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let safe_share = |name: &str, s: &str| {
+        let f = dir.path().join(format!("{name}.toml"));
+        std::fs::write(&f, s).unwrap();
+        let out = dir.path().join(name);
+        bin()
+            .arg("run")
+            .arg(&f)
+            .args([
+                "--set",
+                "world=crazyflie-camera",
+                "--set",
+                "duration=30",
+                "--set",
+                "heading.error_deg=0",
+                "--set",
+                "heading.drift_deg_per_s=0",
+                "--set",
+                "sensors.camera.occlusion_radius_m=0",
+                "--no-plots",
+                "--quiet",
+                "--out",
+            ])
+            .arg(&out)
+            .output()
+            .unwrap();
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        let safe = v["control"]["safe_after_start"].as_f64().unwrap();
+        safe / (10.0 * 3000.0)
+    };
+    let with = safe_share("designed", &designed);
+    let without = safe_share("headless", &headless);
+    assert!(with < 0.01, "designed: {with}");
+    assert!(without > 0.5, "headless: {without}");
+}
