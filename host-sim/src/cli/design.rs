@@ -3,8 +3,8 @@
 //! stdout or `-o FILE`.
 
 use crate::design::{
-    construct, read_points, render_scenario, DesignError, DesignOptions, Generator, Perturbation,
-    Scale, ScenarioOptions, Template,
+    construct, construct_for_camera, read_points, render_scenario, CameraOptions, CameraView,
+    DesignError, DesignOptions, Generator, Perturbation, Scale, ScenarioOptions, Template,
 };
 use crate::exit_code;
 use crate::scenario::Source;
@@ -102,6 +102,28 @@ pub struct DesignArgs {
     /// `aloha` up to 20 agents, `tdma` above] (docs/design.md).
     #[arg(long, value_enum, requires = "vehicle")]
     pub channel: Option<Channel>,
+    /// Design for a camera of this field of view (degrees, in (0, 360]): choose the
+    /// triangles and every agent's heading so that each triangle neighbour stays at least
+    /// the heading margin inside its view at the target and at the initial positions, and
+    /// no line of sight passes another agent (`--clearance`), within the camera's range; write
+    /// `heading_deg` per agent and `[sensors.camera] fov_deg` (docs/design.md, "Designing
+    /// for a camera"). 360: the plain design, byte for byte. Not with `--rotate`.
+    #[arg(long = "fov-deg", value_name = "F", conflicts_with = "rotate")]
+    pub fov_deg: Option<f64>,
+    /// Find the smallest field of view at which the design still finds a formation
+    /// (bisection to 0.5°), print it, and write that design.
+    #[arg(long, conflicts_with_all = ["fov_deg", "rotate"])]
+    pub smallest_fov: bool,
+    /// How far inside the view every neighbour stays for the heading's errors (degrees)
+    /// [default: the `crazyflie-camera` world's heading error + spread + drift × duration,
+    /// 2° + 5° + 0.02°/s × duration].
+    #[arg(long, value_name = "DEG")]
+    pub heading_margin_deg: Option<f64>,
+    /// With `--fov-deg`: no other agent may be this close to a line of sight at the
+    /// target (m) [default: the `crazyflie-camera` world's occlusion radius, 0.05 m, plus
+    /// twice the largest initial displacement]; 0 lets lines of sight pass other agents.
+    #[arg(long, value_name = "M")]
+    pub clearance: Option<f64>,
     /// Write the scenario here instead of stdout.
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
@@ -326,15 +348,98 @@ fn design(args: &DesignArgs) -> Result<(String, String), DesignError> {
         max_neighbours: args.max_neighbours,
         leader,
     };
-    let c = construct(&points, &opts)?;
-    let v = args.v_star.unwrap_or([0.0, 0.0]);
-    if v.iter().any(|x| !x.is_finite()) {
-        return Err(option("v-star", format!("must be finite, got {v:?}")));
-    }
     if let Some(d) = args.duration {
         if !(d.is_finite() && d > 0.0) {
             return Err(option("duration", format!("must be > 0 s, got {d}")));
         }
+    }
+    let duration = args
+        .duration
+        .or_else(|| template.as_ref().and_then(Template::duration))
+        .unwrap_or(100.0);
+    let camera_options = |fov_deg: f64| -> Result<CameraOptions, DesignError> {
+        let displacement = crate::design::initial::displacements(
+            &points,
+            &Perturbation {
+                fraction: args.perturbation,
+                scale: Scale::Spacing,
+                rotate: false,
+                seed: args.seed,
+            },
+        );
+        let world = CameraWorld::preset()?;
+        let largest = displacement
+            .iter()
+            .map(|d| d[0].hypot(d[1]))
+            .fold(0.0, f64::max);
+        Ok(CameraOptions {
+            fov_deg,
+            heading_margin_deg: match args.heading_margin_deg {
+                Some(m) => m,
+                None => world.heading_margin(duration),
+            },
+            displacement,
+            range: world.range,
+            clearance: match args.clearance {
+                Some(c) if c.is_finite() && c >= 0.0 => c,
+                Some(c) => return Err(option("clearance", format!("must be ≥ 0 m, got {c}"))),
+                None => world.occlusion_radius + 2.0 * largest,
+            },
+            seed: args.seed,
+        })
+    };
+    if args.fov_deg.is_none() && !args.smallest_fov {
+        for (given, name) in [
+            (args.heading_margin_deg.is_some(), "heading-margin-deg"),
+            (args.clearance.is_some(), "clearance"),
+        ] {
+            if given {
+                return Err(option(
+                    name,
+                    "applies to a camera design: give --fov-deg or --smallest-fov".to_owned(),
+                ));
+            }
+        }
+    }
+    let mut smallest = None;
+    let fov = if args.smallest_fov {
+        let f = smallest_fov(&points, &opts, &camera_options(360.0)?)?;
+        smallest = Some(f);
+        Some(f)
+    } else {
+        args.fov_deg
+    };
+    let (c, camera, camera_line) = match fov {
+        Some(f) if !(f.is_finite() && f > 0.0 && f <= 360.0) => {
+            return Err(option(
+                "fov-deg",
+                format!("must be in (0, 360] degrees, got {f}"),
+            ))
+        }
+        Some(f) if f < 360.0 => {
+            let cam = camera_options(f)?;
+            let d = construct_for_camera(&points, &opts, &cam)?;
+            let line = format!(
+                "  camera: field of view {f}°{}, heading margin {}°; widest neighbour arc {:.2}° (agent {}) of {}° allowed; attempt {}\n",
+                if smallest.is_some() { " (the smallest found, bisection to 0.5°)" } else { "" },
+                cam.heading_margin_deg,
+                d.widest.0,
+                d.widest.1 + 1,
+                f - 2.0 * cam.heading_margin_deg,
+                d.attempt
+            );
+            let view = CameraView {
+                fov_deg: f,
+                heading_margin_deg: cam.heading_margin_deg,
+                headings: d.headings,
+            };
+            (d.construction, Some(view), line)
+        }
+        _ => (construct(&points, &opts)?, None, String::new()),
+    };
+    let v = args.v_star.unwrap_or([0.0, 0.0]);
+    if v.iter().any(|x| !x.is_finite()) {
+        return Err(option("v-star", format!("must be finite, got {v:?}")));
     }
     let command: Vec<String> = std::env::args().collect();
     let so = ScenarioOptions {
@@ -353,6 +458,7 @@ fn design(args: &DesignArgs) -> Result<(String, String), DesignError> {
             seed: args.seed,
         },
         template,
+        camera,
     };
     let text = render_scenario(&points, &c, &opts, &so)?;
     let f = &c.figures;
@@ -372,6 +478,98 @@ fn design(args: &DesignArgs) -> Result<(String, String), DesignError> {
         f.longest_edge,
         f.mean_edge,
         f.overlapping
-    );
+    ) + &camera_line;
     Ok((text, figures))
+}
+
+/// What `--fov-deg` takes from the `crazyflie-camera` world (docs/design.md argues each).
+struct CameraWorld {
+    /// `heading.error_deg`, `heading.spread_deg`, `heading.drift_deg_per_s`.
+    error_deg: f64,
+    spread_deg: f64,
+    drift_deg_per_s: f64,
+    /// `sensors.camera.range_m` (m).
+    range: f64,
+    /// `sensors.camera.occlusion_radius_m` (m).
+    occlusion_radius: f64,
+}
+
+impl CameraWorld {
+    fn preset() -> Result<Self, DesignError> {
+        let bad = |reason: &str| DesignError::Template {
+            file: "world crazyflie-camera".to_owned(),
+            reason: reason.to_owned(),
+        };
+        let preset = crate::scenario::world::preset("crazyflie-camera")
+            .ok_or_else(|| bad("no such preset"))?;
+        let table: toml::Table = toml::from_str(preset.toml).map_err(|_| bad("not TOML"))?;
+        let key = |path: &[&str], default: f64| {
+            let mut v = table.get(path[0]);
+            for k in &path[1..] {
+                v = v.and_then(|x| x.get(*k));
+            }
+            v.and_then(|x| x.as_float().or_else(|| x.as_integer().map(|i| i as f64)))
+                .unwrap_or(default)
+        };
+        Ok(Self {
+            error_deg: key(&["heading", "error_deg"], 0.0),
+            spread_deg: key(&["heading", "spread_deg"], 0.0),
+            drift_deg_per_s: key(&["heading", "drift_deg_per_s"], 0.0),
+            range: key(&["sensors", "camera", "range_m"], f64::INFINITY),
+            occlusion_radius: key(&["sensors", "camera", "occlusion_radius_m"], 0.0),
+        })
+    }
+
+    /// The default heading margin (degrees) for a run of `duration` seconds: error +
+    /// spread + drift × duration.
+    fn heading_margin(&self, duration: f64) -> f64 {
+        self.error_deg + self.spread_deg + self.drift_deg_per_s * duration
+    }
+}
+
+/// The smallest field of view (degrees) at which [`construct_for_camera`] finds a design:
+/// bisection to 0.5° between `60° + 2·margin` (no triangle fits) and 359.5°.
+fn smallest_fov(
+    points: &[crate::design::Point],
+    opts: &DesignOptions,
+    cam: &CameraOptions,
+) -> Result<f64, DesignError> {
+    let works = |f: f64| {
+        construct_for_camera(
+            points,
+            opts,
+            &CameraOptions {
+                fov_deg: f,
+                ..cam.clone()
+            },
+        )
+        .is_ok()
+    };
+    let mut hi = 359.5;
+    if !works(hi) {
+        // The refusal at the widest field of view says why.
+        construct_for_camera(
+            points,
+            opts,
+            &CameraOptions {
+                fov_deg: hi,
+                ..cam.clone()
+            },
+        )?;
+    }
+    let mut lo = 60.0 + 2.0 * cam.heading_margin_deg;
+    while hi - lo > 0.5 {
+        let mid = (0.5 * (lo + hi) * 2.0).round() / 2.0;
+        let mid = if mid <= lo || mid >= hi {
+            0.5 * (lo + hi)
+        } else {
+            mid
+        };
+        if works(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Ok(hi)
 }

@@ -80,6 +80,9 @@ pub enum DesignError {
     /// The initial positions cannot be made valid.
     #[error("initial positions: {0}")]
     Initial(String),
+    /// No design keeps every neighbour in a camera's view (`--fov-deg`).
+    #[error("camera (--fov-deg): {0}")]
+    Camera(String),
 }
 
 /// Why [`super::verify`] finds a construction wrong: the first problem found, by triangle

@@ -109,37 +109,12 @@ pub fn initial_positions(
             dist(points[i], points[j])
         )));
     }
-    let n = points.len() as f64;
-    let centre = points
-        .iter()
-        .fold([0.0, 0.0], |s, q| [s[0] + q[0] / n, s[1] + q[1] / n]);
-    let reach: Vec<f64> = match p.scale {
-        Scale::Size => vec![p.fraction * formation_size(points); points.len()],
-        Scale::Spacing => vec![p.fraction * spacing(points); points.len()],
-    };
-    let max_displacement = reach.iter().copied().fold(0.0, f64::max);
-    let mut rng = ChaCha8Rng::seed_from_u64(p.seed);
-    let turn = rng.random::<f64>() * 2.0 * PI;
-    let rotation = if p.rotate { turn } else { 0.0 };
-    let (s, co) = rotation.sin_cos();
-    let base: Vec<Point> = points
-        .iter()
-        .map(|q| {
-            let d = [q[0] - centre[0], q[1] - centre[1]];
-            [
-                centre[0] + co * d[0] - s * d[1],
-                centre[1] + s * d[0] + co * d[1],
-            ]
-        })
-        .collect();
-    let mut disp: Vec<Point> = reach
-        .iter()
-        .map(|&reach| {
-            let r = reach * rng.random::<f64>().sqrt();
-            let a = rng.random::<f64>() * 2.0 * PI;
-            [r * a.cos(), r * a.sin()]
-        })
-        .collect();
+    let Draws {
+        rotation,
+        base,
+        mut disp,
+        max_displacement,
+    } = draws(points, p);
     let mut shortened = vec![false; points.len()];
     for _ in 0..64 {
         let q: Vec<Point> = base
@@ -177,6 +152,62 @@ pub fn initial_positions(
     Err(DesignError::Initial(
         "no valid initial positions after shortening the displacements 64 times".to_owned(),
     ))
+}
+
+/// Every agent's displacement from its target as drawn for `p`, before any is shortened
+/// (m): [`initial_positions`] moves agent `i` by `s_i` times it, `0 < s_i ≤ 1` (and turns
+/// the formation first when `p.rotate`). `host-sim design --fov-deg` bounds the
+/// neighbours' bearings with it.
+pub fn displacements(points: &[Point], p: &Perturbation) -> Vec<Point> {
+    draws(points, p).disp
+}
+
+/// The random draws of [`initial_positions`].
+struct Draws {
+    rotation: f64,
+    base: Vec<Point>,
+    disp: Vec<Point>,
+    max_displacement: f64,
+}
+
+fn draws(points: &[Point], p: &Perturbation) -> Draws {
+    let n = points.len() as f64;
+    let centre = points
+        .iter()
+        .fold([0.0, 0.0], |s, q| [s[0] + q[0] / n, s[1] + q[1] / n]);
+    let reach: Vec<f64> = match p.scale {
+        Scale::Size => vec![p.fraction * formation_size(points); points.len()],
+        Scale::Spacing => vec![p.fraction * spacing(points); points.len()],
+    };
+    let max_displacement = reach.iter().copied().fold(0.0, f64::max);
+    let mut rng = ChaCha8Rng::seed_from_u64(p.seed);
+    let turn = rng.random::<f64>() * 2.0 * PI;
+    let rotation = if p.rotate { turn } else { 0.0 };
+    let (s, co) = rotation.sin_cos();
+    let base: Vec<Point> = points
+        .iter()
+        .map(|q| {
+            let d = [q[0] - centre[0], q[1] - centre[1]];
+            [
+                centre[0] + co * d[0] - s * d[1],
+                centre[1] + s * d[0] + co * d[1],
+            ]
+        })
+        .collect();
+    let disp: Vec<Point> = reach
+        .iter()
+        .map(|&reach| {
+            let r = reach * rng.random::<f64>().sqrt();
+            let a = rng.random::<f64>() * 2.0 * PI;
+            [r * a.cos(), r * a.sin()]
+        })
+        .collect();
+    Draws {
+        rotation,
+        base,
+        disp,
+        max_displacement,
+    }
 }
 
 /// The median over the points of the distance to the nearest other point (0 for fewer

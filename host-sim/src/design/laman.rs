@@ -218,7 +218,7 @@ pub fn construct(points: &[Point], opts: &DesignOptions) -> Result<Construction,
 
 /// The two angles of triangle `t` with the largest margins; ties prefer the new agent,
 /// then `a`, then `b`.
-fn controlled(points: &[Point], t: [usize; 3]) -> [ControlledAngle; 2] {
+pub(super) fn controlled(points: &[Point], t: [usize; 3]) -> [ControlledAngle; 2] {
     let a = angles(t.map(|v| points[v]));
     let mut order = [2usize, 0, 1];
     order.sort_by(|&x, &y| margin(a[y]).total_cmp(&margin(a[x])));
@@ -229,7 +229,7 @@ fn controlled(points: &[Point], t: [usize; 3]) -> [ControlledAngle; 2] {
 }
 
 /// The figures of a list of triangles in construction order.
-fn figures(points: &[Point], triangles: &[DesignTriangle]) -> Figures {
+pub(super) fn figures(points: &[Point], triangles: &[DesignTriangle]) -> Figures {
     let n = triangles.len() + 2;
     let mut tri_count = vec![0usize; n.max(points.len())];
     let mut nbrs = vec![0usize; n.max(points.len())];

@@ -23,6 +23,7 @@
 /// One-byte wire ids (lives in the model layer, which the loader uses too).
 pub use crate::model::wire_ids as colouring;
 pub mod error;
+pub mod fov;
 mod geometry;
 mod grow;
 pub mod initial;
@@ -37,12 +38,13 @@ pub use colouring::{
     adjacency_from_triangles, check_distance2, distance2_colouring, ColouringError,
 };
 pub use error::{DesignError, VerifyError};
+pub use fov::{construct_for_camera, view_check, CameraDesign, CameraOptions};
 pub use initial::{initial_positions, Initial, Perturbation, Scale};
 pub use laman::{
     construct, verify, Construction, ControlledAngle, DesignOptions, DesignTriangle, Figures,
 };
 pub use points::{read_points, Generator, Point};
-pub use render::{render_scenario, ScenarioOptions, Template};
+pub use render::{render_scenario, CameraView, ScenarioOptions, Template};
 pub use shape::{
     compare, fit_similarity, folded_triangles, ShapeComparison, ShapeError, SimilarityFit,
 };

@@ -9,6 +9,7 @@
 use super::error::DesignError;
 use super::initial::{formation_size, initial_positions, Initial, Perturbation, Scale};
 use super::laman::{Construction, DesignOptions};
+
 use super::points::Point;
 use std::fmt::Write;
 
@@ -154,6 +155,11 @@ impl Template {
         self.number("controller", "angle_margin_deg").unwrap_or(5.0)
     }
 
+    /// The template's `duration` (s), if it has one.
+    pub fn duration(&self) -> Option<f64> {
+        self.number_top("duration")
+    }
+
     /// `criteria.collision_distance` (default 0.05 m).
     pub fn collision_distance(&self) -> f64 {
         self.number("criteria", "collision_distance")
@@ -184,6 +190,23 @@ pub struct ScenarioOptions {
     pub perturbation: Perturbation,
     /// Template; `None`: [`Template::paper`].
     pub template: Option<Template>,
+    /// The camera the construction was designed for (`--fov-deg`); `None`: no camera
+    /// written, no headings.
+    pub camera: Option<CameraView>,
+}
+
+/// A camera a construction was designed for ([`super::fov`]): written as `[sensors.camera]
+/// fov_deg` and one `heading_deg` per agent, after checking at the target and at the
+/// initial positions that every triangle neighbour is at least the heading margin inside
+/// the view.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CameraView {
+    /// Field of view (degrees).
+    pub fov_deg: f64,
+    /// Heading margin (degrees).
+    pub heading_margin_deg: f64,
+    /// Every agent's heading (rad), in point order.
+    pub headings: Vec<f64>,
 }
 
 impl Default for ScenarioOptions {
@@ -199,6 +222,7 @@ impl Default for ScenarioOptions {
             leader: true,
             perturbation: Perturbation::default(),
             template: None,
+            camera: None,
         }
     }
 }
@@ -237,6 +261,15 @@ pub fn render_scenario(
         tpl.angle_margin_deg(),
         tpl.collision_distance(),
     )?;
+    let with_camera;
+    let tpl = match &o.camera {
+        Some(cam) => {
+            check_camera(points, &init.positions, c, cam)?;
+            with_camera = tpl.with_fov(cam.fov_deg);
+            &with_camera
+        }
+        None => tpl,
+    };
     let f = &c.figures;
     let n = points.len();
     let mut s = String::new();
@@ -305,6 +338,22 @@ pub fn render_scenario(
         init.shortened
     );
     let _ = writeln!(w, "#   so that every triangle starts valid and unfolded");
+    if let Some(cam) = &o.camera {
+        let _ = writeln!(
+            w,
+            "# Camera: field of view {}°, every agent's heading_deg chosen so that each triangle",
+            cam.fov_deg
+        );
+        let _ = writeln!(
+            w,
+            "#   neighbour stays at least {}° (the heading margin) inside its view, at the target",
+            cam.heading_margin_deg
+        );
+        let _ = writeln!(
+            w,
+            "#   and at the initial positions (docs/design.md, \"Designing for a camera\")"
+        );
+    }
     let _ = writeln!(
         w,
         "# Schema: docs/scenarios.md. Agent i is point i − 1 of the target."
@@ -345,6 +394,9 @@ pub fn render_scenario(
             q[0],
             q[1]
         );
+        if let Some(h) = o.camera.as_ref().and_then(|cam| cam.headings.get(i)) {
+            let _ = writeln!(w, "heading_deg = {}", deg(*h));
+        }
     }
     for t in &c.triangles {
         let [a, b, v] = t.vertices.map(|x| x + 1);
@@ -387,7 +439,57 @@ pub fn render_scenario(
     Ok(s)
 }
 
+/// Checks at the target and at the initial positions that every triangle neighbour is at
+/// least the heading margin inside its agent's view ([`super::fov::view_check`]).
+fn check_camera(
+    points: &[Point],
+    initial: &[Point],
+    c: &Construction,
+    cam: &CameraView,
+) -> Result<(), DesignError> {
+    let tris: Vec<[usize; 3]> = c.triangles.iter().map(|t| t.vertices).collect();
+    for (when, q) in [("target", points), ("initial positions", initial)] {
+        super::fov::view_check(
+            q,
+            &tris,
+            &cam.headings,
+            cam.fov_deg.to_radians(),
+            cam.heading_margin_deg.to_radians(),
+        )
+        .map_err(|(i, j, off)| {
+            DesignError::Camera(format!(
+                "at the {when}, agent {}'s neighbour {} is {:.2}° off its heading, beyond \
+                 F/2 − margin = {}°/2 − {}°",
+                i + 1,
+                j + 1,
+                off.to_degrees(),
+                cam.fov_deg,
+                cam.heading_margin_deg
+            ))
+        })?;
+    }
+    Ok(())
+}
+
 impl Template {
+    /// This template with `[sensors.camera] fov_deg` set to `fov_deg`.
+    fn with_fov(&self, fov_deg: f64) -> Self {
+        let mut t = self.clone();
+        let sensors = t
+            .table
+            .entry("sensors".to_owned())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        if let Some(s) = sensors.as_table_mut() {
+            let camera = s
+                .entry("camera".to_owned())
+                .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+            if let Some(cam) = camera.as_table_mut() {
+                cam.insert("fov_deg".to_owned(), toml::Value::Float(fov_deg));
+            }
+        }
+        t
+    }
+
     fn number_top(&self, key: &str) -> Option<f64> {
         let v = self.table.get(key)?;
         v.as_float().or_else(|| v.as_integer().map(|i| i as f64))

@@ -57,15 +57,21 @@ pub fn force_limit_note(model: &Model) -> Option<String> {
 
 /// Why some bearings are missing at the end, if a camera with a limited field of view
 /// or range leaves an agent without one of its triangles' neighbours at positions `q`
-/// (headings taken as the preset's `heading.initial`, spread ignored): part of the
-/// outcome's reason when the run does not converge.
+/// (each agent's heading its `[[agents]] heading_deg` if given, else the preset's
+/// `heading.initial`, spread ignored): part of the outcome's reason when the run does
+/// not converge.
 pub fn view_note(model: &Model, q: &[[f64; 2]]) -> Option<String> {
     let cam = model.sensors.camera.as_ref()?;
-    let heading = model.world.heading.map_or(0.0, |h| h.initial);
-    let d = [heading.cos(), heading.sin()];
+    let nominal = model.world.heading.map_or(0.0, |h| h.initial);
     let (cos_half, limited) = ((0.5 * cam.fov).cos(), cam.fov < std::f64::consts::TAU);
     for t in &model.triangles {
         for &i in &t.vertices {
+            let heading = model
+                .agents
+                .get(i)
+                .and_then(|a| a.heading)
+                .unwrap_or(nominal);
+            let d = [heading.cos(), heading.sin()];
             for &j in t.vertices.iter().filter(|&&j| j != i) {
                 let (Some(a), Some(b)) = (q.get(i), q.get(j)) else {
                     continue;

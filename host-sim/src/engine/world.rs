@@ -61,7 +61,10 @@ impl Headings {
         let (mut start, mut drift) = (Vec::with_capacity(n), Vec::with_capacity(n));
         for i in 0..n {
             let mut r = stream(key, i, CONSTANTS);
-            truth.push(h.initial + h.spread * (2.0 * r.random::<f64>() - 1.0));
+            // The spread is drawn whether or not the agent's heading is given, so that the
+            // draws after it (error, drift) do not depend on the scenario's headings.
+            let drawn = h.initial + h.spread * (2.0 * r.random::<f64>() - 1.0);
+            truth.push(model.agents.get(i).and_then(|a| a.heading).unwrap_or(drawn));
             start.push(h.error * normal(&mut r));
             drift.push(h.drift * normal(&mut r));
         }

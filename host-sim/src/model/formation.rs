@@ -22,6 +22,10 @@ pub struct AgentModel {
     pub friction: [f64; 2],
     /// `D^v` (diagonal).
     pub velocity_damping: [f64; 2],
+    /// The true initial heading (rad) given by the scenario (`[[agents]] heading_deg`):
+    /// wins over the heading model's `initial` and spread; `None`: the model's draw (0
+    /// without a heading model).
+    pub heading: Option<f64>,
 }
 
 /// One controlled angle, by agent index.

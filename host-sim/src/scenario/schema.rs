@@ -151,6 +151,11 @@ pub struct AgentSpec {
     /// `D^v`, default from `[agent_defaults]`.
     #[serde(default)]
     pub velocity_damping: Option<Diagonal>,
+    /// The agent's true initial heading (degrees): its body x axis and its camera's
+    /// boresight. Default: `heading.initial_deg` plus the spread draw (0 without
+    /// `[heading]`); a given value wins over the spread.
+    #[serde(default)]
+    pub heading_deg: Option<f64>,
 }
 
 /// One controlled angle of a triangle.

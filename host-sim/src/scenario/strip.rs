@@ -34,6 +34,7 @@ pub fn strip_model(n: usize, duration: f64) -> Result<Model, ScenarioErrors> {
                 mass: 1.0,
                 friction: [0.5, 0.5],
                 velocity_damping: [0.0, 0.0],
+                heading: None,
             }
         })
         .collect();

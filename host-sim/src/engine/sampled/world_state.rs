@@ -14,8 +14,8 @@ pub(super) struct WorldState {
     pub(super) wind: Option<Wind>,
     /// With own clocks: the agents that tick at the current step, each at its tick.
     due: Vec<Option<AgentTick>>,
-    /// Each agent's true heading (rad; 0 without a heading model): the camera's
-    /// boresight.
+    /// Each agent's true heading (rad; without a heading model the scenario's
+    /// `heading_deg`, else 0): the camera's boresight.
     pub(super) truth: Vec<f64>,
 }
 
@@ -25,9 +25,16 @@ impl WorldState {
         let w = &model.world;
         let headings = w.heading.as_ref().map(|h| Headings::new(model, h));
         Self {
-            truth: headings
-                .as_ref()
-                .map_or_else(|| vec![0.0; model.n()], |h| h.truth.clone()),
+            truth: headings.as_ref().map_or_else(
+                || {
+                    model
+                        .agents
+                        .iter()
+                        .map(|a| a.heading.unwrap_or(0.0))
+                        .collect()
+                },
+                |h| h.truth.clone(),
+            ),
             headings,
             clocks: w.clock.as_ref().map(|c| Clocks::new(model, c)),
             wind: w.wind.as_ref().map(|x| Wind::new(model, x)),

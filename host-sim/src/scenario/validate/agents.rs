@@ -65,6 +65,15 @@ pub(super) fn check(
             c.non_negative(InvalidValue, &f("friction"), friction[k]);
             c.non_negative(NonPositiveGain, &f("velocity_damping"), velocity_damping[k]);
         }
+        if let Some(h) = a.heading_deg {
+            if !(h.is_finite() && h.abs() <= 360.0) {
+                c.err(
+                    InvalidValue,
+                    &f("heading_deg"),
+                    format!("must be a finite angle in [-360, 360] degrees, got {h}"),
+                );
+            }
+        }
         agents.push(AgentModel {
             id: match a.id {
                 AgentId::Number(k) => u8::try_from(k).unwrap_or(0),
@@ -76,6 +85,7 @@ pub(super) fn check(
             mass,
             friction,
             velocity_damping,
+            heading: a.heading_deg.map(f64::to_radians),
         });
     }
     if s.agents.len() < 3 {
