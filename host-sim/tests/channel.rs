@@ -685,3 +685,35 @@ fn comm_rate_auto_picks_the_highest_rate_the_channel_carries() {
         "{e}"
     );
 }
+
+/// `"auto"` sizes the timeouts for the link's loss (docs/radio.md "comm_rate_hz =
+/// auto"): the 2×5 grid designed for the Crazyflie broadcasts at 33.3 Hz; with 10 %
+/// random loss on top of ALOHA's collisions its timeouts span 4.5 periods (0.135 s), with
+/// 20 % 5.5 (0.165 s), and with 20 % the grid stays in control over 100 s. Negative
+/// control: the same loss with the timeouts of a loss-free channel (3.5 periods, 0.105
+/// s) is not in control.
+#[test]
+fn comm_rate_auto_spans_more_broadcasts_under_random_loss() {
+    let grid = concat!(env!("CARGO_MANIFEST_DIR"), "/sweeps/world/grid2x5.toml");
+    let lossless = model(grid, &["duration=100"]);
+    assert!((lossless.limits.neighbour_timeout - 3.5 / (100.0 / 3.0)).abs() < 1e-9);
+    let ten = model(grid, &["duration=100", "radio.loss=0.1"]);
+    assert!((ten.limits.neighbour_timeout - 4.5 / (100.0 / 3.0)).abs() < 1e-9);
+    let lossy = model(grid, &["duration=100", "radio.loss=0.2"]);
+    assert!((lossy.limits.neighbour_timeout - 5.5 / (100.0 / 3.0)).abs() < 1e-9);
+    assert!((lossy.limits.bearing_hold - 0.165).abs() < 1e-9);
+    let r = run(&lossy);
+    assert_ne!(r.outcome, Outcome::NotInControl, "{}", r.reason);
+    let short = model(
+        grid,
+        &[
+            "duration=100",
+            "radio.loss=0.2",
+            "controller.comm_rate_hz=33.333333333333336",
+            "controller.neighbour_timeout=0.105",
+            "sensors.positions.max_age_s=0.105",
+            "controller.bearing_hold_s=0.105",
+        ],
+    );
+    assert_eq!(run(&short).outcome, Outcome::NotInControl);
+}

@@ -162,15 +162,53 @@ pub fn resolve_auto(mut model: Model) -> Model {
             .min(MAX_EVERY);
         }
     }
+    if model.comm_every > 1 {
+        let broadcasts = timeout_broadcasts(&model, auto.load.unwrap_or(0.0));
+        raise_timeouts_to(&mut model, &mut auto.raised, broadcasts);
+    }
     auto.rate_hz = 1.0 / (period * model.comm_every as f64);
     model.comm_auto = Some(auto);
     model
 }
 
+/// Broadcast periods the timeouts span at offered load `load` (docs/radio.md
+/// "comm_rate_hz = auto"): a link copy is lost with probability
+/// `ℓ = 1 − (1 − radio.loss) e^{−2G}` (ALOHA; `1 − (1 − radio.loss)` with TDMA), and a
+/// neighbour goes silent after `n` losses in a row; `n` is the smallest whole number, at
+/// least 3, with `ℓⁿ` at most what three losses in a row give at ALOHA's target load with
+/// no other loss (`(1 − e^{−0.2})³` = 0.6 %), plus the half period of the clocks'
+/// phases: [`TIMEOUT_BROADCASTS`] = 3.5 without random loss, 4.5 at 10 %, 5.5 at 20 %.
+fn timeout_broadcasts(model: &Model, load: f64) -> f64 {
+    let aloha = model
+        .radio
+        .channel
+        .as_ref()
+        .is_some_and(|c| c.access == Access::Aloha);
+    let access = if aloha { (-2.0 * load).exp() } else { 1.0 };
+    let lost = 1.0 - (1.0 - model.radio.loss) * access;
+    let reference = (1.0 - (-2.0 * ALOHA_LOAD_TARGET).exp()).powi(3);
+    let mut n = TIMEOUT_BROADCASTS - 0.5;
+    // `lost` < 1 (the validated loss is below 1); at most 64 losses in a row.
+    while lost.powf(n) > reference * (1.0 + 1e-9) && n < 64.0 {
+        n += 1.0;
+    }
+    n + 0.5
+}
+
 /// Raises the timeouts shorter than [`TIMEOUT_BROADCASTS`] broadcast periods to that,
 /// recording each in `raised` (once, with its file value).
 fn raise_timeouts(model: &mut Model, raised: &mut Vec<(&'static str, f64, f64)>) {
-    let need = TIMEOUT_BROADCASTS * model.comm_period();
+    raise_timeouts_to(model, raised, TIMEOUT_BROADCASTS);
+}
+
+/// Raises the timeouts shorter than `broadcasts` broadcast periods to that, recording
+/// each in `raised` (once, with its file value).
+fn raise_timeouts_to(
+    model: &mut Model,
+    raised: &mut Vec<(&'static str, f64, f64)>,
+    broadcasts: f64,
+) {
+    let need = broadcasts * model.comm_period();
     let mut raise = |key: &'static str, value: &mut f64| {
         let from = raised.iter().find(|r| r.0 == key).map_or(*value, |r| r.1);
         if from < need {
