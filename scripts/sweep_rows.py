@@ -4,6 +4,8 @@ per point, its runs' settle times and final angle errors (runs.csv)."""
 
 import csv
 import math
+import statistics
+from collections import Counter
 from pathlib import Path
 
 
@@ -41,3 +43,20 @@ def converged(point: dict) -> tuple[float, float, float]:
         float(point["converged_lo"]),
         float(point["converged_hi"]),
     )
+
+
+def row_cells(point: dict, runs: list[dict]) -> tuple[float, str]:
+    """A table row's cells after the first, from one point and its runs: runs, converged
+    fraction with its 95 % interval, median settle time of the converged runs, median
+    final angle error, and the other outcomes; with the converged fraction."""
+    settle, err = settle_times(runs), angle_errors_deg(runs)
+    frac, lo, hi = converged(point)
+    others = Counter(r["outcome"] for r in runs if r["outcome"] != "converged")
+    other_s = ", ".join(f"{k} {v}" for k, v in sorted(others.items())) or "–"
+    settle_s = f"{statistics.median(settle):.1f}" if settle else "–"
+    err_s = f"{statistics.median(err):.3f}" if err else "–"
+    cells = (
+        f"{len(runs)} | {100 * frac:.0f} % ({100 * lo:.0f}–{100 * hi:.0f} %) "
+        f"| {settle_s} | {err_s} | {other_s} |"
+    )
+    return frac, cells

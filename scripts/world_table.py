@@ -9,12 +9,10 @@ runs, the median final angle error, and the outcomes of the runs that did not co
 The last line names the deployment envelope: the points where at least 95 % converged.
 """
 
-import statistics
 import sys
-from collections import Counter
 from pathlib import Path
 
-from sweep_rows import angle_errors_deg, converged, load, settle_times
+from sweep_rows import load, row_cells
 
 
 def main() -> int:
@@ -34,17 +32,8 @@ def main() -> int:
     print("|---|---|---|---|---|---|")
     inside = []
     for p in points:
-        rs = by_point.get(p["point"], [])
-        settle, err = settle_times(rs), angle_errors_deg(rs)
-        frac, lo, hi = converged(p)
-        others = Counter(r["outcome"] for r in rs if r["outcome"] != "converged")
-        other_s = ", ".join(f"{k} {v}" for k, v in sorted(others.items())) or "–"
-        settle_s = f"{statistics.median(settle):.1f}" if settle else "–"
-        err_s = f"{statistics.median(err):.3f}" if err else "–"
-        print(
-            f"| {p[key]} | {len(rs)} | {100 * frac:.0f} % ({100 * lo:.0f}–{100 * hi:.0f} %) "
-            f"| {settle_s} | {err_s} | {other_s} |"
-        )
+        frac, cells = row_cells(p, by_point.get(p["point"], []))
+        print(f"| {p[key]} | {cells}")
         if frac >= 0.95:
             inside.append(p[key])
     print()

@@ -428,6 +428,19 @@ fn jobs_do_not_change_the_outputs_and_summary_only_skips_the_series() {
     assert!(!d.join("so").join("timeseries.csv").exists());
 }
 
+/// The lines of `host-sim ARGS`' standard error that contain `containing` (the command
+/// must succeed without a panic).
+fn validate_warnings(args: &[&str], containing: &str) -> Vec<String> {
+    let o = bin().args(args).output().expect("spawn host-sim");
+    no_panic(&o);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    text(&o.stderr)
+        .lines()
+        .filter(|l| l.contains(containing))
+        .map(str::to_owned)
+        .collect()
+}
+
 /// `validate` warns when a camera's field of view leaves an agent without one of its
 /// triangles' neighbours, at the start and in the target shape (the 2×5 grid in the
 /// camera world: its forward 87° camera cannot see a neighbour behind); an all-round
@@ -436,18 +449,12 @@ fn jobs_do_not_change_the_outputs_and_summary_only_skips_the_series() {
 fn validate_warns_when_a_camera_cannot_see_a_neighbour() {
     let grid = concat!(env!("CARGO_MANIFEST_DIR"), "/sweeps/world/grid2x5.toml");
     let warnings = |extra: &[&str]| {
-        let o = bin()
-            .args(["validate", grid, "--set", "world=crazyflie-camera"])
-            .args(extra)
-            .output()
-            .expect("spawn host-sim");
-        no_panic(&o);
-        assert!(o.status.success(), "{}", text(&o.stderr));
-        text(&o.stderr)
-            .lines()
-            .filter(|l| l.contains("out of view of its camera"))
-            .map(str::to_owned)
-            .collect::<Vec<_>>()
+        let args = [
+            &["validate", grid, "--set", "world=crazyflie-camera"],
+            extra,
+        ]
+        .concat();
+        validate_warnings(&args, "out of view of its camera")
     };
     let seen = warnings(&[]);
     assert_eq!(seen.len(), 2, "{seen:?}");
@@ -466,20 +473,8 @@ fn validate_warns_when_the_force_limit_is_above_what_the_vehicle_flies() {
         env!("CARGO_MANIFEST_DIR"),
         "/../crazyflie-app/formation.toml"
     );
-    let warned = |args: &[&str]| {
-        let o = bin()
-            .arg("validate")
-            .args(args)
-            .output()
-            .expect("spawn host-sim");
-        no_panic(&o);
-        assert!(o.status.success(), "{}", text(&o.stderr));
-        text(&o.stderr)
-            .lines()
-            .filter(|l| l.contains("controller.max_force"))
-            .map(str::to_owned)
-            .collect::<Vec<_>>()
-    };
+    let warned =
+        |args: &[&str]| validate_warnings(&[&["validate"], args].concat(), "controller.max_force");
     let seen = warned(&["formation-only", "--set", "world=crazyflie"]);
     assert_eq!(seen.len(), 1, "{seen:?}");
     assert!(

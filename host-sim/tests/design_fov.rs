@@ -296,16 +296,17 @@ fn a_full_circle_field_of_view_is_the_plain_design_byte_for_byte() {
     assert!(!body(&full).contains("heading_deg"));
 }
 
-#[test]
-fn the_designed_grid_converges_behind_its_cameras_and_not_without_its_headings() {
-    let dir = tempfile::tempdir().unwrap();
+/// The 2×5 grid designed for a 120° camera over `duration` seconds (lines of sight may
+/// pass the agents between, 5 % displacements), and the same file without its
+/// `heading_deg` lines.
+fn grid_at_120(duration: &str) -> (String, String) {
     let g = grid();
     let o = design(&[
         g.to_str().unwrap(),
         "--fov-deg",
         "120",
         "--duration",
-        "60",
+        duration,
         "--perturbation",
         "0.05",
         "--clearance",
@@ -313,11 +314,18 @@ fn the_designed_grid_converges_behind_its_cameras_and_not_without_its_headings()
     ]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
     let designed = text(&o.stdout);
-    let headless: String = designed
+    let headless = designed
         .lines()
         .filter(|l| !l.starts_with("heading_deg"))
         .map(|l| format!("{l}\n"))
         .collect();
+    (designed, headless)
+}
+
+#[test]
+fn the_designed_grid_converges_behind_its_cameras_and_not_without_its_headings() {
+    let dir = tempfile::tempdir().unwrap();
+    let (designed, headless) = grid_at_120("60");
     let run = |name: &str, s: &str| {
         let f = dir.path().join(format!("{name}.toml"));
         std::fs::write(&f, s).unwrap();
@@ -388,25 +396,7 @@ fn the_smallest_fields_of_view_are_measured() {
 #[test]
 fn under_a_heading_model_the_given_headings_turn_the_cameras() {
     let dir = tempfile::tempdir().unwrap();
-    let g = grid();
-    let o = design(&[
-        g.to_str().unwrap(),
-        "--fov-deg",
-        "120",
-        "--duration",
-        "300",
-        "--perturbation",
-        "0.05",
-        "--clearance",
-        "0",
-    ]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
-    let designed = text(&o.stdout);
-    let headless: String = designed
-        .lines()
-        .filter(|l| !l.starts_with("heading_deg"))
-        .map(|l| format!("{l}\n"))
-        .collect();
+    let (designed, headless) = grid_at_120("300");
     let safe_share = |name: &str, s: &str| {
         let f = dir.path().join(format!("{name}.toml"));
         std::fs::write(&f, s).unwrap();
