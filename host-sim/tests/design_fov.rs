@@ -150,20 +150,8 @@ const MARGIN_300: f64 = 13.0;
 fn designed_for_a_camera_every_neighbour_stays_in_view_with_the_margin() {
     // The 120° camera: lines of sight may pass other agents (`--clearance 0`;
     // with the bodies' occlusion the 2×5 grid needs 162°, below), displacements of 5 %.
-    let g = grid();
-    let o = design(&[
-        g.to_str().unwrap(),
-        "--fov-deg",
-        "120",
-        "--duration",
-        "300",
-        "--perturbation",
-        "0.05",
-        "--clearance",
-        "0",
-    ]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
-    let w = parse(&text(&o.stdout));
+    let (designed, _) = grid_at_120("300");
+    let w = parse(&designed);
     assert_eq!(w.fov_deg, Some(120.0));
     let h: Vec<f64> = w.headings.iter().map(|h| h.expect("heading_deg")).collect();
     assert_eq!(h.len(), 10);
@@ -177,6 +165,7 @@ fn designed_for_a_camera_every_neighbour_stays_in_view_with_the_margin() {
     // Negative control: the plain design of the same grid under the same camera fails
     // the same check with its agents' default heading (0), and for some agent with any
     // heading (its neighbours span more than F − 2·margin).
+    let g = grid();
     let plain = design(&[
         g.to_str().unwrap(),
         "--duration",
