@@ -100,14 +100,13 @@ impl Template {
     /// unslotted today (docs/design.md).
     pub fn slotted(mut self, n: usize) -> Self {
         use crate::model::channel::{
-            CRAZYFLIE_BIT_RATE, CRAZYFLIE_OVERHEAD_BYTES, CRAZYFLIE_TURNAROUND,
+            air_time, CRAZYFLIE_BIT_RATE as RATE, CRAZYFLIE_OVERHEAD_BYTES as OVERHEAD,
+            CRAZYFLIE_TURNAROUND,
         };
-        use ph_formation_core::wire::position::MAX_POSITION_LEN;
-        let bytes = (ph_formation_core::MAX_FRAME_LEN + MAX_POSITION_LEN) as f64
-            + 2.0 * CRAZYFLIE_OVERHEAD_BYTES;
+        use ph_formation_core::{wire::position::MAX_POSITION_LEN, MAX_FRAME_LEN};
+        let packet = |len| CRAZYFLIE_TURNAROUND + air_time(len, OVERHEAD, RATE);
         // To the nanosecond, so that the file reads 0.000697.
-        let slot =
-            ((2.0 * CRAZYFLIE_TURNAROUND + bytes * 8.0 / CRAZYFLIE_BIT_RATE) * 1e9).round() / 1e9;
+        let slot = ((packet(MAX_FRAME_LEN) + packet(MAX_POSITION_LEN)) * 1e9).round() / 1e9;
         let mut channel = toml::Table::new();
         channel.insert("access".to_owned(), toml::Value::String("tdma".to_owned()));
         channel.insert("slot".to_owned(), toml::Value::Float(slot));

@@ -114,10 +114,16 @@ pub struct ChannelModel {
     pub slot: f64,
 }
 
+/// Seconds on the air of a packet of `len` payload bytes with `overhead` bytes besides
+/// (preamble, address, control, CRC, header) at `bit_rate` bits per second.
+pub fn air_time(len: usize, overhead: f64, bit_rate: f64) -> f64 {
+    (len as f64 + overhead) * 8.0 / bit_rate
+}
+
 impl ChannelModel {
     /// Seconds on the air of a frame of `len` payload bytes.
     pub fn air_time(&self, len: usize) -> f64 {
-        (len as f64 + self.overhead_bytes) * 8.0 / self.bit_rate
+        air_time(len, self.overhead_bytes, self.bit_rate)
     }
 
     /// TDMA superframe length (s) for `n` agents.
