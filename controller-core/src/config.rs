@@ -172,6 +172,11 @@ pub enum LeaderRole {
     A,
     /// Agent `b` (force `+k_z z̃ + D_z ż`).
     B,
+    /// Either end of an edge whose orientation no one controls (S11b): only the distance
+    /// part, `(k_z (|p| − |z*|) + d_u u·ṗ) u` with `p` the partner offset and
+    /// `u = p/|p|`, which needs no common frame. For agents whose heading estimates
+    /// disagree (SPEC §7, "Heading disagreement").
+    Distance,
 }
 
 /// The leader-edge maneuver (S11).

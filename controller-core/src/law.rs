@@ -193,6 +193,30 @@ pub fn leader_force<T: Real>(k_z: T, d_z: &[T; 2], z_tilde: &Vec2<T>, z_dot: &Ve
     -(z_tilde * k_z) - diag_mul(d_z, z_dot)
 }
 
+/// S11b: the leader force of an edge whose orientation no one controls, on the end whose
+/// partner offset is `p` (partner minus self) and relative velocity `ṗ`:
+/// `U = (k_z (|p| − |z*|) + d_u u·ṗ) u` with `u = p/|p|` and `d_u = uᵀD_z u` (the
+/// gradient and the radial damping of `½ k_z (|z| − |z*|)²`). It is odd in `(p, ṗ)`, so
+/// both ends use it as is and their forces are opposite; it reads `p` only through its
+/// length and the agent's own bearing `u`, so it needs no common frame (SPEC §7, "Heading
+/// disagreement"). Zero at `p = 0`, where `u` is undefined.
+#[inline]
+pub fn leader_distance_force<T: Real>(
+    k_z: T,
+    d_z: &[T; 2],
+    p: &Vec2<T>,
+    z_star_norm: T,
+    p_dot: &Vec2<T>,
+) -> Vec2<T> {
+    let len = geometry::norm(p);
+    if len <= T::zero() {
+        return Vec2::new(T::zero(), T::zero());
+    }
+    let u = p / len;
+    let d_u = d_z[0] * u.x * u.x + d_z[1] * u.y * u.y;
+    u * (k_z * (len - z_star_norm) + d_u * u.dot(p_dot))
+}
+
 /// S12: velocity tracking `U^v_n = D^r_n v* − D^v_n (v_n − v*)`.
 #[inline]
 pub fn velocity_force<T: Real>(

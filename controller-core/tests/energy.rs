@@ -19,8 +19,13 @@ struct Check {
 
 /// V̇ from the agents' outputs vs S14 at one random state.
 fn check(f: &Formation, s: &State, seed: u64) -> Check {
+    check_forces_of(f, f, s, seed)
+}
+
+/// [`check`] with the agents of `agents_of` and the storage and S14 terms of `f`.
+fn check_forces_of(agents_of: &Formation, f: &Formation, s: &State, seed: u64) -> Check {
     let mut r = rng(seed ^ 0x5eed);
-    let mut agents = f.agents::<f64>();
+    let mut agents = agents_of.agents::<f64>();
     // Random estimates for every owned (angle, edge), all above r_min.
     for a in agents.iter_mut() {
         let owned: Vec<_> = a.owned_estimates().collect();
@@ -85,8 +90,17 @@ fn check(f: &Formation, s: &State, seed: u64) -> Check {
     if let Some((la, lb, k, dz, z_star)) = f.leader {
         let z = s.q[la] - s.q[lb];
         let z_dot = s.v[la] - s.v[lb];
-        add(k * (z - Vec2::from(z_star)).dot(&z_dot), &mut v_dot);
-        add(-energy::leader_dissipation(&dz, &z_dot), &mut s14);
+        if f.leader_distance {
+            // S13 with ½ k_z (|z| − |z*|)² and S14 with d_u (u·ż)² (S11b).
+            let u = z / z.norm();
+            let d_u = dz[0] * u.x * u.x + dz[1] * u.y * u.y;
+            let len_err = z.norm() - Vec2::from(z_star).norm();
+            add(k * len_err * u.dot(&z_dot), &mut v_dot);
+            add(-d_u * u.dot(&z_dot).powi(2), &mut s14);
+        } else {
+            add(k * (z - Vec2::from(z_star)).dot(&z_dot), &mut v_dot);
+            add(-energy::leader_dissipation(&dz, &z_dot), &mut s14);
+        }
     }
     Check { v_dot, s14, scale }
 }
@@ -142,7 +156,9 @@ fn energy_identity_holds_at_random_states() {
                 fan_positions(k, 0.2, &mut r),
             )
         };
-        let f = Formation::random(n, tris, &target, &mut r);
+        let mut f = Formation::random(n, tris, &target, &mut r);
+        // Every third state: the leaders hold only the distance (S11b).
+        f.leader_distance = seed % 3 == 0;
         let s = random_state(q, &mut r);
         let c = check(&f, &s, seed);
         let rel = (c.v_dot - c.s14).abs() / c.scale;
@@ -160,6 +176,33 @@ fn energy_identity_holds_at_random_states() {
         );
     }
     eprintln!("worst relative mismatch {worst:e}");
+}
+
+#[test]
+fn the_distance_leaders_storage_is_not_s11s() {
+    // Negative control of S11b's term: charged with S11's storage and dissipation (what
+    // the leaders of the paper would give), its V̇ misses S14 at generic states.
+    let mut misses = 0;
+    for seed in 0..50u64 {
+        let mut r = rng(seed);
+        let mut f = Formation::random(4, strip(4), &strip_positions(4, 0.1, &mut r), &mut r);
+        f.leader_distance = true;
+        let s = random_state(strip_positions(4, 0.2, &mut r), &mut r);
+        let distance = check(&f, &s, seed);
+        assert!((distance.v_dot - distance.s14).abs() <= 1e-9 * distance.scale);
+        // The same agents' forces, checked against S11's terms.
+        let mut held = f.clone();
+        held.leader_distance = false;
+        let c = check_forces_of(&f, &held, &s, seed);
+        if (c.v_dot - c.s14).abs() / c.scale > 1e-6 {
+            misses += 1;
+        }
+    }
+    assert!(
+        misses > 45,
+        "S11's terms matched S11b's forces in {} of 50",
+        50 - misses
+    );
 }
 
 #[test]

@@ -3,9 +3,12 @@
 mod testkit;
 
 use nalgebra::Rotation2;
+use ph_formation_core::Measurements;
 use ph_formation_core::Vec2;
 use rand::Rng;
-use testkit::{rng, sense_and_exchange, strip, strip_positions, Formation, HostAgent, State};
+use testkit::{
+    bearings, rng, sense_and_exchange, strip, strip_positions, Formation, HostAgent, State,
+};
 
 fn forces<T: ph_formation_core::Real>(
     f: &Formation,
@@ -122,4 +125,102 @@ fn f32_and_f64_agree() {
         }
     }
     eprintln!("worst f32/f64 relative difference {worst:e}");
+}
+
+/// The forces of formation `f` at rest at `q`, each agent measuring in its own frame, the
+/// world turned by `turn[i]` (its heading error), and each force turned back into the
+/// world as its body applies it.
+fn forces_in_own_frames(f: &Formation, q: &[Vec2<f64>], turn: &[f64]) -> Vec<Vec2<f64>> {
+    let s = State {
+        q: q.to_vec(),
+        v: vec![Vec2::zeros(); q.len()],
+    };
+    let mut agents: Vec<HostAgent<f64>> = f.agents::<f64>();
+    for a in agents.iter_mut() {
+        let owned: Vec<_> = a.owned_estimates().collect();
+        for e in owned {
+            let key = usize::from(e.apex) * 1000 + usize::from(e.far) * 10 + e.triangle;
+            assert!(a.set_estimate(&ph_formation_core::OwnedEstimate {
+                value: est(key),
+                ..e
+            }));
+        }
+    }
+    for (i, a) in agents.iter_mut().enumerate() {
+        let rot = Rotation2::new(turn[i]);
+        let mut b = bearings::<f64>(f, &s, i, true);
+        for m in &mut b {
+            m.bearing = rot * m.bearing;
+            m.rate = m.rate.map(|r| rot * r);
+        }
+        let partner = f
+            .leader
+            .and_then(|(la, lb, ..)| (i == la).then_some(lb).or((i == lb).then_some(la)));
+        let m = Measurements {
+            time: 0.0,
+            dt: 0.0,
+            velocity: Vec2::zeros(),
+            bearings: &b,
+            partner_offset: partner.map(|p| rot * (q[p] - q[i])),
+        };
+        a.sense(&m).expect("valid measurements");
+    }
+    for i in 0..agents.len() {
+        for j in f.neighbours(i) {
+            let (src, dst) = if i < j {
+                let (l, r) = agents.split_at_mut(j);
+                (&l[i], &mut r[0])
+            } else {
+                let (l, r) = agents.split_at_mut(i);
+                (&r[0], &mut l[j])
+            };
+            dst.receive_direct(src).expect("neighbour");
+        }
+    }
+    agents
+        .iter_mut()
+        .enumerate()
+        .map(|(i, a)| Rotation2::new(-turn[i]) * a.evaluate().expect("nominal").force)
+        .collect()
+}
+
+/// SPEC §7, "Heading disagreement": at rest with `v* = 0`, the angle law and S11b need no
+/// common frame: every agent may measure in its own turned frame and the forces in the
+/// world are the same. S11 is not (the negative control): each leader turns `z*`.
+#[test]
+fn distance_leaders_need_no_common_frame_and_s11_leaders_do() {
+    let (mut held_differs, mut worst) = (0, 0.0f64);
+    for seed in 0..100u64 {
+        let (mut f, s) = setup(seed);
+        f.v_star = [0.0; 2];
+        let mut r = rng(seed ^ 0xf7a3);
+        let turn: Vec<f64> = (0..f.n).map(|_| r.random_range(-0.5..0.5)).collect();
+        let zero = vec![0.0; f.n];
+        f.leader_distance = true;
+        let common = forces_in_own_frames(&f, &s.q, &zero);
+        let own = forces_in_own_frames(&f, &s.q, &turn);
+        for (c, o) in common.iter().zip(&own) {
+            let rel = (c - o).norm() / (1.0 + c.norm());
+            worst = worst.max(rel);
+            assert!(
+                rel <= 1e-9,
+                "seed {seed}: {c:?} in one frame, {o:?} in own frames"
+            );
+        }
+        f.leader_distance = false;
+        let common = forces_in_own_frames(&f, &s.q, &zero);
+        let own = forces_in_own_frames(&f, &s.q, &turn);
+        if common
+            .iter()
+            .zip(&own)
+            .any(|(c, o)| (c - o).norm() > 1e-6 * (1.0 + c.norm()))
+        {
+            held_differs += 1;
+        }
+    }
+    assert_eq!(
+        held_differs, 100,
+        "S11 leaders were frame-free in some states"
+    );
+    eprintln!("worst relative difference with S11b {worst:e}");
 }

@@ -578,6 +578,11 @@ enum ph_leader_role
    * Agent `b`.
    */
   PH_LEADER_B = 1,
+  /**
+   * Either end of an edge whose orientation no one controls: the distance part of S11
+   * alone (S11b), for agents whose heading estimates disagree.
+   */
+  PH_LEADER_DISTANCE = 2,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L

@@ -75,6 +75,9 @@ pub enum ph_leader_role {
     PH_LEADER_A = 0,
     /// Agent `b`.
     PH_LEADER_B = 1,
+    /// Either end of an edge whose orientation no one controls: the distance part of S11
+    /// alone (S11b), for agents whose heading estimates disagree.
+    PH_LEADER_DISTANCE = 2,
 }
 
 /// One controlled angle `α = (apex; v, w)` of a triangle.
@@ -307,6 +310,7 @@ fn role_to_core(r: u8) -> Result<LeaderRole, ph_status> {
     match r {
         x if x == ph_leader_role::PH_LEADER_A as u8 => Ok(LeaderRole::A),
         x if x == ph_leader_role::PH_LEADER_B as u8 => Ok(LeaderRole::B),
+        x if x == ph_leader_role::PH_LEADER_DISTANCE as u8 => Ok(LeaderRole::Distance),
         _ => Err(ph_status::PH_ERR_CONFIG_BAD_ENUM),
     }
 }
@@ -315,6 +319,7 @@ fn role_from_core(r: LeaderRole) -> ph_leader_role {
     match r {
         LeaderRole::A => ph_leader_role::PH_LEADER_A,
         LeaderRole::B => ph_leader_role::PH_LEADER_B,
+        LeaderRole::Distance => ph_leader_role::PH_LEADER_DISTANCE,
     }
 }
 
@@ -604,11 +609,11 @@ mod tests {
         assert_eq!(to_core(&c), Err(ph_status::PH_ERR_CONFIG_BAD_ENUM));
         let mut c = good;
         c.has_leader = 1;
-        c.leader.role = 2;
+        c.leader.role = 3;
         assert_eq!(to_core(&c), Err(ph_status::PH_ERR_CONFIG_BAD_ENUM));
         // Without has_leader the leader block is not read.
         let mut c = good;
-        c.leader.role = 2;
+        c.leader.role = 3;
         c.leader.displacement.count = 100;
         assert!(to_core(&c).is_ok());
     }

@@ -149,12 +149,18 @@ fn a_body_frame_run_is_the_world_frame_run_when_every_heading_is_known() {
 }
 
 /// A heading error turns what the agent senses and commands: a leader pair whose
-/// estimates are off turns the leader edge with them.
+/// estimates are off turns the leader edge with them when both hold `z*` in their own
+/// frames (`leader.orientation = "held"`, S11; the default there is S11b, tests/heading.rs).
 #[test]
 fn heading_errors_turn_the_leader_edge() {
     let r = run(&model(
         "paper",
-        &["duration=60", "heading.error_deg=5", "seed=3"],
+        &[
+            "duration=60",
+            "heading.error_deg=5",
+            "seed=3",
+            "leader.orientation=held",
+        ],
     ));
     let exact = run(&model("paper", &["duration=60", "seed=3"]));
     assert!(

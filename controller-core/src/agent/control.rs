@@ -233,6 +233,14 @@ impl<T: Real, const MT: usize, const NB: usize> Agent<T, MT, NB> {
                 LeaderRole::B => {
                     -law::leader_force(l.stiffness, &l.damping, &(p - z_star), &(v_p - v))
                 }
+                // S11b, the same on both ends: it is odd in (p, ṗ).
+                LeaderRole::Distance => law::leader_distance_force(
+                    l.stiffness,
+                    &l.damping,
+                    &p,
+                    crate::geometry::norm(&z_star),
+                    &(v_p - v),
+                ),
             };
         }
         if !finite_vec(&force) {

@@ -54,6 +54,8 @@ pub struct Formation {
     pub v_star: [f64; 2],
     /// The leader edge, if any.
     pub leader: Option<Leader>,
+    /// The leaders hold only the distance (S11b, [`LeaderRole::Distance`]), not S11.
+    pub leader_distance: bool,
     /// Estimator mode.
     pub mode: EstimatorMode,
 }
@@ -177,6 +179,7 @@ impl Formation {
                 diag(rng),
                 [rng.random_range(-2.0..2.0), rng.random_range(-2.0..2.0)],
             )),
+            leader_distance: false,
             mode: EstimatorMode::Shared,
         }
     }
@@ -229,7 +232,11 @@ impl Formation {
         if let Some((a, b, k, dz, z)) = self.leader {
             if i == a || i == b {
                 c.leader = Some(LeaderConfig {
-                    role: if i == a { LeaderRole::A } else { LeaderRole::B },
+                    role: match (self.leader_distance, i == a) {
+                        (true, _) => LeaderRole::Distance,
+                        (false, true) => LeaderRole::A,
+                        (false, false) => LeaderRole::B,
+                    },
                     partner: id(if i == a { b } else { a }),
                     stiffness: t(k),
                     damping: dz.map(t),

@@ -327,6 +327,7 @@ fn validate_command(
             let limits = [
                 crate::engine::speed_limit_note(&m),
                 crate::engine::force_limit_note(&m),
+                crate::engine::leader_orientation_note(&m),
             ];
             for w in limits.into_iter().flatten() {
                 eprintln!("warning: {w}");

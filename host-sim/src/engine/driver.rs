@@ -55,6 +55,44 @@ pub fn force_limit_note(model: &Model) -> Option<String> {
     ))
 }
 
+/// What `[leader] orientation` does that the scenario may not expect (SPEC §7, "Heading
+/// disagreement"): `held` in a world whose heading estimates disagree (the leaders pull
+/// toward two targets), or a free orientation under a `displacement` that turns `z*`
+/// (only `|z*|` is held). A warning, and part of the outcome's reason.
+pub fn leader_orientation_note(model: &Model) -> Option<String> {
+    use crate::model::LeaderOrientation;
+    let l = model.leader.as_ref()?;
+    if model.orientation_free(l.orientation) {
+        let first = l.displacement.steps.first()?.value;
+        let turn = l.displacement.steps.iter().find(|s| {
+            let [x, y] = s.value;
+            (first[0] * y - first[1] * x).abs() > 1e-9 * (x.hypot(y) * first[0].hypot(first[1]))
+                || first[0] * x + first[1] * y < 0.0
+        })?;
+        let why = if l.orientation == LeaderOrientation::Auto {
+            "auto: the world's heading estimates disagree"
+        } else {
+            "free"
+        };
+        Some(format!(
+            "leader.displacement turns z* at {} s, but leader.orientation is {why}: the \
+             leaders hold only |z*| (SPEC S11b) and the formation keeps the orientation it \
+             formed in",
+            turn.from
+        ))
+    } else if l.orientation == LeaderOrientation::Held && model.world.headings_disagree() {
+        Some(
+            "leader.orientation = \"held\" in a world whose heading estimates disagree \
+             ([heading]): each leader turns z* by its own heading error, so the two pull \
+             toward two targets and the formation drifts (SPEC §7, \"Heading \
+             disagreement\"); \"free\" (the default there) holds only |z*|"
+                .to_owned(),
+        )
+    } else {
+        None
+    }
+}
+
 /// Why some bearings are missing at the end, if a camera with a limited field of view
 /// or range leaves an agent without one of its triangles' neighbours at positions `q`
 /// (each agent's heading its `[[agents]] heading_deg` if given, else the preset's
@@ -117,6 +155,7 @@ pub fn run(
     }
     warnings.extend(speed_limit_note(model));
     warnings.extend(force_limit_note(model));
+    warnings.extend(leader_orientation_note(model));
     match model.mode {
         Mode::Sampled => {
             let mut e = SampledSim::new(model)?;
@@ -190,6 +229,7 @@ pub fn drive(
         for note in speed_limit_note(model)
             .into_iter()
             .chain(force_limit_note(model))
+            .chain(leader_orientation_note(model))
         {
             reason = format!("{reason}; {note}");
         }

@@ -1,7 +1,7 @@
 //! From the model to `controller-core`: each agent's `AgentConfig` and core agent
 //! (the host simulates `Agent<f64, MT, NB>`).
 
-use super::{AngleModel, Estimator, Model, ModelError};
+use super::{AngleModel, Estimator, LeaderOrientation, Model, ModelError};
 use ph_formation_core::{
     AgentConfig, AngleConfig, BearingFilter, EstimatorMode, LeaderConfig, LeaderRole, Limits,
     Schedule, ScheduleStep, TrackerConfig, TriangleConfig,
@@ -17,6 +17,17 @@ pub const NB: usize = ph_formation_core::MAX_NEIGHBOURS;
 pub type CoreAgent = ph_formation_core::Agent<f64, MT, NB>;
 
 impl Model {
+    /// Whether the leaders leave the orientation free (S11b on both ends) under
+    /// `[leader] orientation` (SPEC §7, "Heading disagreement"): `auto` does when the
+    /// world's heading estimates disagree.
+    pub fn orientation_free(&self, orientation: LeaderOrientation) -> bool {
+        match orientation {
+            LeaderOrientation::Held => false,
+            LeaderOrientation::Free => true,
+            LeaderOrientation::Auto => self.world.headings_disagree(),
+        }
+    }
+
     /// Core estimator mode.
     pub fn estimator_mode(&self) -> EstimatorMode {
         match self.estimator {
@@ -72,10 +83,15 @@ impl Model {
             u16::try_from(self.comm_every).map_err(|_| ModelError::CommEvery(self.comm_every))?;
         c.comm_phase = u16::try_from(self.comm_phase(i)).unwrap_or(0);
         if let Some(l) = &self.leader {
+            let (a, b) = if self.orientation_free(l.orientation) {
+                (LeaderRole::Distance, LeaderRole::Distance)
+            } else {
+                (LeaderRole::A, LeaderRole::B)
+            };
             let role = if l.a == i {
-                Some((LeaderRole::A, l.b))
+                Some((a, l.b))
             } else if l.b == i {
-                Some((LeaderRole::B, l.a))
+                Some((b, l.a))
             } else {
                 None
             };

@@ -68,4 +68,30 @@ pub struct LeaderModel {
     pub damping: [f64; 2],
     /// `z*(t)`.
     pub displacement: Schedule<f64>,
+    /// Who controls the edge's orientation (`[leader] orientation`).
+    pub orientation: LeaderOrientation,
+}
+
+/// `[leader] orientation`: whether the leader edge holds its orientation (SPEC §7,
+/// "Heading disagreement"; docs/scenarios.md).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LeaderOrientation {
+    /// `free` when the world's heading estimates disagree (a `[heading]` with an error, a
+    /// drift or noise), `held` otherwise.
+    #[default]
+    Auto,
+    /// Both leaders apply S11, each in its own frame (the paper): `z*` sets the scale
+    /// and the orientation.
+    Held,
+    /// Both leaders apply only the distance part (S11b), which needs no common frame:
+    /// `|z*|` sets the scale; no one controls the orientation.
+    Free,
+}
+
+impl LeaderOrientation {
+    /// Whether this is the default (left out when a scenario is written).
+    pub fn is_auto(&self) -> bool {
+        *self == Self::Auto
+    }
 }

@@ -34,7 +34,7 @@ pub use devices::{CameraModel, RadioDepartures, RadioModel, SensorDepartures, Se
 pub use error::ModelError;
 pub use estimates::{estimate_layout, resolve_estimates, EstimateInfo};
 pub use faults::{FaultKind, FaultModel, FAULT_KINDS};
-pub use formation::{AgentModel, AngleModel, LeaderModel, TriangleModel};
+pub use formation::{AgentModel, AngleModel, LeaderModel, LeaderOrientation, TriangleModel};
 pub use graph::Graph;
 pub use options::{BearingRate, Estimator, Mode};
 pub use sensing::SensingNoise;

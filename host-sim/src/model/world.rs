@@ -166,6 +166,13 @@ impl WorldModel {
             && clock.is_none()
     }
 
+    /// Whether the agents' heading estimates can differ from one another (an error, a
+    /// drift or noise): then no two agents share a frame exactly.
+    pub fn headings_disagree(&self) -> bool {
+        self.heading
+            .is_some_and(|h| h.error > 0.0 || h.drift > 0.0 || h.noise > 0.0)
+    }
+
     /// The vehicle's speed limit, if it has one (m/s).
     pub fn max_speed(&self) -> Option<f64> {
         match &self.vehicle {

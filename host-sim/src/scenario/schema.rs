@@ -4,7 +4,7 @@
 
 use super::settings::{AttackSpec, ControllerSpec, Integration, RadioSpec, SensorSpec};
 use super::world::{ClockSpec, HeadingSpec, PlantTable, WindSpec};
-use crate::model::{Criteria, Mode};
+use crate::model::{Criteria, LeaderOrientation, Mode};
 use serde::{Deserialize, Serialize};
 
 /// A diagonal 2×2 matrix: one number (`d·I`) or `[d_x, d_y]`.
@@ -203,6 +203,9 @@ pub struct LeaderSpec {
     pub damping: Diagonal,
     /// `z*(t)`.
     pub displacement: ScheduleSpec,
+    /// Who controls the edge's orientation: `auto` (default), `both`, `a`.
+    #[serde(default, skip_serializing_if = "LeaderOrientation::is_auto")]
+    pub orientation: LeaderOrientation,
 }
 
 /// A whole scenario file (schema in `docs/scenarios.md`).

@@ -37,6 +37,7 @@ pub(super) fn leader(
                     stiffness: l.stiffness,
                     damping: l.damping.pair(),
                     displacement,
+                    orientation: l.orientation,
                 }),
                 _ => None,
             }
