@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
-"""One markdown table of docs/world.md from a finished one-axis sweep folder.
+"""One markdown table of docs/world.md from a finished sweep folder.
 
 Usage: python3 scripts/world_table.py out/sweeps/world-<name>
 
-Per point: the swept value, runs, converged fraction with its 95 % Wilson interval (from
+Per point: the swept value (one column per axis), runs, converged fraction with its 95 % Wilson interval (from
 points.csv, as `host-sim sweep` computed it), the median settle time of the converged
 runs, the median final angle error, and the outcomes of the runs that did not converge.
 The last line names the deployment envelope: the points where at least 95 % converged.
@@ -23,21 +23,27 @@ def main() -> int:
     axis = [k for k in points[0].keys() if k.startswith("axis:")] or [
         k for k in points[0].keys() if "." in k
     ]
-    key = axis[0] if axis else "point"
-    name = key.removeprefix("axis:")
+    keys = axis or ["point"]
+    names = [k.removeprefix("axis:") for k in keys]
+    head = " | ".join(f"`{n}`" for n in names)
     print(
-        f"| `{name}` | runs | converged (95 % interval) | settle median (s) "
+        f"| {head} | runs | converged (95 % interval) | settle median (s) "
         "| final angle error median (°) | other outcomes |"
     )
-    print("|---|---|---|---|---|---|")
+    print("|" + "---|" * len(keys) + "---|---|---|---|---|")
     inside = []
     for p in points:
         frac, cells = row_cells(p, by_point.get(p["point"], []))
-        print(f"| {p[key]} | {cells}")
+        values = " | ".join(p[k] for k in keys)
+        print(f"| {values} | {cells}")
         if frac >= 0.95:
-            inside.append(p[key])
+            inside.append(", ".join(p[k] for k in keys))
     print()
-    print(f"≥ 95 % converged at `{name}` = {', '.join(inside) if inside else 'none'}")
+    if len(keys) == 1:
+        at, sep = f"`{names[0]}` = ", ", "
+    else:
+        at, sep = "(" + ", ".join(f"`{n}`" for n in names) + ") = ", "; "
+    print(f"≥ 95 % converged at {at}{sep.join(inside) if inside else 'none'}")
     return 0
 
 
