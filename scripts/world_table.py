@@ -9,6 +9,7 @@ runs, the median final angle error, and the outcomes of the runs that did not co
 The last line names the deployment envelope: the points where at least 95 % converged.
 """
 
+import json
 import sys
 from pathlib import Path
 
@@ -19,9 +20,12 @@ def main() -> int:
     if len(sys.argv) != 2:
         print(__doc__, file=sys.stderr)
         return 2
-    points, by_point = load(Path(sys.argv[1]))
-    axis = [k for k in points[0].keys() if k.startswith("axis:")] or [
-        k for k in points[0].keys() if "." in k
+    d = Path(sys.argv[1])
+    points, by_point = load(d)
+    # The axes as the sweep names them (sweep.json), else the columns that look like keys.
+    named = json.load(open(d / "sweep.json")).get("axes") if (d / "sweep.json").exists() else None
+    axis = [k for k in (named or []) if k in points[0]] or [
+        k for k in points[0].keys() if k.startswith("axis:") or "." in k
     ]
     keys = axis or ["point"]
     names = [k.removeprefix("axis:") for k in keys]

@@ -31,7 +31,8 @@
 //! urgency (an agent with one or two candidates left goes first); when the growth gets
 //! stuck it starts again from another start triangle with randomised scores, up to
 //! [`attempts`] times (deterministic for a seed), and then refuses, naming the agent that
-//! could not join and why.
+//! could not join and why. After the first design it tries [`MORE_ATTEMPTS`] more and
+//! writes the one whose thinnest triangle is widest.
 
 use super::error::DesignError;
 use super::laman::{Construction, DesignOptions};
@@ -83,6 +84,9 @@ pub struct CameraDesign {
     /// The attempt that succeeded (1-based).
     pub attempt: usize,
 }
+
+/// Attempts after the first that found a design, the best of which is written.
+pub const MORE_ATTEMPTS: usize = 32;
 
 /// Attempts before refusing: 1,000 up to 30 agents, fewer beyond (a failed attempt costs
 /// O(N²)): the smallest fields of view of docs/design.md were found with these.
@@ -236,7 +240,15 @@ pub fn construct_for_camera(
     }
     let total = attempts(n);
     let mut worst: Option<Stuck> = None;
+    // After the first design, [`MORE_ATTEMPTS`] more, and the one whose thinnest triangle
+    // is widest wins (the thinner the triangles, the more the angles' errors move the
+    // agents): `(smallest interior angle, triangles, attempt)`.
+    let mut best: Option<(f64, Vec<[usize; 3]>, usize)> = None;
+    let mut first_ok = None;
     for k in 0..total {
+        if first_ok.is_some_and(|f: usize| k > f + MORE_ATTEMPTS) {
+            break;
+        }
         let start = starts[k % starts.len()];
         let noise = if k == 0 {
             0.0
@@ -245,13 +257,25 @@ pub fn construct_for_camera(
         };
         let mut rng = ChaCha8Rng::seed_from_u64(cam.seed ^ (k as u64).wrapping_mul(0x9E37));
         match g.attempt(start, noise, &mut rng) {
-            Ok(tris) => return Ok(g.finish(tris, opts, k + 1)),
+            Ok(tris) => {
+                first_ok.get_or_insert(k);
+                let thinnest = tris
+                    .iter()
+                    .map(|&t| g.min_angle(t))
+                    .fold(f64::INFINITY, f64::min);
+                if best.as_ref().is_none_or(|(q, ..)| thinnest > *q) {
+                    best = Some((thinnest, tris, k + 1));
+                }
+            }
             Err(s) => {
                 if worst.as_ref().is_none_or(|w| s.placed > w.placed) {
                     worst = Some(s);
                 }
             }
         }
+    }
+    if let Some((_, tris, attempt)) = best {
+        return Ok(g.finish(tris, opts, attempt));
     }
     let s = worst.map_or_else(String::new, |s| s.reason);
     refuse(format!(

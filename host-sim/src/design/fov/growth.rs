@@ -111,7 +111,7 @@ impl Growth<'_> {
             })
     }
 
-    fn min_angle(&self, t: [usize; 3]) -> f64 {
+    pub(super) fn min_angle(&self, t: [usize; 3]) -> f64 {
         angles(t.map(|v| self.pts[v]))
             .into_iter()
             .fold(f64::INFINITY, f64::min)
