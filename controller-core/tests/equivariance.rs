@@ -7,14 +7,15 @@ use ph_formation_core::Measurements;
 use ph_formation_core::Vec2;
 use rand::Rng;
 use testkit::{
-    bearings, rng, sense_and_exchange, strip, strip_positions, Formation, HostAgent, State,
+    bearings, exchange, rng, sense_and_exchange, strip, strip_positions, Formation, HostAgent,
+    State,
 };
 
-fn forces<T: ph_formation_core::Real>(
+/// The agents of `f`, every owned estimate set to `estimates` of its key.
+fn agents_with<T: ph_formation_core::Real>(
     f: &Formation,
-    s: &State,
     estimates: &dyn Fn(usize) -> f64,
-) -> Vec<Vec2<f64>> {
+) -> Vec<HostAgent<T>> {
     let mut agents: Vec<HostAgent<T>> = f.agents::<T>();
     for a in agents.iter_mut() {
         let owned: Vec<_> = a.owned_estimates().collect();
@@ -26,6 +27,15 @@ fn forces<T: ph_formation_core::Real>(
             }));
         }
     }
+    agents
+}
+
+fn forces<T: ph_formation_core::Real>(
+    f: &Formation,
+    s: &State,
+    estimates: &dyn Fn(usize) -> f64,
+) -> Vec<Vec2<f64>> {
+    let mut agents = agents_with::<T>(f, estimates);
     sense_and_exchange(f, s, &mut agents, 0.0, 0.0);
     agents
         .iter_mut()
@@ -135,17 +145,7 @@ fn forces_in_own_frames(f: &Formation, q: &[Vec2<f64>], turn: &[f64]) -> Vec<Vec
         q: q.to_vec(),
         v: vec![Vec2::zeros(); q.len()],
     };
-    let mut agents: Vec<HostAgent<f64>> = f.agents::<f64>();
-    for a in agents.iter_mut() {
-        let owned: Vec<_> = a.owned_estimates().collect();
-        for e in owned {
-            let key = usize::from(e.apex) * 1000 + usize::from(e.far) * 10 + e.triangle;
-            assert!(a.set_estimate(&ph_formation_core::OwnedEstimate {
-                value: est(key),
-                ..e
-            }));
-        }
-    }
+    let mut agents = agents_with::<f64>(f, &est);
     for (i, a) in agents.iter_mut().enumerate() {
         let rot = Rotation2::new(turn[i]);
         let mut b = bearings::<f64>(f, &s, i, true);
@@ -165,18 +165,7 @@ fn forces_in_own_frames(f: &Formation, q: &[Vec2<f64>], turn: &[f64]) -> Vec<Vec
         };
         a.sense(&m).expect("valid measurements");
     }
-    for i in 0..agents.len() {
-        for j in f.neighbours(i) {
-            let (src, dst) = if i < j {
-                let (l, r) = agents.split_at_mut(j);
-                (&l[i], &mut r[0])
-            } else {
-                let (l, r) = agents.split_at_mut(i);
-                (&r[0], &mut l[j])
-            };
-            dst.receive_direct(src).expect("neighbour");
-        }
-    }
+    exchange(f, &mut agents);
     agents
         .iter_mut()
         .enumerate()

@@ -289,8 +289,20 @@ fn a_full_circle_field_of_view_is_the_plain_design_byte_for_byte() {
 /// pass the agents between, 5 % displacements), and the same file without its
 /// `heading_deg` lines.
 fn grid_at_120(duration: &str) -> (String, String) {
+    let designed = design_grid_at_120(duration, &[]);
+    let headless = designed
+        .lines()
+        .filter(|l| !l.starts_with("heading_deg"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    (designed, headless)
+}
+
+/// The grid designed at 120° whose lines of sight may pass agents (`extra`: more design
+/// options).
+fn design_grid_at_120(duration: &str, extra: &[&str]) -> String {
     let g = grid();
-    let o = design(&[
+    let mut args = vec![
         g.to_str().unwrap(),
         "--fov-deg",
         "120",
@@ -300,15 +312,11 @@ fn grid_at_120(duration: &str) -> (String, String) {
         "0.05",
         "--clearance",
         "0",
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    let o = design(&args);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
-    let designed = text(&o.stdout);
-    let headless = designed
-        .lines()
-        .filter(|l| !l.starts_with("heading_deg"))
-        .map(|l| format!("{l}\n"))
-        .collect();
-    (designed, headless)
+    text(&o.stdout)
 }
 
 #[test]
@@ -347,23 +355,8 @@ fn the_designed_grid_converges_behind_its_cameras_and_not_without_its_headings()
 #[test]
 fn the_120_degree_grid_converges_in_the_camera_world_when_bodies_hide_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    let g = grid();
-    let o = design(&[
-        g.to_str().unwrap(),
-        "--vehicle",
-        "crazyflie",
-        "--fov-deg",
-        "120",
-        "--duration",
-        "300",
-        "--perturbation",
-        "0.05",
-        "--clearance",
-        "0",
-    ]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
     let f = dir.path().join("g120.toml");
-    std::fs::write(&f, &o.stdout).unwrap();
+    std::fs::write(&f, design_grid_at_120("300", &["--vehicle", "crazyflie"])).unwrap();
     let run = |seed: u64, extra: &[&str]| {
         let mut sets = vec![
             "world=crazyflie-camera".to_owned(),

@@ -326,6 +326,11 @@ pub fn sense_and_exchange<T: ph_formation_core::Real>(
         };
         a.sense(&m).expect("valid measurements");
     }
+    exchange(f, agents);
+}
+
+/// Exchanges every agent's broadcast with its neighbours directly (no wire).
+pub fn exchange<T: ph_formation_core::Real>(f: &Formation, agents: &mut [HostAgent<T>]) {
     for i in 0..agents.len() {
         for j in f.neighbours(i) {
             let (src, dst) = if i < j {
