@@ -178,16 +178,22 @@ fn energy_identity_holds_at_random_states() {
     eprintln!("worst relative mismatch {worst:e}");
 }
 
+/// A random 4-agent strip and a random state of it, for case `seed`.
+fn strip4(seed: u64) -> (Formation, State) {
+    let mut r = rng(seed);
+    let f = Formation::random(4, strip(4), &strip_positions(4, 0.1, &mut r), &mut r);
+    let s = random_state(strip_positions(4, 0.2, &mut r), &mut r);
+    (f, s)
+}
+
 #[test]
 fn the_distance_leaders_storage_is_not_s11s() {
     // Negative control of S11b's term: charged with S11's storage and dissipation (what
     // the leaders of the paper would give), its V̇ misses S14 at generic states.
     let mut misses = 0;
     for seed in 0..50u64 {
-        let mut r = rng(seed);
-        let mut f = Formation::random(4, strip(4), &strip_positions(4, 0.1, &mut r), &mut r);
+        let (mut f, s) = strip4(seed);
         f.leader_distance = true;
-        let s = random_state(strip_positions(4, 0.2, &mut r), &mut r);
         let distance = check(&f, &s, seed);
         assert!((distance.v_dot - distance.s14).abs() <= 1e-9 * distance.scale);
         // The same agents' forces, checked against S11's terms.
@@ -211,10 +217,8 @@ fn energy_identity_detects_unshared_gains() {
     // its V̇ differs from S14 at generic states.
     let mut failures = 0;
     for seed in 0..50u64 {
-        let mut r = rng(seed);
-        let mut f = Formation::random(4, strip(4), &strip_positions(4, 0.1, &mut r), &mut r);
+        let (mut f, s) = strip4(seed);
         f.mode = EstimatorMode::PerAgent;
-        let s = random_state(strip_positions(4, 0.2, &mut r), &mut r);
         let c = check(&f, &s, seed);
         if (c.v_dot - c.s14).abs() / c.scale > 1e-6 {
             failures += 1;
