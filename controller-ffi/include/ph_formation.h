@@ -68,10 +68,11 @@
  * gained the second-order lead and its kept acceleration, `ph_actuator_set_second_lead`;
  * the safety policies `ph_policy_*` and `ph_separation_guard`, the position packet
  * `ph_position_*`; 7: `ph_frame_stats` gained `track_resets`, `ph_actuator` the gap
- * bound and stall limit of SPEC S21c, `ph_actuator_set_max_gap`). Compare the header's value with `ph_abi_version()` of the library
- * you link.
+ * bound and stall limit of SPEC S21c, `ph_actuator_set_max_gap`; 8: `ph_leader_role`
+ * gained `PH_LEADER_DISTANCE`, the frame-free leader of SPEC S11b). Compare the header's
+ * value with `ph_abi_version()` of the library you link.
  */
-#define PH_ABI_VERSION 7
+#define PH_ABI_VERSION 8
 
 /**
  * Two positions closer than this (m) are coincident: no bearing between them, and
