@@ -23,6 +23,7 @@ pub const REQUIRED: [&str; 3] = ["LICENSE-MIT", "LICENSE-APACHE", "README.md"];
 /// its own), then `cargo package --list` checked for [`REQUIRED`]. `--allow-dirty`: what
 /// is checked is the packaging, not whether the developer has committed.
 pub fn run() -> Result<(), String> {
+    clear_stale_extracts();
     let mut args = vec!["package", "--allow-dirty"];
     for (name, _) in CRATES {
         args.extend(["-p", name]);
@@ -34,6 +35,46 @@ pub fn run() -> Result<(), String> {
     }
     println!("packaged: {}", CRATES.map(|c| c.0).join(", "));
     Ok(())
+}
+
+/// Removes what earlier `cargo package` runs left of [`CRATES`] in cargo's extracted
+/// sources of local registries (`$CARGO_HOME/registry/src/-<hash>/<name>-<version>`).
+/// cargo names that directory by the temporary registry's path, not by the `.crate`'s
+/// checksum, and does not extract again when it exists: a clone at the same path as an
+/// earlier one (a CI checkout) would verify the C ABI crate against the earlier run's
+/// core. crates.io's sources (`index.crates.io-…`) are not touched.
+fn clear_stale_extracts() {
+    let home = std::env::var_os("CARGO_HOME")
+        .map(std::path::PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| std::path::Path::new(&h).join(".cargo")));
+    let Some(src) = home.map(|h| h.join("registry/src")) else {
+        return;
+    };
+    let Ok(registries) = std::fs::read_dir(&src) else {
+        return;
+    };
+    for reg in registries.flatten() {
+        // Local registries have no host name: their directory starts with `-`.
+        if !reg.file_name().to_string_lossy().starts_with('-') {
+            continue;
+        }
+        for (name, _) in CRATES {
+            let Ok(entries) = std::fs::read_dir(reg.path()) else {
+                continue;
+            };
+            for e in entries.flatten() {
+                let file = e.file_name();
+                let file = file.to_string_lossy();
+                let ours = file
+                    .strip_prefix(name)
+                    .and_then(|rest| rest.strip_prefix('-'))
+                    .is_some_and(|v| v.starts_with(|c: char| c.is_ascii_digit()));
+                if ours {
+                    let _ = std::fs::remove_dir_all(e.path());
+                }
+            }
+        }
+    }
 }
 
 /// `Err(file)`: the first of [`REQUIRED`] not among the listed files (one per line).
