@@ -346,12 +346,11 @@ fn the_designed_grid_converges_behind_its_cameras_and_not_without_its_headings()
 }
 
 /// Issue 43's done-when, as far as it exists: the grid designed `--vehicle crazyflie
-/// --fov-deg 120` (lines of
-/// sight may pass agents: no 120° design clears the bodies, docs/cameras.md) converges
-/// for 300 s under `world = "crazyflie-camera"` (its heading errors and drift, 1°
-/// bearings) for seeds 1–3 when the bodies hide nothing; the leaders hold |z*| (S11b, the
-/// world's default). Negative controls: the preset's occluding bodies (`not_in_control`),
-/// and the paper's S11 leaders (`held`).
+/// --fov-deg 120` (lines of sight may pass agents: no 120° design clears the bodies,
+/// docs/cameras.md) converges for 300 s under `world = "crazyflie-camera"` (its heading
+/// errors and drift, 1° bearings) for seeds 1–3 when the bodies hide nothing; the
+/// leaders hold |z*| (S11b, the world's default). Negative controls: the preset's
+/// occluding bodies (`not_in_control`), and the paper's S11 leaders (`held`).
 #[test]
 fn the_120_degree_grid_converges_in_the_camera_world_when_bodies_hide_nothing() {
     let dir = tempfile::tempdir().unwrap();
