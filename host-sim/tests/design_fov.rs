@@ -373,7 +373,24 @@ fn the_120_degree_grid_converges_in_the_camera_world_when_bodies_hide_nothing() 
         }
         c.output().unwrap().status.code()
     };
+    // validate names the hidden neighbour behind the preset's bodies, and not without them.
+    let validate = |extra: &[&str]| {
+        let mut c = bin();
+        c.arg("validate")
+            .arg(&f)
+            .args(["--set", "world=crazyflie-camera"]);
+        for s in extra {
+            c.args(["--set", s]);
+        }
+        text(&c.output().unwrap().stderr)
+    };
     let clear = ["sensors.camera.occlusion_radius_m=0"];
+    assert!(
+        validate(&[]).contains("is hidden from its camera by another agent's body"),
+        "{}",
+        validate(&[])
+    );
+    assert!(!validate(&clear).contains("hidden"), "{}", validate(&clear));
     for seed in 1..=3 {
         assert_eq!(run(seed, &clear), Some(0), "seed {seed}");
     }

@@ -94,14 +94,24 @@ pub fn leader_orientation_note(model: &Model) -> Option<String> {
 }
 
 /// Why some bearings are missing at the end, if a camera with a limited field of view
-/// or range leaves an agent without one of its triangles' neighbours at positions `q`
-/// (each agent's heading its `[[agents]] heading_deg` if given, else the preset's
-/// `heading.initial`, spread ignored): part of the outcome's reason when the run does
-/// not converge.
+/// or range, or another agent's body in the way, leaves an agent without one of its
+/// triangles' neighbours at positions `q` (each agent's heading its `[[agents]]
+/// heading_deg` if given, else the preset's `heading.initial`, spread ignored): part of
+/// the outcome's reason when the run does not converge.
 pub fn view_note(model: &Model, q: &[[f64; 2]]) -> Option<String> {
     let cam = model.sensors.camera.as_ref()?;
     let nominal = model.world.heading.map_or(0.0, |h| h.initial);
     let (cos_half, limited) = ((0.5 * cam.fov).cos(), cam.fov < std::f64::consts::TAU);
+    // The camera's own occlusion test (engine/sensors/occlusion.rs) on these positions.
+    let at: Vec<ph_formation_core::Vec2<f64>> = q
+        .iter()
+        .map(|p| ph_formation_core::Vec2::new(p[0], p[1]))
+        .collect();
+    let bodies = (cam.occlusion_radius > 0.0).then(|| {
+        let mut o = super::sensors::occlusion::Occluders::new(cam.occlusion_radius);
+        o.rebuild(&at);
+        o
+    });
     for t in &model.triangles {
         for &i in &t.vertices {
             let heading = model
@@ -117,8 +127,21 @@ pub fn view_note(model: &Model, q: &[[f64; 2]]) -> Option<String> {
                 let e = [b[0] - a[0], b[1] - a[1]];
                 let r = e[0].hypot(e[1]);
                 let outside = limited && d[0] * e[0] + d[1] * e[1] < r * cos_half;
+                let name = |k: usize| model.agents.get(k).map_or("?", |x| x.name.as_str());
+                let hidden = !outside
+                    && r <= cam.range
+                    && bodies.as_ref().is_some_and(|o| o.hides(&at, i, j, r));
+                if hidden {
+                    return Some(format!(
+                        "agent {}'s neighbour {} is hidden from its camera by another \
+                         agent's body (occlusion radius {} m: sensors.camera), so it has no \
+                         bearing to it",
+                        name(i),
+                        name(j),
+                        cam.occlusion_radius
+                    ));
+                }
                 if outside || r > cam.range {
-                    let name = |k: usize| model.agents.get(k).map_or("?", |x| x.name.as_str());
                     return Some(format!(
                         "agent {}'s neighbour {} is {} its camera ({}: sensors.camera), \
                          so it has no bearing to it",

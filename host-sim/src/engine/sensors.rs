@@ -17,7 +17,7 @@
 mod camera;
 mod draws;
 mod latency;
-mod occlusion;
+pub(crate) mod occlusion;
 mod shared_positions;
 mod source;
 

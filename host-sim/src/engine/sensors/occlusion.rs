@@ -18,7 +18,7 @@ type Body = GeomWithData<[f64; 2], usize>;
 
 /// The agents' bodies at one tick.
 #[derive(Debug)]
-pub(super) struct Occluders {
+pub(crate) struct Occluders {
     /// `ρ` (m, > 0).
     radius: f64,
     tree: RTree<Body>,
@@ -26,7 +26,7 @@ pub(super) struct Occluders {
 
 impl Occluders {
     /// No bodies yet, of radius `radius`.
-    pub(super) fn new(radius: f64) -> Self {
+    pub(crate) fn new(radius: f64) -> Self {
         Self {
             radius,
             tree: RTree::new(),
@@ -34,7 +34,7 @@ impl Occluders {
     }
 
     /// The bodies at positions `q`.
-    pub(super) fn rebuild(&mut self, q: &[Vec2<f64>]) {
+    pub(crate) fn rebuild(&mut self, q: &[Vec2<f64>]) {
         let bodies = q
             .iter()
             .enumerate()
@@ -46,7 +46,7 @@ impl Occluders {
 
     /// Whether agent `j` is hidden from agent `i` at positions `q` (those of the last
     /// [`Self::rebuild`]); `r = |q_j − q_i|`.
-    pub(super) fn hides(&self, q: &[Vec2<f64>], i: usize, j: usize, r: f64) -> bool {
+    pub(crate) fn hides(&self, q: &[Vec2<f64>], i: usize, j: usize, r: f64) -> bool {
         let (a, b) = (q[i], q[j]);
         let rho = self.radius;
         let lo = [a.x.min(b.x) - rho, a.y.min(b.y) - rho];
