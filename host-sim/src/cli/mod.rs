@@ -324,12 +324,7 @@ fn validate_command(
                 }
             }
             // Printed even with --quiet, as warnings are.
-            let limits = [
-                crate::engine::speed_limit_note(&m),
-                crate::engine::force_limit_note(&m),
-                crate::engine::leader_orientation_note(&m),
-            ];
-            for w in limits.into_iter().flatten() {
+            for w in crate::engine::model_notes(&m) {
                 eprintln!("warning: {w}");
             }
             if let Some(w) = crate::engine::load::overload_warning(&m) {

@@ -93,6 +93,20 @@ pub fn leader_orientation_note(model: &Model) -> Option<String> {
     }
 }
 
+/// Every note on what the scenario asks that the world will not give (the speed limit,
+/// the force limit, the leader edge's orientation), in that order: `run`'s and
+/// `validate`'s warnings, and part of a failed run's reason.
+pub fn model_notes(model: &Model) -> Vec<String> {
+    [
+        speed_limit_note(model),
+        force_limit_note(model),
+        leader_orientation_note(model),
+    ]
+    .into_iter()
+    .flatten()
+    .collect()
+}
+
 /// Why some bearings are missing at the end, if a camera with a limited field of view
 /// or range, or another agent's body in the way, leaves an agent without one of its
 /// triangles' neighbours at positions `q` (each agent's heading its `[[agents]]
@@ -176,9 +190,7 @@ pub fn run(
     if let Some(auto) = &model.comm_auto {
         warnings.push(super::load::auto_note(auto));
     }
-    warnings.extend(speed_limit_note(model));
-    warnings.extend(force_limit_note(model));
-    warnings.extend(leader_orientation_note(model));
+    warnings.extend(model_notes(model));
     match model.mode {
         Mode::Sampled => {
             let mut e = SampledSim::new(model)?;
@@ -249,11 +261,7 @@ pub fn drive(
         }
     }
     if verdict.outcome != crate::analysis::Outcome::Converged {
-        for note in speed_limit_note(model)
-            .into_iter()
-            .chain(force_limit_note(model))
-            .chain(leader_orientation_note(model))
-        {
+        for note in model_notes(model) {
             reason = format!("{reason}; {note}");
         }
         let at: Vec<[f64; 2]> = q.iter().map(|p| [p.x, p.y]).collect();

@@ -34,9 +34,7 @@ pub mod world;
 
 pub use continuous::ContinuousSim;
 pub use controller::{local_core, AgentController, LocalCore, LOCAL_CAPACITIES};
-pub use driver::{
-    drive, force_limit_note, leader_orientation_note, run, speed_limit_note, view_note,
-};
+pub use driver::{drive, model_notes, run, view_note};
 pub use error::{RunError, SetupError};
 pub use record::{NullRecorder, Recorder, Row};
 pub use result::RunResult;
