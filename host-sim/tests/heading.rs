@@ -49,6 +49,9 @@ fn a_grid_whose_headings_disagree_holds_with_free_orientation_and_not_with_held(
         );
         if *orientation == "auto" {
             assert_eq!(r.outcome, Outcome::Converged, "seed {seed}: {}", r.reason);
+            // In control: the agents were almost never in their safe output.
+            let safe = r.safe_share.unwrap_or(1.0);
+            assert!(safe < 0.01, "seed {seed}: {safe} of the outputs safe");
             assert!(
                 turn < 0.05 && grow < 0.02 && drift < 0.05,
                 "seed {seed}: turned {turn} rad, scale off by {grow}, drifted {drift} m"
